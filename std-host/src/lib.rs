@@ -1,0 +1,1 @@
+//! rrt on a host.
