@@ -67,6 +67,7 @@ pub mod error;
 pub mod fixed;
 pub mod proximity;
 pub mod raster;
+pub mod voxelize;
 
 pub use connectivity::Connectivity;
 pub use discrete_ray::{DiscreteRay, Face, Hit, WalkEnd};
