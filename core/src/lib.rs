@@ -65,6 +65,7 @@ pub mod connectivity;
 pub mod discrete_ray;
 pub mod error;
 pub mod fixed;
+pub mod geometry;
 pub mod proximity;
 pub mod raster;
 pub mod voxelize;
