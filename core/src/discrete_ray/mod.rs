@@ -305,17 +305,44 @@ impl DiscreteRay {
             return Err(RayError::ExtentMismatch);
         }
         let plane = raster.plane();
-        Ok(match mode {
-            Connectivity::Six => {
-                step::run::<{ step::SIX }, T>(&self.p, &mut self.s, plane, budget, test)
-            }
+        Ok(self.run(mode, |i| plane.get(i).copied(), budget, test))
+    }
+
+    fn run<C: Fn(usize) -> Option<u8>, T: FnMut(usize, u8) -> bool>(
+        &mut self,
+        mode: Connectivity,
+        cells: C,
+        budget: u32,
+        test: T,
+    ) -> WalkEnd {
+        let (p, s) = (&self.p, &mut self.s);
+        match mode {
+            Connectivity::Six => step::run::<{ step::SIX }, C, T>(p, s, cells, budget, test),
             Connectivity::TwentySix => {
-                step::run::<{ step::TWENTY_SIX }, T>(&self.p, &mut self.s, plane, budget, test)
+                step::run::<{ step::TWENTY_SIX }, C, T>(p, s, cells, budget, test)
             }
             Connectivity::Adaptive => {
-                step::run::<{ step::ADAPTIVE }, T>(&self.p, &mut self.s, plane, budget, test)
+                step::run::<{ step::ADAPTIVE }, C, T>(p, s, cells, budget, test)
             }
-        })
+        }
+    }
+
+    /// The ray's voxels in an *empty* raster of its extent (every cell
+    /// [`cell::EMPTY`], so Adaptive steps like TwentySix), without needing a
+    /// plane: for tools that list a ray's voxels, and for rasters too large
+    /// to allocate. Yields the same voxels as [`DiscreteRay::voxels`] over an
+    /// all-empty plane.
+    ///
+    /// ```
+    /// use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
+    /// use rrt_core::raster::Extent;
+    /// let huge = Extent::cube(65536).unwrap(); // 2^48 voxels: never allocated
+    /// let ray = DiscreteRay::new(huge, [0, 0, 0], [1, 1, 1]).unwrap().unwrap();
+    /// assert_eq!(ray.path(Connectivity::TwentySix).count(), 65536);
+    /// ```
+    #[must_use]
+    pub fn path(self, mode: Connectivity) -> Path {
+        Path { ray: self, mode }
     }
 
     /// Walks to the first non-transparent ([`cell::OPAQUE`]) voxel, with no
@@ -460,6 +487,19 @@ impl DiscreteRay {
         m
     }
 
+    /// The current voxel as a [`Visit`], unless the walk ended.
+    fn visit(&self, end: WalkEnd, cell: u8) -> Option<Visit> {
+        match end {
+            WalkEnd::Exit => None,
+            WalkEnd::Hit | WalkEnd::Budget => Some(Visit {
+                index: self.s.index,
+                cell,
+                moved: self.last_move(),
+                face: self.face(),
+            }),
+        }
+    }
+
     fn face(&self) -> Option<Face> {
         let last = self.s.last;
         if last == 0 {
@@ -479,6 +519,33 @@ impl DiscreteRay {
             axis,
             self.p.dir.get(axis).copied().unwrap_or(0) > 0,
         ))
+    }
+}
+
+/// Iterator over the voxels of a [`DiscreteRay`] in an empty raster, see
+/// [`DiscreteRay::path`].
+#[derive(Clone, Debug)]
+pub struct Path {
+    ray: DiscreteRay,
+    mode: Connectivity,
+}
+
+impl Path {
+    /// The ray in its current state.
+    #[must_use]
+    pub const fn ray(&self) -> &DiscreteRay {
+        &self.ray
+    }
+}
+
+impl Iterator for Path {
+    type Item = Visit;
+
+    fn next(&mut self) -> Option<Visit> {
+        let end = self
+            .ray
+            .run(self.mode, |_| Some(cell::EMPTY), 1, |_, _| false);
+        self.ray.visit(end, cell::EMPTY)
     }
 }
 
@@ -505,23 +572,11 @@ impl Iterator for Voxels<'_> {
         let mut seen = None;
         let end = self
             .ray
-            .walk(&self.raster, self.mode, 1, |index, cell| {
+            .walk(&self.raster, self.mode, 1, |_, cell| {
                 seen = Some(cell);
-                let _ = index;
                 false
             })
             .ok()?;
-        match end {
-            WalkEnd::Exit => None,
-            WalkEnd::Hit | WalkEnd::Budget => {
-                let cell = seen?;
-                Some(Visit {
-                    index: self.ray.s.index,
-                    cell,
-                    moved: self.ray.last_move(),
-                    face: self.ray.face(),
-                })
-            }
-        }
+        self.ray.visit(end, seen?)
     }
 }

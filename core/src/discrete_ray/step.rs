@@ -53,16 +53,18 @@ const fn bit(f: u32) -> u8 {
     1 << f
 }
 
-/// Walks from the current state, visiting at most `budget` voxels.
+/// Walks from the current state, visiting at most `budget` voxels. `cells`
+/// reads the plane (a slice lookup for a real raster, `Some(EMPTY)` for the
+/// empty raster of [`super::DiscreteRay::path`]).
 ///
 /// On return `s` describes the last visited voxel (the hit voxel after a hit),
 /// so that a later call continues exactly after it. Only the entry voxel is
 /// ever pending (`fresh`): a budget stop never advances past a visited voxel.
 #[inline(always)]
-pub(crate) fn run<const MODE: u8, T: FnMut(usize, u8) -> bool>(
+pub(crate) fn run<const MODE: u8, C: Fn(usize) -> Option<u8>, T: FnMut(usize, u8) -> bool>(
     p: &Params,
     s: &mut State,
-    plane: &[u8],
+    cells: C,
     budget: u32,
     mut test: T,
 ) -> WalkEnd {
@@ -88,7 +90,7 @@ pub(crate) fn run<const MODE: u8, T: FnMut(usize, u8) -> bool>(
         if left == 0 {
             return WalkEnd::Budget;
         }
-        let Some(&c) = plane.get(idx) else {
+        let Some(c) = cells(idx) else {
             s.done = true;
             return WalkEnd::Exit;
         };
@@ -101,7 +103,7 @@ pub(crate) fn run<const MODE: u8, T: FnMut(usize, u8) -> bool>(
         }
         cur = c;
     } else {
-        let Some(&c) = plane.get(idx) else {
+        let Some(c) = cells(idx) else {
             s.done = true;
             return WalkEnd::Exit;
         };
@@ -173,7 +175,7 @@ pub(crate) fn run<const MODE: u8, T: FnMut(usize, u8) -> bool>(
         }
 
         // ---- visit ----
-        let Some(&c) = plane.get(idx) else {
+        let Some(c) = cells(idx) else {
             // Unreachable for a ray set up on this extent (the crossing counts
             // keep the index inside); ending is the panic-free answer.
             break WalkEnd::Exit;
