@@ -53,6 +53,8 @@ pub mod oracle {
     //! Exact rational reference for discrete rays, written independently of
     //! the stepper: it collects every voxel-boundary crossing of the clipped
     //! ray, sorts them, and takes the voxel at the midpoint of each interval.
+    //! [`check_exact`] compares a ray's Six, TwentySix and Adaptive voxels with
+    //! it.
 
     use rrt_core::fixed::VOXEL;
 
@@ -257,6 +259,282 @@ pub mod oracle {
         match hi {
             Some(h) if h.lt(lo) => None,
             _ => Some(lo),
+        }
+    }
+
+    use rrt_core::check::check_ray;
+    use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
+    use rrt_core::raster::{Extent, Raster};
+
+    /// One ray to test.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Case {
+        /// Raster dimensions.
+        pub dims: [u32; 3],
+        /// Fixed-point origin.
+        pub origin: [i64; 3],
+        /// Fixed-point direction (for a segment, `end − origin`).
+        pub dir: [i32; 3],
+        /// A segment (`t ∈ [0, 1]`) rather than a half-line.
+        pub segment: bool,
+    }
+
+    pub fn make_ray(c: &Case) -> Option<DiscreteRay> {
+        let e = Extent::new(c.dims[0], c.dims[1], c.dims[2]).unwrap();
+        if c.segment {
+            let to = [0, 1, 2].map(|k| c.origin[k] + i64::from(c.dir[k]));
+            DiscreteRay::segment(e, c.origin, to).unwrap()
+        } else {
+            DiscreteRay::new(e, c.origin, c.dir).unwrap()
+        }
+    }
+
+    /// The voxels of `ray`, through `r` or, without a raster, through an empty one.
+    fn coords(
+        e: Extent,
+        ray: DiscreteRay,
+        r: Option<&Raster<'_>>,
+        mode: Connectivity,
+    ) -> Vec<[u32; 3]> {
+        match r {
+            Some(r) => ray
+                .voxels(r, mode)
+                .unwrap()
+                .map(|v| e.coord(v.index).unwrap())
+                .collect(),
+            None => ray.path(mode).map(|v| e.coord(v.index).unwrap()).collect(),
+        }
+    }
+
+    /// Checks one case against the oracle and runs every invariant checker; `plane` must match `case.dims`
+    /// (`None`: an empty raster, walked without a plane).
+    #[track_caller]
+    pub fn check_exact(case: &Case, plane: Option<&[u8]>, label: &str) {
+        let e = Extent::new(case.dims[0], case.dims[1], case.dims[2]).unwrap();
+        let raster = plane.map(|p| Raster::new(e, p).unwrap());
+        let r = raster.as_ref();
+        let p = passage(case.dims, case.origin, case.dir, case.segment);
+        let ray = make_ray(case);
+        let (p, ray) = match (p, ray) {
+            (None, None) => return,
+            (Some(p), Some(ray)) => (p, ray),
+            (p, ray) => panic!(
+                "{label}: oracle passage {:?} but ray {:?} for {case:?}",
+                p.is_some(),
+                ray.is_some()
+            ),
+        };
+        let to_u = |v: [i64; 3]| v.map(|x| u32::try_from(x).expect("oracle voxel inside"));
+        let expect: Vec<[u32; 3]> = p.intervals.iter().map(|(v, _)| to_u(*v)).collect();
+        assert_eq!(
+            ray.entry_voxel(),
+            expect[0],
+            "{label}: entry voxel, {case:?}"
+        );
+        assert_eq!(
+            ray.exit_voxel(),
+            *expect.last().unwrap(),
+            "{label}: exit voxel, {case:?}"
+        );
+
+        // Six: every interval voxel (⊇ every voxel whose interior the ray passes
+        // through) in order; extra voxels only where the ray crosses an edge or
+        // corner, and every voxel visited touches the ray, in parameter order.
+        let six = coords(e, ray, r, Connectivity::Six);
+        let mut want = expect.iter().peekable();
+        let mut last_touch = p.t_in;
+        for (i, v) in six.iter().enumerate() {
+            let t = touch(case.origin, case.dir, &p, *v).unwrap_or_else(|| {
+                panic!("{label}: six voxel #{i} {v:?} does not touch the ray, {case:?}")
+            });
+            assert!(
+                !t.lt(last_touch),
+                "{label}: six voxel #{i} {v:?} out of ray order, {case:?}"
+            );
+            last_touch = t;
+            if want.peek() == Some(&v) {
+                want.next();
+            } else {
+                // A tie voxel: it must touch the ray only where a crossing happens.
+                assert!(
+                    p.intervals.iter().any(|(_, start)| start.same(t)),
+                    "{label}: six voxel #{i} {v:?} is neither an interval voxel nor a tie voxel, {case:?}"
+                );
+            }
+        }
+        assert!(
+            want.next().is_none(),
+            "{label}: six ray skipped interval voxels, {case:?}\n six={six:?}\n want={expect:?}"
+        );
+        assert_eq!(
+            ray.crossings().map(|c| c as usize),
+            p.crossings,
+            "{label}: crossings, {case:?}"
+        );
+        assert_eq!(
+            six.len(),
+            1 + p.crossings.iter().sum::<usize>(),
+            "{label}: six count, {case:?}"
+        );
+
+        // TwentySix: the entry voxel, then the voxel holding the ray right after
+        // each driving-axis crossing.
+        let mut want26 = vec![expect[0]];
+        for t in &p.drive_crossings {
+            let (v, _) = p
+                .intervals
+                .iter()
+                .find(|(_, start)| start.same(*t))
+                .unwrap_or_else(|| panic!("{label}: no interval after a drive crossing"));
+            want26.push(to_u(*v));
+        }
+        assert_eq!(
+            ray.driving_axis(),
+            p.drive,
+            "{label}: driving axis, {case:?}"
+        );
+        let tws = coords(e, ray, r, Connectivity::TwentySix);
+        assert_eq!(tws, want26, "{label}: twenty-six voxels, {case:?}");
+
+        // Adaptive: a subsequence of six.
+        let ada = coords(e, ray, r, Connectivity::Adaptive);
+        let mut it = six.iter();
+        for v in &ada {
+            assert!(
+                it.any(|s| s == v),
+                "{label}: adaptive voxel {v:?} not on the six ray in order, {case:?}"
+            );
+        }
+
+        if let Some(r) = r {
+            for mode in Connectivity::ALL {
+                if let Err(v) = check_ray(r, &ray, mode) {
+                    panic!("{label}: {mode:?}: {v:?}, {case:?}");
+                }
+            }
+        }
+    }
+}
+
+pub mod fuzz {
+    //! Fuzz cases shared by the cargo-fuzz targets (`fuzz/`) and the stable
+    //! replay test (`tests/fuzz_regressions.rs`): the same `Arbitrary`
+    //! decoding and the same checkers run in both, so a crash file found by
+    //! the fuzzer replays exactly under `cargo test`.
+
+    use arbitrary::Arbitrary;
+    use rrt_core::check::check_adaptive_matches_six;
+    use rrt_core::discrete_ray::DiscreteRay;
+    use rrt_core::error::RayError;
+    use rrt_core::fixed::VOXEL;
+    use rrt_core::proximity::flag_neighbourhood;
+    use rrt_core::raster::{Extent, RasterMut, cell};
+
+    use crate::oracle::{Case, check_exact};
+
+    /// One fixed-point coordinate, biased towards the interesting ones.
+    #[derive(Arbitrary, Debug, Clone, Copy)]
+    pub enum Coord {
+        /// Any value (mostly out of the accepted range: must be refused).
+        Raw(i64),
+        /// Near the box, in fixed units.
+        Near(i32),
+        /// On a voxel boundary.
+        Lattice(i8),
+        /// At a voxel centre.
+        Centre(i8),
+    }
+
+    impl Coord {
+        fn fixed(self) -> i64 {
+            match self {
+                Self::Raw(v) => v,
+                Self::Near(v) => i64::from(v),
+                Self::Lattice(v) => i64::from(v) * VOXEL,
+                Self::Centre(v) => i64::from(v) * VOXEL + VOXEL / 2,
+            }
+        }
+    }
+
+    /// One direction component.
+    #[derive(Arbitrary, Debug, Clone, Copy)]
+    pub enum Component {
+        /// Any `i32`.
+        Raw(i32),
+        /// A small value (±1 of the last fractional bit and around).
+        Small(i8),
+        /// Whole voxels.
+        Voxels(i8),
+    }
+
+    impl Component {
+        fn fixed(self) -> i32 {
+            match self {
+                Self::Raw(v) => v,
+                Self::Small(v) => i32::from(v),
+                Self::Voxels(v) => i32::from(v) * (1 << 16),
+            }
+        }
+    }
+
+    /// A discrete ray through a small raster with random cells.
+    #[derive(Arbitrary, Debug, Clone)]
+    pub struct RayCase {
+        /// Raster dimensions, each taken modulo 32, plus one.
+        pub dims: [u8; 3],
+        /// Cell bits, repeated over the plane (bit 0 OPAQUE, bit 1 PROXIMITY).
+        pub cells: Vec<u8>,
+        /// Origin.
+        pub origin: [Coord; 3],
+        /// Direction, or segment extent.
+        pub dir: [Component; 3],
+        /// A segment rather than a half-line.
+        pub segment: bool,
+    }
+
+    /// Runs the oracle and every discrete-ray checker on `case`; panics on
+    /// the first violation (the fuzzer reports the panic as a crash).
+    pub fn run_ray_case(case: &RayCase) {
+        let dims = case.dims.map(|d| u32::from(d % 32) + 1);
+        let Ok(extent) = Extent::new(dims[0], dims[1], dims[2]) else {
+            unreachable!("dims in 1..=32")
+        };
+        let origin = case.origin.map(Coord::fixed);
+        let dir = case.dir.map(Component::fixed);
+        let c = Case {
+            dims,
+            origin,
+            dir,
+            segment: case.segment,
+        };
+        // Out-of-range inputs must be refused with the documented errors.
+        let set_up = if c.segment {
+            let to = [0, 1, 2].map(|k| origin[k].wrapping_add(i64::from(dir[k])));
+            DiscreteRay::segment(extent, origin, to)
+        } else {
+            DiscreteRay::new(extent, origin, dir)
+        };
+        match set_up {
+            Ok(_) => {}
+            Err(RayError::OriginOutOfRange { .. } | RayError::SegmentTooLong { .. }) => return,
+            Err(e) => panic!("setup failed for an accepted input: {e:?} {c:?}"),
+        }
+        let mut plane: Vec<u8> = (0..extent.len())
+            .map(|i| {
+                case.cells
+                    .get(i % case.cells.len().max(1))
+                    .map_or(0, |b| b & (cell::OPAQUE | cell::PROXIMITY))
+            })
+            .collect();
+        check_exact(&c, Some(&plane), "fuzz");
+        // With proper proximity flags, Adaptive must hit what Six hits.
+        let mut raster = RasterMut::new(extent, &mut plane).expect("plane length");
+        flag_neighbourhood(&mut raster);
+        let r = raster.as_raster();
+        if let Ok(Some(ray)) = set_up {
+            if let Err(v) = check_adaptive_matches_six(&r, &ray) {
+                panic!("adaptive missed a six hit: {v:?} {c:?}");
+            }
         }
     }
 }

@@ -29,6 +29,11 @@ use crate::raster::{RasterMut, cell, to_usize};
 /// ```
 pub fn flag_neighbourhood(raster: &mut RasterMut<'_>) {
     let [nx, ny, _] = raster.extent().dims().map(to_usize);
+    // Both non-zero and their product fits (it divides the plane length);
+    // checked anyway so that no chunking below can be asked for size 0.
+    let Some(slice) = nx.checked_mul(ny).filter(|&s| s != 0 && nx != 0) else {
+        return;
+    };
     let plane = raster.plane_mut();
     for c in plane.iter_mut() {
         *c = (*c & !cell::PROXIMITY)
@@ -43,7 +48,6 @@ pub fn flag_neighbourhood(raster: &mut RasterMut<'_>) {
         dilate_lines(row, 1);
     }
     // Along y: rows of nx cells within each z-slice.
-    let slice = nx.wrapping_mul(ny);
     for s in plane.chunks_exact_mut(slice) {
         dilate_lines(s, nx);
     }

@@ -118,13 +118,14 @@ pub(crate) fn setup(
     let size = n.map(|v| i128::from(v) << FRAC_BITS);
     let o = origin.map(i128::from);
     let d = dir.map(i128::from);
+    let ad = dir.map(|v| i128::from(v.unsigned_abs()));
 
     // Clip: t_in = max(0, near crossings), t_out = min(t_max, far crossings).
     let mut t_in = Rat::ZERO;
     let mut entry_axis: Option<usize> = None;
     let mut t_out: Option<Rat> = if segment { Some(Rat::ONE) } else { None };
     for k in 0..3 {
-        let (ok, dk, sk) = (o[k], d[k], size[k]);
+        let (ok, dk, sk, den) = (o[k], d[k], size[k], ad[k]);
         if dk == 0 {
             // Parallel to both faces of this slab: inside iff 0 <= O < size
             // (voxels are half-open, so the top face belongs to no voxel).
@@ -135,7 +136,6 @@ pub(crate) fn setup(
         }
         let (near, far) = if dk > 0 { (0, sk) } else { (sk, 0) };
         let sign = dk.signum();
-        let den = dk.abs();
         let tn = Rat {
             n: mul(sub(near, ok)?, sign)?,
             d: den,
@@ -213,9 +213,12 @@ pub(crate) fn setup(
             }
         }
     }
-    let ad = d.map(i128::abs);
+    let at = |v: &[i128; 3], k: usize| v.get(k).copied().ok_or(RayError::Arithmetic);
     let before = |j: usize, k: usize| -> Result<i64, RayError> {
-        let raw = sub(mul(dist[j], ad[k])?, mul(dist[k], ad[j])?)?;
+        let raw = sub(
+            mul(at(&dist, j)?, at(&ad, k)?)?,
+            mul(at(&dist, k)?, at(&ad, j)?)?,
+        )?;
         let v = add(mul(raw, 2)?, if j < k { -1 } else { 1 })?;
         i64::try_from(v).map_err(|_| RayError::Arithmetic)
     };
@@ -235,10 +238,13 @@ pub(crate) fn setup(
     };
     let frame = [a, b, c];
     let strides = extent.strides();
-    let off = frame.map(|k| match dir[k] {
-        0 => 0,
-        v if v > 0 => strides[k],
-        _ => strides[k].wrapping_neg(),
+    let off = frame.map(|k| {
+        let stride = strides.get(k).copied().unwrap_or(0);
+        match dir.get(k).copied().unwrap_or(0) {
+            0 => 0,
+            v if v > 0 => stride,
+            _ => stride.wrapping_neg(),
+        }
     });
     let diag = [
         off[0],
@@ -247,16 +253,14 @@ pub(crate) fn setup(
         off[0].wrapping_add(off[1]).wrapping_add(off[2]),
     ];
     let mut inc = [0i64; 3];
-    for (f, &k) in frame.iter().enumerate() {
-        let v = mul(mul(ad[k], i128::from(VOXEL))?, 2)?;
-        if let Some(slot) = inc.get_mut(f) {
-            *slot = i64::try_from(v).map_err(|_| RayError::Arithmetic)?;
-        }
+    for (slot, &k) in inc.iter_mut().zip(frame.iter()) {
+        let v = mul(mul(at(&ad, k)?, i128::from(VOXEL))?, 2)?;
+        *slot = i64::try_from(v).map_err(|_| RayError::Arithmetic)?;
     }
     let err = [before(a, b)?, before(a, c)?, before(b, c)?];
     let thr = [if a < b { -2 } else { 0 }, if a < c { -2 } else { 0 }];
     let index = extent.index(entry).ok_or(RayError::Arithmetic)?;
-    let entry_face = entry_axis.map(|k| Face::entered(k, dir[k] > 0));
+    let entry_face = entry_axis.map(|k| Face::entered(k, dir.get(k).is_some_and(|&v| v > 0)));
     let perm = frame.map(|k| {
         if k == 0 {
             0

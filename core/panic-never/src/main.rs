@@ -1,0 +1,130 @@
+//! A bare-metal binary that drives rrt-core's public traversal API with
+//! inputs the optimizer cannot see (volatile reads of static memory), linked
+//! with a panic handler that calls a symbol defined nowhere.
+//!
+//! If any panic is reachable from the code below (an index out of bounds,
+//! an overflow with overflow checks on, an unwrap, a division by zero), the
+//! optimizer must keep the call to the panic handler, the handler references
+//! `rrt_core_reachable_panic`, and the link fails with an undefined symbol.
+//! A successful link is the proof. See core/panic-never/README.md for what
+//! it does and does not cover.
+#![no_std]
+#![no_main]
+
+use core::panic::PanicInfo;
+use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
+
+use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
+use rrt_core::proximity::flag_neighbourhood;
+use rrt_core::raster::{Extent, Raster, RasterMut};
+
+unsafe extern "C" {
+    /// Deliberately undefined: referencing it fails the link.
+    fn rrt_core_reachable_panic() -> !;
+}
+
+#[panic_handler]
+fn panic(_: &PanicInfo<'_>) -> ! {
+    // SAFETY: never linked; a reference to it is a link error.
+    unsafe { rrt_core_reachable_panic() }
+}
+
+/// Opaque inputs: the optimizer must assume any bytes here.
+static mut INPUT: [u8; 256] = [0; 256];
+/// The raster plane.
+static mut PLANE: [u8; 16384] = [0; 16384];
+/// Results, so nothing is optimized away.
+static mut SINK: u64 = 0;
+
+fn input<const N: usize>(at: usize) -> [u8; N] {
+    let mut out = [0u8; N];
+    for (i, b) in out.iter_mut().enumerate() {
+        // SAFETY: in-bounds volatile reads of a static byte array.
+        *b = unsafe { read_volatile(addr_of!(INPUT).cast::<u8>().add((at + i) % 256)) };
+    }
+    out
+}
+fn u32_at(at: usize) -> u32 {
+    u32::from_le_bytes(input(at))
+}
+fn i32_at(at: usize) -> i32 {
+    i32::from_le_bytes(input(at))
+}
+fn i64_at(at: usize) -> i64 {
+    i64::from_le_bytes(input(at))
+}
+fn sink(v: u64) {
+    // SAFETY: a volatile write to a static.
+    unsafe { write_volatile(addr_of_mut!(SINK), read_volatile(addr_of!(SINK)) ^ v) };
+}
+
+fn mode(b: u8) -> Connectivity {
+    match b % 3 {
+        0 => Connectivity::Six,
+        1 => Connectivity::TwentySix,
+        _ => Connectivity::Adaptive,
+    }
+}
+
+fn drive() {
+    let Ok(extent) = Extent::new(u32_at(0), u32_at(4), u32_at(8)) else {
+        return sink(1);
+    };
+    sink(extent.len() as u64);
+    sink(u64::from(
+        extent.index([u32_at(12), u32_at(16), u32_at(20)]).is_some(),
+    ));
+    if let Some(c) = extent.coord(u32_at(24) as usize) {
+        sink(u64::from(c[0] ^ c[1] ^ c[2]));
+    }
+    // SAFETY: the only reference to PLANE while `drive` runs.
+    let plane: &mut [u8] = unsafe { &mut *addr_of_mut!(PLANE) };
+    let len = (u32_at(28) as usize).min(plane.len());
+    let plane = &mut plane[..len];
+    if let Ok(mut r) = RasterMut::new(extent, plane) {
+        flag_neighbourhood(&mut r);
+    }
+    // SAFETY: as above.
+    let plane: &[u8] = unsafe { &*addr_of!(PLANE) };
+    let raster = Raster::new(extent, &plane[..len]);
+    let origin = [i64_at(32), i64_at(40), i64_at(48)];
+    let dir = [i32_at(56), i32_at(60), i32_at(64)];
+    let end = [i64_at(68), i64_at(76), i64_at(84)];
+    let m = mode(input::<1>(92)[0]);
+    let budget = u32_at(96);
+    for ray in [
+        DiscreteRay::new(extent, origin, dir),
+        DiscreteRay::segment(extent, origin, end),
+    ] {
+        let Ok(Some(mut ray)) = ray else { continue };
+        sink(u64::from(ray.crossings()[0]) ^ ray.driving_axis() as u64);
+        if let Some(f) = ray.entry_face() {
+            sink(f.axis() as u64);
+        }
+        for v in ray.path(m).take(u32_at(100) as usize) {
+            sink(v.index as u64);
+        }
+        let Ok(raster) = raster else { continue };
+        match ray.walk(&raster, m, budget, |i, c| (i as u8 ^ c) & 3 == 0) {
+            Ok(WalkEnd::Hit) => sink(ray.hit().index as u64 ^ u64::from(ray.hit().steps)),
+            Ok(WalkEnd::Budget | WalkEnd::Exit) => sink(u64::from(ray.steps())),
+            Err(_) => sink(7),
+        }
+        while let Ok(Some(h)) = ray.first_hit(&raster, m) {
+            sink(h.index as u64 ^ u64::from(h.voxel[2]));
+        }
+        if let Ok(vs) = ray.voxels(&raster, mode(input::<1>(104)[0])) {
+            for v in vs {
+                sink(v.index as u64 ^ u64::from(v.cell));
+            }
+        }
+    }
+}
+
+/// Entry point (no runtime: this binary is only linked, never run).
+#[unsafe(no_mangle)]
+pub extern "C" fn _start() -> ! {
+    loop {
+        drive();
+    }
+}
