@@ -531,10 +531,10 @@ pub mod fuzz {
         let mut raster = RasterMut::new(extent, &mut plane).expect("plane length");
         flag_neighbourhood(&mut raster);
         let r = raster.as_raster();
-        if let Ok(Some(ray)) = set_up {
-            if let Err(v) = check_adaptive_matches_six(&r, &ray) {
-                panic!("adaptive missed a six hit: {v:?} {c:?}");
-            }
+        if let Ok(Some(ray)) = set_up
+            && let Err(v) = check_adaptive_matches_six(&r, &ray)
+        {
+            panic!("adaptive missed a six hit: {v:?} {c:?}");
         }
     }
 }
