@@ -139,7 +139,7 @@ pub struct RayReport {
 ///   TwentySix exactly `1 + crossings[driving]` and ends in the exit slice,
 ///   Adaptive at most `1 + Σ crossings` and ends in the exit slice;
 /// * `first_hit` and its resumption find the opaque voxels of the iteration
-///   in order, with the same step counts and faces;
+///   in order, with the same step counts, faces and whole resume state;
 /// * walking with budget 1 and 3, resumed until done, visits the same voxels.
 ///
 /// # Errors
@@ -346,7 +346,13 @@ fn check_hit_sequence(
         match (got, want) {
             (None, None) => break,
             (Some(h), Some((v, steps))) => {
-                if h.index != v.index || h.steps != steps || h.face != v.face {
+                // The whole resume state must agree, not just the hit: the
+                // unbounded walk reconstructs what its loop did not carry.
+                if h.index != v.index
+                    || h.steps != steps
+                    || h.face != v.face
+                    || walker != *iter.ray()
+                {
                     return Err(Violation::HitMismatch { nth });
                 }
                 if first.is_none() {

@@ -78,7 +78,7 @@ mod tests;
 
 use crate::error::RayError;
 use crate::raster::{Extent, Raster, cell};
-use params::{Params, Start};
+use params::Params;
 
 pub use crate::connectivity::Connectivity;
 
@@ -234,7 +234,7 @@ impl DiscreteRay {
     /// assert!(DiscreteRay::new(e, [-VOXEL, VOXEL, VOXEL], [-1, 0, 0]).unwrap().is_none());
     /// ```
     pub fn new(extent: Extent, origin: [i64; 3], dir: [i32; 3]) -> Result<Option<Self>, RayError> {
-        Ok(params::setup(extent, origin, dir, false)?.map(Self::from_setup))
+        params::setup(extent, origin, dir, false)
     }
 
     /// The segment from `from` to `to` (`t ∈ [0, 1]`), clipped to `extent`.
@@ -265,21 +265,7 @@ impl DiscreteRay {
             let delta = t.wrapping_sub(f);
             *slot = i32::try_from(delta).map_err(|_| RayError::SegmentTooLong { axis })?;
         }
-        Ok(params::setup(extent, from, dir, true)?.map(Self::from_setup))
-    }
-
-    fn from_setup((p, start): (Params, Start)) -> Self {
-        let s = State {
-            index: start.index,
-            err: start.err,
-            rem: start.rem,
-            steps: 0,
-            last: 0,
-            tie: false,
-            fresh: true,
-            done: false,
-        };
-        Self { p, s }
+        params::setup(extent, from, dir, true)
     }
 
     /// Walks the ray through `raster` until `test(index, cell)` accepts a
@@ -308,7 +294,7 @@ impl DiscreteRay {
         Ok(self.run(mode, |i| plane.get(i).copied(), budget, test))
     }
 
-    fn run<C: Fn(usize) -> Option<u8>, T: FnMut(usize, u8) -> bool>(
+    fn run<C: Fn(usize) -> Option<u8> + Copy, T: FnMut(usize, u8) -> bool>(
         &mut self,
         mode: Connectivity,
         cells: C,

@@ -39,6 +39,18 @@
 //     c: e2 -= inc_a, e3 -= inc_b
 // The terms stay within ±(2·S·max|D| + 1) < 2^49, so the wrapping adds below
 // never wrap; they are wrapping only so that no panic path exists.
+//
+// Specialisation. A walk is a sequence of *runs*: a 26-run takes 26-steps
+// and carries only the index, e1, e2 and the driving-axis counter (e3, the
+// minor counters and the step count are linear in the numbers of crossings
+// taken and are reconstructed exactly when the run ends); a 6-run takes
+// 6-steps and derives its step count from the crossings it consumed. Six is
+// one 6-run, TwentySix one 26-run, Adaptive alternates: a 26-run ends on a
+// voxel whose PROXIMITY flag is set (the paper's "one test per step"), a
+// 6-run on a voxel whose flag is clear with no tie pending. Walks whose
+// budget can stop them (the iterator's, the checkers') instead track every
+// variable at every step: they are the reference the checkers compare the
+// reconstructing runs against, state for state.
 
 use super::params::Params;
 use super::{State, WalkEnd};
@@ -48,9 +60,12 @@ pub(crate) const SIX: u8 = 0;
 pub(crate) const TWENTY_SIX: u8 = 1;
 pub(crate) const ADAPTIVE: u8 = 2;
 
-/// Moved-axes mask of a 6-step along frame axis `f`.
-const fn bit(f: u32) -> u8 {
-    1 << f
+/// How a run ended.
+enum Run {
+    /// The walk ends.
+    End(WalkEnd),
+    /// The current voxel asks for the other kind of step (Adaptive only).
+    Switch,
 }
 
 /// Walks from the current state, visiting at most `budget` voxels. `cells`
@@ -61,7 +76,11 @@ const fn bit(f: u32) -> u8 {
 /// so that a later call continues exactly after it. Only the entry voxel is
 /// ever pending (`fresh`): a budget stop never advances past a visited voxel.
 #[inline(always)]
-pub(crate) fn run<const MODE: u8, C: Fn(usize) -> Option<u8>, T: FnMut(usize, u8) -> bool>(
+pub(crate) fn run<
+    const MODE: u8,
+    C: Fn(usize) -> Option<u8> + Copy,
+    T: FnMut(usize, u8) -> bool,
+>(
     p: &Params,
     s: &mut State,
     cells: C,
@@ -72,6 +91,98 @@ pub(crate) fn run<const MODE: u8, C: Fn(usize) -> Option<u8>, T: FnMut(usize, u8
         return WalkEnd::Exit;
     }
     let mut left = budget;
+    if s.fresh {
+        // Visit the entry voxel.
+        if left == 0 {
+            return WalkEnd::Budget;
+        }
+        let Some(c) = cells(s.index) else {
+            s.done = true;
+            return WalkEnd::Exit;
+        };
+        left = left.wrapping_sub(1);
+        s.fresh = false;
+        s.steps = s.steps.wrapping_add(1);
+        if test(s.index, c) {
+            return WalkEnd::Hit;
+        }
+    }
+    // A walk visits at most one voxel per crossing left: when the budget
+    // covers them all it cannot stop the walk and need not be counted.
+    let [ra, rb, rc] = s.rem;
+    let most = u64::from(ra)
+        .wrapping_add(u64::from(rb))
+        .wrapping_add(u64::from(rc));
+    let end = if u64::from(left) > most {
+        drive::<MODE, false, C, T>(p, s, cells, &mut left, &mut test)
+    } else {
+        drive::<MODE, true, C, T>(p, s, cells, &mut left, &mut test)
+    };
+    if matches!(end, WalkEnd::Exit) {
+        s.done = true;
+    }
+    end
+}
+
+/// Runs the mode's steps from a visited voxel until the walk ends.
+#[inline(always)]
+fn drive<
+    const MODE: u8,
+    const BUDGETED: bool,
+    C: Fn(usize) -> Option<u8> + Copy,
+    T: FnMut(usize, u8) -> bool,
+>(
+    p: &Params,
+    s: &mut State,
+    cells: C,
+    left: &mut u32,
+    test: &mut T,
+) -> WalkEnd {
+    match MODE {
+        SIX => match six_run::<BUDGETED, false, C, T>(p, s, cells, left, test) {
+            Run::End(e) => e,
+            Run::Switch => WalkEnd::Exit, // a pure Six run never switches
+        },
+        TWENTY_SIX => match twenty_six_run::<BUDGETED, false, C, T>(p, s, cells, left, test) {
+            Run::End(e) => e,
+            Run::Switch => WalkEnd::Exit,
+        },
+        _ => loop {
+            let Some(cur) = cells(s.index) else {
+                return WalkEnd::Exit;
+            };
+            let r = if s.tie || cur & cell::PROXIMITY != 0 {
+                six_run::<BUDGETED, true, C, T>(p, s, cells, left, test)
+            } else {
+                twenty_six_run::<BUDGETED, true, C, T>(p, s, cells, left, test)
+            };
+            if let Run::End(e) = r {
+                return e;
+            }
+        },
+    }
+}
+
+/// 6-steps from the current voxel. With `ADAPTIVE`, the run also ends (with
+/// [`Run::Switch`]) after visiting a voxel whose PROXIMITY flag is clear
+/// when no tie is pending.
+///
+/// Not inlined: a run is called once per walk (or per switch), and its loop
+/// gets the registers to itself.
+#[inline(never)]
+fn six_run<
+    const BUDGETED: bool,
+    const ADAPTIVE: bool,
+    C: Fn(usize) -> Option<u8> + Copy,
+    T: FnMut(usize, u8) -> bool,
+>(
+    p: &Params,
+    s: &mut State,
+    cells: C,
+    left: &mut u32,
+    test: &mut T,
+) -> Run {
+    let start = *s;
     let mut idx = s.index;
     let [mut e1, mut e2, mut e3] = s.err;
     let [mut ra, mut rb, mut rc] = s.rem;
@@ -80,116 +191,88 @@ pub(crate) fn run<const MODE: u8, C: Fn(usize) -> Option<u8>, T: FnMut(usize, u8
     let mut tie = s.tie;
     let [off_a, off_b, off_c] = p.off;
     let [inc_a, inc_b, inc_c] = p.inc;
-    let diag = p.diag;
-    let [thr_b, thr_c] = p.thr;
-
-    // The cell of the current voxel: needed by Adaptive to choose the step.
-    let mut cur: u8;
-    if s.fresh {
-        // Visit the entry voxel.
-        if left == 0 {
-            return WalkEnd::Budget;
-        }
-        let Some(c) = cells(idx) else {
-            s.done = true;
-            return WalkEnd::Exit;
-        };
-        left = left.wrapping_sub(1);
-        steps = steps.wrapping_add(1);
-        s.fresh = false;
-        s.steps = steps;
-        if test(idx, c) {
-            return WalkEnd::Hit;
-        }
-        cur = c;
-    } else {
-        let Some(c) = cells(idx) else {
-            s.done = true;
-            return WalkEnd::Exit;
-        };
-        cur = c;
-    }
+    // Track the tie flag at every step when someone reads it during the run.
+    let track = BUDGETED || ADAPTIVE;
 
     let end = loop {
-        if left == 0 {
-            break WalkEnd::Budget;
-        }
-        // ---- advance: one step, one offset ----
-        let six = match MODE {
-            SIX => true,
-            TWENTY_SIX => false,
-            _ => tie || cur & cell::PROXIMITY != 0,
-        };
-        if six {
-            if e1 < 0 && e2 < 0 {
-                if ra == 0 {
-                    break WalkEnd::Exit;
-                }
-                ra = ra.wrapping_sub(1);
-                tie = e1 == -1 || e2 == -1;
-                idx = idx.wrapping_add(off_a);
-                e1 = e1.wrapping_add(inc_b);
-                e2 = e2.wrapping_add(inc_c);
-                last = bit(0);
-            } else if e1 > 0 && e3 < 0 {
-                if rb == 0 {
-                    break WalkEnd::Exit;
-                }
-                rb = rb.wrapping_sub(1);
-                tie = e1 == 1 || e3 == -1;
-                idx = idx.wrapping_add(off_b);
-                e1 = e1.wrapping_sub(inc_a);
-                e3 = e3.wrapping_add(inc_c);
-                last = bit(1);
-            } else {
-                if rc == 0 {
-                    break WalkEnd::Exit;
-                }
-                rc = rc.wrapping_sub(1);
-                // c never wins a tie against b (b < c), only against a.
-                tie = e2 == 1;
-                idx = idx.wrapping_add(off_c);
-                e2 = e2.wrapping_sub(inc_a);
-                e3 = e3.wrapping_sub(inc_b);
-                last = bit(2);
+        if BUDGETED {
+            if *left == 0 {
+                break Run::End(WalkEnd::Budget);
             }
-        } else {
+            *left = left.wrapping_sub(1);
+        }
+        // ---- advance: the earliest crossing ----
+        if e1 < 0 && e2 < 0 {
             if ra == 0 {
-                break WalkEnd::Exit;
+                break Run::End(WalkEnd::Exit);
             }
             ra = ra.wrapping_sub(1);
-            tie = false;
-            let sb = e1 > thr_b;
-            let sc = e2 > thr_c;
-            // All-ones when the minor axis steps, zero otherwise.
-            let mb = i64::from(sb).wrapping_neg();
-            let mc = i64::from(sc).wrapping_neg();
-            e1 = e1.wrapping_add(inc_b).wrapping_sub(inc_a & mb);
-            e2 = e2.wrapping_add(inc_c).wrapping_sub(inc_a & mc);
-            e3 = e3.wrapping_add(inc_c & mb).wrapping_sub(inc_b & mc);
-            rb = rb.wrapping_sub(u32::from(sb));
-            rc = rc.wrapping_sub(u32::from(sc));
-            let m = usize::from(sb) | (usize::from(sc) << 1);
-            idx = idx.wrapping_add(*diag.get(m).unwrap_or(&off_a));
-            last = 1 | (u8::from(sb) << 1) | (u8::from(sc) << 2);
+            if track {
+                tie = e1 == -1 || e2 == -1;
+            }
+            idx = idx.wrapping_add(off_a);
+            e1 = e1.wrapping_add(inc_b);
+            e2 = e2.wrapping_add(inc_c);
+            last = 1;
+        } else if e1 > 0 && e3 < 0 {
+            if rb == 0 {
+                break Run::End(WalkEnd::Exit);
+            }
+            rb = rb.wrapping_sub(1);
+            if track {
+                tie = e1 == 1 || e3 == -1;
+            }
+            idx = idx.wrapping_add(off_b);
+            e1 = e1.wrapping_sub(inc_a);
+            e3 = e3.wrapping_add(inc_c);
+            last = 2;
+        } else {
+            if rc == 0 {
+                break Run::End(WalkEnd::Exit);
+            }
+            rc = rc.wrapping_sub(1);
+            if track {
+                // c never wins a tie against b (b < c), only against a.
+                tie = e2 == 1;
+            }
+            idx = idx.wrapping_add(off_c);
+            e2 = e2.wrapping_sub(inc_a);
+            e3 = e3.wrapping_sub(inc_b);
+            last = 4;
         }
-
+        if BUDGETED {
+            steps = steps.wrapping_add(1);
+        }
         // ---- visit ----
         let Some(c) = cells(idx) else {
             // Unreachable for a ray set up on this extent (the crossing counts
             // keep the index inside); ending is the panic-free answer.
-            break WalkEnd::Exit;
+            break Run::End(WalkEnd::Exit);
         };
-        left = left.wrapping_sub(1);
-        steps = steps.wrapping_add(1);
         if test(idx, c) {
-            break WalkEnd::Hit;
+            break Run::End(WalkEnd::Hit);
         }
-        cur = c;
+        if ADAPTIVE && !tie && c & cell::PROXIMITY == 0 {
+            break Run::Switch;
+        }
     };
 
-    if matches!(end, WalkEnd::Exit) {
-        s.done = true;
+    if !BUDGETED {
+        // One voxel per crossing consumed.
+        let taken = start
+            .rem
+            .iter()
+            .zip([ra, rb, rc])
+            .fold(0u32, |t, (&r0, r)| t.wrapping_add(r0.wrapping_sub(r)));
+        steps = start.steps.wrapping_add(taken);
+        if !track && taken > 0 {
+            // The tie test of the last step, on the terms before it.
+            tie = match last {
+                1 => e1.wrapping_sub(inc_b) == -1 || e2.wrapping_sub(inc_c) == -1,
+                2 => e1.wrapping_add(inc_a) == 1 || e3.wrapping_sub(inc_c) == -1,
+                _ => e2.wrapping_add(inc_a) == 1,
+            };
+        }
     }
     s.index = idx;
     s.err = [e1, e2, e3];
@@ -197,5 +280,109 @@ pub(crate) fn run<const MODE: u8, C: Fn(usize) -> Option<u8>, T: FnMut(usize, u8
     s.steps = steps;
     s.last = last;
     s.tie = tie;
+    end
+}
+
+/// 26-steps from the current voxel. With `ADAPTIVE`, the run also ends (with
+/// [`Run::Switch`]) after visiting a voxel whose PROXIMITY flag is set.
+///
+/// Not inlined, as [`six_run`].
+#[inline(never)]
+fn twenty_six_run<
+    const BUDGETED: bool,
+    const ADAPTIVE: bool,
+    C: Fn(usize) -> Option<u8> + Copy,
+    T: FnMut(usize, u8) -> bool,
+>(
+    p: &Params,
+    s: &mut State,
+    cells: C,
+    left: &mut u32,
+    test: &mut T,
+) -> Run {
+    let start = *s;
+    let mut idx = s.index;
+    let [mut e1, mut e2, mut e3] = s.err;
+    let [mut ra, mut rb, mut rc] = s.rem;
+    let mut steps = s.steps;
+    let mut last = s.last;
+    let [inc_a, inc_b, inc_c] = p.inc;
+    let diag = p.diag;
+    let off_a = p.off[0];
+    let [thr_b, thr_c] = p.thr;
+    // Minor axes of the last step (bit 0 = b, bit 1 = c).
+    let mut minors = 0usize;
+
+    let end = loop {
+        if BUDGETED {
+            if *left == 0 {
+                break Run::End(WalkEnd::Budget);
+            }
+            *left = left.wrapping_sub(1);
+        }
+        // ---- advance: the driving crossing and the minors no later ----
+        if ra == 0 {
+            break Run::End(WalkEnd::Exit);
+        }
+        ra = ra.wrapping_sub(1);
+        let sb = e1 > thr_b;
+        let sc = e2 > thr_c;
+        // All-ones when the minor axis steps, zero otherwise.
+        let mb = i64::from(sb).wrapping_neg();
+        let mc = i64::from(sc).wrapping_neg();
+        e1 = e1.wrapping_add(inc_b).wrapping_sub(inc_a & mb);
+        e2 = e2.wrapping_add(inc_c).wrapping_sub(inc_a & mc);
+        minors = usize::from(sb) | (usize::from(sc) << 1);
+        idx = idx.wrapping_add(*diag.get(minors).unwrap_or(&off_a));
+        if BUDGETED {
+            e3 = e3.wrapping_add(inc_c & mb).wrapping_sub(inc_b & mc);
+            rb = rb.wrapping_sub(u32::from(sb));
+            rc = rc.wrapping_sub(u32::from(sc));
+            steps = steps.wrapping_add(1);
+            last = 1 | (u8::from(sb) << 1) | (u8::from(sc) << 2);
+        }
+        // ---- visit ----
+        let Some(c) = cells(idx) else {
+            break Run::End(WalkEnd::Exit);
+        };
+        if test(idx, c) {
+            break Run::End(WalkEnd::Hit);
+        }
+        if ADAPTIVE && c & cell::PROXIMITY != 0 {
+            break Run::Switch;
+        }
+    };
+
+    let k = start.rem[0].wrapping_sub(ra);
+    if !BUDGETED && k > 0 {
+        // e1 = e1₀ + k·inc_b − n_b·inc_a, and likewise for c: solve for the
+        // numbers of minor crossings (exact: inc_a > 0 since the ray moved).
+        // |k·inc| < 2^65, so this is done in i128, once per run.
+        let kb = i128::from(k);
+        let count = |e0: i64, e: i64, inc: i64| -> u32 {
+            let num = i128::from(e0)
+                .wrapping_add(kb.wrapping_mul(i128::from(inc)))
+                .wrapping_sub(i128::from(e));
+            u32::try_from(num.checked_div(i128::from(inc_a)).unwrap_or(0)).unwrap_or(0)
+        };
+        let nb = count(start.err[0], e1, inc_b);
+        let nc = count(start.err[1], e2, inc_c);
+        rb = start.rem[1].wrapping_sub(nb);
+        rc = start.rem[2].wrapping_sub(nc);
+        e3 = start.err[2]
+            .wrapping_add(inc_c.wrapping_mul(i64::from(nb)))
+            .wrapping_sub(inc_b.wrapping_mul(i64::from(nc)));
+        steps = start.steps.wrapping_add(k);
+        last = 1 | (u8::try_from(minors).unwrap_or(0) << 1);
+    }
+    s.index = idx;
+    s.err = [e1, e2, e3];
+    s.rem = [ra, rb, rc];
+    s.steps = steps;
+    s.last = last;
+    if k > 0 {
+        // 26-steps take ties with the driving step: none is left pending.
+        s.tie = false;
+    }
     end
 }
