@@ -74,5 +74,6 @@ pub use connectivity::Connectivity;
 pub use discrete_ray::{DiscreteRay, Face, Hit, WalkEnd};
 pub use error::{RasterError, RayError};
 pub use raster::{Extent, Raster, RasterMut};
+pub mod object_table;
 pub mod store;
 pub mod voxel;
