@@ -526,6 +526,46 @@ impl<'a> RecordStoreMut<'a> {
         }
     }
 
+    /// Calls `f` once per record, in storage order, with a read-only view of
+    /// the whole store, the record's voxel and a copy of the record; a
+    /// returned record replaces it. `f` must not change the key (the light
+    /// pass changes only visibility and illumination); a changed key is
+    /// restored so the store stays valid.
+    ///
+    /// # Errors
+    /// The first error `f` returns; records visited before it keep their
+    /// updates.
+    pub(crate) fn update_each<E, F>(&mut self, mut f: F) -> Result<(), E>
+    where
+        F: FnMut(RecordStore<'_>, [u32; 3], VoxelRecord) -> Result<Option<VoxelRecord>, E>,
+    {
+        let extent = self.extent;
+        let dir = self.dir;
+        for (b, w) in dir.windows(2).enumerate() {
+            let [lo, hi] = *w else { continue };
+            let Some(origin) = brick_origin(extent, b) else {
+                continue;
+            };
+            for k in to_usize(lo)..to_usize(hi) {
+                let Some(r) = self.records.get(k).copied() else {
+                    continue;
+                };
+                let view = RecordStore {
+                    extent,
+                    dir,
+                    records: self.records,
+                };
+                if let Some(mut new) = f(view, voxel_at(origin, r.position()), r)?
+                    && let Some(slot) = self.records.get_mut(k)
+                {
+                    new.key = r.key;
+                    *slot = new;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The record of voxel `v`, mutably.
     pub fn get_voxel_mut(&mut self, v: [u32; 3]) -> Option<&mut VoxelRecord> {
         let i = find(self.extent, self.dir, self.records, v)?;
