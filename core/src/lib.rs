@@ -74,3 +74,10 @@ pub use connectivity::Connectivity;
 pub use discrete_ray::{DiscreteRay, Face, Hit, WalkEnd};
 pub use error::{RasterError, RayError};
 pub use raster::{Extent, Raster, RasterMut};
+pub mod csg;
+pub mod light;
+pub mod object_table;
+pub mod store;
+#[cfg(test)]
+mod testkit;
+pub mod voxel;

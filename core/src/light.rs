@@ -1,0 +1,430 @@
+//! Light visibility and the precomputed view-independent illumination.
+//!
+//! After the scene is built (the plane is complete), [`illuminate`] fires,
+//! from every record's voxel centre and for every light, a discrete shadow
+//! ray through the raster ([`DiscreteRay::segment`] towards the light,
+//! clipped by the raster; a light outside the raster is reached when the
+//! ray leaves it) and stores in the record's 2-bit field
+//! ([`LightVisibility`]): visible, occluded, or visible through translucent
+//! material only (blockers whose material has transmission `T > 0` and no
+//! opaque blocker). Then it precomputes
+//!
+//! ```text
+//! illum = I_a·Kd·C + Σ_{lights marked Visible, N·L > 0} I·L_rgb·Kd·C·(N·L)
+//! ```
+//!
+//! in fixed point, saturating at 1.0 (C: the record's colour, Kd: its
+//! material's, N: the stored normal, L: the unit direction from the voxel
+//! centre to the light, normalized with an integer square root). Lights
+//! marked translucent are left to the renderer, which fires their shadow ray
+//! and adds their attenuated diffuse term.
+//!
+//! # Facing away
+//! A light the stored normal faces away from (`N·L ≤ 0`) gets no light, as
+//! in the SPD: on a closed shape ([`Shape::is_closed`]) it is marked
+//! occluded without firing a ray. An open shape (triangle, patch, open
+//! cone) can be seen from both sides; for a light behind it the shadow ray is
+//! fired from the back side (with `−N`) and the bits say whether the back
+//! side sees the light. `illum` holds the front side's (the stored
+//! normal's) sum only; a renderer that sees the back of an open surface adds
+//! the diffuse terms of the lights on the back from their bits.
+//!
+//! # No self-shadowing acne
+//! A voxelized surface is a layer about two voxels thick (up to
+//! `2·½(|nx|+|ny|+|nz|) ≤ √3` voxels for a 26-separating one), so a shadow
+//! ray leaving a surface voxel towards a light the surface faces, and more
+//! so at grazing angles, runs through neighbouring voxels of the same
+//! surface before it gets clear. Those must not count as blockers. The
+//! rule: an opaque voxel `b` met by the shadow ray from voxel centre `c₀`
+//! with (light-side) normal `N₀` is ignored when
+//!
+//! 1. its centre lies at most [`LightParams::slab`] (default 2 voxels)
+//!    above `c₀`'s tangent plane: `(c_b − c₀)·N₀ ≤ slab`, **and**
+//! 2. it belongs to the same object, or to a surface oriented like this one
+//!    (stored normals within 60°, [`LightParams::same_surface_cos`]): the
+//!    neighbouring triangle of a mesh or patch of a teapot.
+//!
+//! Why this is right: every voxel of a surface layer lies within its
+//! half-thickness `w ≤ √3/2` of the surface, so near `c₀` the layer fills
+//! heights `≤ 2w < 2` voxels above `c₀`'s tangent plane; a convex object
+//! lies entirely below that plane plus `2w`, so it never shadows itself
+//! where `N·L > 0` (the lone-sphere test: every voxel facing the light is
+//! visible, every voxel facing away occluded). A **concave** object still
+//! shadows itself: the far side of a torus's hole, the body of a teapot
+//! under its spout, rise higher than two voxels above the tangent plane and
+//! block. What the rule gives up is self-shadowing by parts of the surface
+//! less than two voxels above the tangent plane, below the raster's
+//! resolution. Condition 2 keeps contact shadows: a sphere resting on a
+//! floor has, near the contact, normals facing the floor's, so its voxels
+//! block the floor's shadow rays even within the slab.
+//!
+//! A voxel whose record is missing (a plane that does not match the store)
+//! counts as an opaque blocker.
+
+use core::fmt;
+
+use crate::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
+use crate::error::RayError;
+use crate::fixed::{VOXEL, voxel_centre};
+use crate::object_table::{Lights, Materials, ObjectTable, SCALAR_BITS};
+use crate::raster::{Extent, Raster, cell};
+use crate::store::{RecordStore, RecordStoreMut};
+use crate::voxel::{LightVisibility, VoxelRecord, dot_unit, normalize};
+use crate::voxelize::NORMAL_ONE;
+
+/// Tuning of the shadow rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LightParams {
+    /// Connectivity of the shadow rays. 6-connected rays (the default) go
+    /// through every voxel the continuous ray pierces, so a 6-tunnel-free
+    /// scene cannot leak light.
+    pub mode: Connectivity,
+    /// Height above a voxel's tangent plane (fixed units) below which
+    /// voxels of the same surface are ignored: 2 voxels by default (module
+    /// docs).
+    pub slab: i64,
+    /// Two stored normals with dot product at least this
+    /// ([`NORMAL_ONE`]-scaled) belong to one surface for the acne rule:
+    /// `NORMAL_ONE / 2` (60°) by default.
+    pub same_surface_cos: i32,
+}
+
+impl Default for LightParams {
+    fn default() -> Self {
+        Self {
+            mode: Connectivity::Six,
+            slab: VOXEL.wrapping_mul(2),
+            same_surface_cos: NORMAL_ONE / 2,
+        }
+    }
+}
+
+/// Why the light pass stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum LightError {
+    /// The raster and the store have different dimensions.
+    ExtentMismatch,
+    /// A shadow ray could not be set up (a light position beyond
+    /// [`crate::discrete_ray::ORIGIN_LIMIT`] on an axis is clamped first, so
+    /// this reports an internal limit).
+    Ray(RayError),
+}
+
+impl fmt::Display for LightError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::ExtentMismatch => f.write_str("raster and record store differ in size"),
+            Self::Ray(e) => write!(f, "shadow ray: {e}"),
+        }
+    }
+}
+
+impl core::error::Error for LightError {}
+
+impl From<RayError> for LightError {
+    fn from(e: RayError) -> Self {
+        Self::Ray(e)
+    }
+}
+
+/// Counts from one light pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct LightReport {
+    /// Records processed.
+    pub records: u64,
+    /// Shadow rays fired.
+    pub rays: u64,
+    /// (record, light) pairs marked visible.
+    pub visible: u64,
+    /// Pairs marked translucent.
+    pub translucent: u64,
+    /// Pairs blocked by an opaque voxel.
+    pub occluded: u64,
+    /// Pairs on a closed shape facing away from the light (occluded, no
+    /// ray fired).
+    pub facing_away: u64,
+    /// Records whose object id or material is not in the tables (treated
+    /// as a closed, opaque, non-diffuse object).
+    pub missing: u64,
+}
+
+/// Fires the shadow rays and fills [`VoxelRecord::lights`] and
+/// [`VoxelRecord::illum`] of every record (module docs). Lights past
+/// [`crate::voxel::MAX_LIGHTS`] cannot exist ([`Lights`] refuses them).
+///
+/// Work: one shadow ray per record and light, each bounded by the raster's
+/// size.
+///
+/// # Errors
+/// [`LightError::ExtentMismatch`] if `raster` and `store` differ in size.
+pub fn illuminate<const N: usize>(
+    raster: &Raster<'_>,
+    store: &mut RecordStoreMut<'_>,
+    objects: &ObjectTable<'_>,
+    materials: &Materials<N>,
+    lights: &Lights,
+    params: &LightParams,
+) -> Result<LightReport, LightError> {
+    let extent = raster.extent();
+    if store.as_store().extent() != extent {
+        return Err(LightError::ExtentMismatch);
+    }
+    let mut report = LightReport::default();
+    store.update_each(|view, v, rec| {
+        shade_record(
+            raster,
+            &view,
+            extent,
+            objects,
+            materials,
+            lights,
+            params,
+            v,
+            rec,
+            &mut report,
+        )
+        .map(Some)
+    })?;
+    Ok(report)
+}
+
+#[allow(clippy::too_many_arguments)] // the pass's context, unpacked once
+fn shade_record<const N: usize>(
+    raster: &Raster<'_>,
+    view: &RecordStore<'_>,
+    extent: Extent,
+    objects: &ObjectTable<'_>,
+    materials: &Materials<N>,
+    lights: &Lights,
+    params: &LightParams,
+    v: [u32; 3],
+    mut rec: VoxelRecord,
+    report: &mut LightReport,
+) -> Result<VoxelRecord, LightError> {
+    report.records = report.records.saturating_add(1);
+    let object = objects.get(rec.object);
+    let material = materials.get(rec.material);
+    if object.is_none() || material.is_none() {
+        report.missing = report.missing.saturating_add(1);
+    }
+    let closed = object.is_none_or(|o| o.shape.is_closed());
+    let kd = material.map_or(0, |m| m.kd);
+    let normal = rec.normal_vector();
+    let c0 = v.map(voxel_centre);
+    let start = extent.index(v);
+    rec.lights = 0;
+    // Sum of I·L_rgb·(N·L) over visible front-side lights, 2^-32 units.
+    let mut acc = [u128::from(lights.ambient) << SCALAR_BITS; 3];
+    for (i, light) in lights.as_slice().iter().enumerate() {
+        let to_light = sub(light.position, c0);
+        let l = normalize(to_light);
+        let ndl = l.map_or(0, |l| dot_unit(normal, l));
+        let (side, front) = if ndl > 0 {
+            (normal, true)
+        } else if closed || ndl == 0 {
+            if l.is_some() {
+                report.facing_away = report.facing_away.saturating_add(1);
+                rec.set_light(i, LightVisibility::Occluded);
+                continue;
+            }
+            // The light sits at the voxel centre: nothing can block it.
+            (normal, true)
+        } else {
+            (normal.map(i32::wrapping_neg), false)
+        };
+        report.rays = report.rays.saturating_add(1);
+        let vis = shadow_ray(
+            raster,
+            view,
+            materials,
+            params,
+            start,
+            c0,
+            light.position,
+            side,
+            normal,
+            rec.object,
+        )?;
+        rec.set_light(i, vis);
+        match vis {
+            LightVisibility::Visible => {
+                report.visible = report.visible.saturating_add(1);
+                if front && ndl > 0 {
+                    let ndl = u128::from(ndl.unsigned_abs());
+                    for (a, c) in acc.iter_mut().zip(light.color.iter()) {
+                        // I·L (2^-32) · N·L (2^-30) >> 30: 2^-32, < 2^66.
+                        let term = u128::from(light.intensity)
+                            .saturating_mul(u128::from(*c))
+                            .saturating_mul(ndl)
+                            >> 30;
+                        *a = a.saturating_add(term);
+                    }
+                }
+            }
+            LightVisibility::Translucent => {
+                report.translucent = report.translucent.saturating_add(1);
+            }
+            LightVisibility::Occluded | LightVisibility::Reserved => {
+                report.occluded = report.occluded.saturating_add(1);
+            }
+        }
+    }
+    for ((out, a), c) in rec.illum.iter_mut().zip(acc.iter()).zip(rec.color.iter()) {
+        // C (0..255) · Kd (2^-16) · acc (2^-32) → 0..255 after >> 48, rounded.
+        let x = u128::from(*c)
+            .saturating_mul(u128::from(kd))
+            .saturating_mul(*a)
+            .saturating_add(1 << 47)
+            >> 48;
+        *out = u8::try_from(x.min(255)).unwrap_or(u8::MAX);
+    }
+    Ok(rec)
+}
+
+/// `a − b` per axis, saturating.
+fn sub(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+    [
+        a[0].saturating_sub(b[0]),
+        a[1].saturating_sub(b[1]),
+        a[2].saturating_sub(b[2]),
+    ]
+}
+
+/// Whether fixed-point point `p` lies in the raster box.
+fn inside_box(extent: Extent, p: [i64; 3]) -> bool {
+    p.iter()
+        .zip(extent.dims())
+        .all(|(c, n)| *c >= 0 && *c < i64::from(n).saturating_mul(VOXEL))
+}
+
+/// Outcome of walking one shadow ray piece.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Piece {
+    Clear,
+    Blocked,
+}
+
+#[allow(clippy::too_many_arguments)] // one ray's context
+fn shadow_ray<const N: usize>(
+    raster: &Raster<'_>,
+    view: &RecordStore<'_>,
+    materials: &Materials<N>,
+    params: &LightParams,
+    start: Option<usize>,
+    c0: [i64; 3],
+    light: [i64; 3],
+    side: [i32; 3],
+    stored: [i32; 3],
+    object: u32,
+) -> Result<LightVisibility, LightError> {
+    let extent = raster.extent();
+    let mut translucent = false;
+    let mut test = |index: usize, c: u8| -> bool {
+        if c & cell::OPAQUE == 0 || Some(index) == start {
+            return false;
+        }
+        let Some(b) = view.get(index) else {
+            return true;
+        };
+        let Some(vb) = extent.coord(index) else {
+            return true;
+        };
+        let d = sub(vb.map(voxel_centre), c0);
+        // (c_b − c₀)·N₀ in fixed units: |d| < 2^33, |N| <= 2^30.
+        let height = d
+            .iter()
+            .zip(side.iter())
+            .map(|(a, n)| i128::from(*a).saturating_mul(i128::from(*n)))
+            .fold(0i128, i128::saturating_add)
+            >> 30;
+        let same_surface =
+            b.object == object || dot_unit(b.normal_vector(), stored) >= params.same_surface_cos;
+        if height <= i128::from(params.slab) && same_surface {
+            return false;
+        }
+        if materials
+            .get(b.material)
+            .is_some_and(|m| m.transmission > 0)
+        {
+            translucent = true;
+            return false;
+        }
+        true
+    };
+    let delta = [0, 1, 2].map(|k| {
+        i128::from(light.get(k).copied().unwrap_or(0))
+            .saturating_sub(i128::from(c0.get(k).copied().unwrap_or(0)))
+    });
+    let span = delta.iter().map(|d| d.unsigned_abs()).max().unwrap_or(0);
+    let limit = u128::from(i32::MAX.unsigned_abs());
+    let outcome = if span <= limit {
+        walk_piece(
+            raster,
+            params.mode,
+            DiscreteRay::segment(extent, c0, light)?,
+            &mut test,
+        )?
+    } else if !inside_box(extent, light) {
+        // Far light outside the raster: the half-line towards it leaves the
+        // raster where the segment would; scale the direction into i32.
+        let shift = 128u32
+            .saturating_sub(span.leading_zeros())
+            .saturating_sub(31);
+        let dir = delta.map(|d| i32::try_from(d >> shift).unwrap_or(0));
+        walk_piece(
+            raster,
+            params.mode,
+            DiscreteRay::new(extent, c0, dir)?,
+            &mut test,
+        )?
+    } else {
+        // A light inside a raster wider than 2^15 voxels: walk the segment
+        // in pieces whose extent fits i32 (at most 4: span < 2^33).
+        let pieces = span.div_ceil(limit).max(1);
+        let pieces_i = i128::try_from(pieces).unwrap_or(1);
+        let mut outcome = Piece::Clear;
+        let at = |j: i128| -> [i64; 3] {
+            [0, 1, 2].map(|k| {
+                let d = delta.get(k).copied().unwrap_or(0);
+                let c = i128::from(c0.get(k).copied().unwrap_or(0));
+                // |d·j| < 2^35 · 4: fits; the result lies between c0 and light.
+                let p = c.saturating_add(d.saturating_mul(j).checked_div(pieces_i).unwrap_or(0));
+                i64::try_from(p).unwrap_or(0)
+            })
+        };
+        for j in 0..pieces_i {
+            let ray = DiscreteRay::segment(extent, at(j), at(j.saturating_add(1)))?;
+            if walk_piece(raster, params.mode, ray, &mut test)? == Piece::Blocked {
+                outcome = Piece::Blocked;
+                break;
+            }
+        }
+        outcome
+    };
+    Ok(match (outcome, translucent) {
+        (Piece::Blocked, _) => LightVisibility::Occluded,
+        (Piece::Clear, true) => LightVisibility::Translucent,
+        (Piece::Clear, false) => LightVisibility::Visible,
+    })
+}
+
+fn walk_piece<T: FnMut(usize, u8) -> bool>(
+    raster: &Raster<'_>,
+    mode: Connectivity,
+    ray: Option<DiscreteRay>,
+    test: &mut T,
+) -> Result<Piece, LightError> {
+    let Some(mut ray) = ray else {
+        return Ok(Piece::Clear);
+    };
+    match ray.walk(raster, mode, u32::MAX, &mut *test)? {
+        WalkEnd::Hit => Ok(Piece::Blocked),
+        WalkEnd::Exit => Ok(Piece::Clear),
+        // u32::MAX voxels exceed any raster's diagonal; treat as clear.
+        WalkEnd::Budget => Ok(Piece::Clear),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,526 @@
+//! Unit tests of the light pass, on scenes voxelized by the brute-force
+//! voxelizers of `testkit` (integer only).
+
+use std::vec;
+use std::vec::Vec;
+
+use super::*;
+use crate::fixed::VOXEL;
+use crate::geometry::{Cuboid, Sphere, Torus, Triangle};
+use crate::object_table::{Light, Material, Object, SCALAR_ONE, Shape};
+use crate::store::{Limits, ObjectAttrs, RecordStore, RecordStoreMut};
+use crate::testkit::{self, Scene};
+use crate::voxelize::{Separation, VoxelSink};
+
+fn vox(v: [i64; 3]) -> [i64; 3] {
+    v.map(|c| c * VOXEL)
+}
+
+struct World {
+    objects: Vec<Object>,
+    materials: Materials<4>,
+    lights: Lights,
+}
+
+impl World {
+    fn new(lights: &[[i64; 3]]) -> Self {
+        let mut materials = Materials::new();
+        // 0: opaque, Kd 0.75, white.
+        materials
+            .push(Material {
+                color: [SCALAR_ONE; 3],
+                kd: SCALAR_ONE * 3 / 4,
+                ..Material::default()
+            })
+            .unwrap();
+        // 1: translucent.
+        materials
+            .push(Material {
+                color: [SCALAR_ONE; 3],
+                kd: SCALAR_ONE / 2,
+                transmission: SCALAR_ONE / 2,
+                ..Material::default()
+            })
+            .unwrap();
+        // SPD: I = sqrt(nl) / (2 nl); for one light 0.5.
+        let i = SCALAR_ONE / 2;
+        let mut l = Lights::new(i);
+        for p in lights {
+            l.push(Light {
+                position: *p,
+                color: [SCALAR_ONE; 3],
+                intensity: i,
+            })
+            .unwrap();
+        }
+        Self {
+            objects: Vec::new(),
+            materials,
+            lights: l,
+        }
+    }
+
+    fn run(&mut self, scene: &mut Scene) -> LightReport {
+        self.run_with(scene, &LightParams::default())
+    }
+
+    fn run_with(&mut self, scene: &mut Scene, params: &LightParams) -> LightReport {
+        let mut storage = vec![Object::UNUSED; self.objects.len()];
+        let mut table = ObjectTable::new(&mut storage, &mut []);
+        for o in &self.objects {
+            table.push(*o).unwrap();
+        }
+        let raster = Raster::new(scene.extent, &scene.plane).unwrap();
+        let mut store = RecordStoreMut::new(scene.extent, &scene.dir, &mut scene.records).unwrap();
+        illuminate(
+            &raster,
+            &mut store,
+            &table,
+            &self.materials,
+            &self.lights,
+            params,
+        )
+        .unwrap()
+    }
+}
+
+fn attrs(object: u32, material: u16) -> ObjectAttrs {
+    ObjectAttrs {
+        object,
+        material,
+        color: [200, 100, 50],
+    }
+}
+
+fn sphere_obj(c: [i64; 3], r: i64) -> Object {
+    Object {
+        shape: Shape::Sphere(Sphere {
+            centre: vox(c),
+            radius: r * VOXEL,
+        }),
+        material: 0,
+    }
+}
+
+/// C·Kd·I_a for the red channel: 200 · 0.75 · 0.5.
+const AMBIENT_ONLY: u8 = 75;
+
+const LIM: Limits = Limits {
+    objects: 16,
+    materials: 2,
+};
+
+/// The acceptance test: a lone sphere lit by one light has every voxel
+/// facing the light visible and every voxel facing away occluded.
+#[test]
+fn lone_sphere_has_no_acne() {
+    let e = Extent::cube(64).unwrap();
+    for sep in [Separation::Six, Separation::TwentySix] {
+        for light in [vox([300, 250, 400]), vox([60, 4, 61]), vox([32, 32, -500])] {
+            let vz = |s: &mut dyn VoxelSink| {
+                testkit::sphere(e, vox([32, 32, 32]), 20 * VOXEL, sep, s);
+            };
+            let mut scene = testkit::build(e, &[(attrs(0, 0), &vz)], LIM);
+            let mut w = World::new(&[light]);
+            w.objects.push(sphere_obj([32, 32, 32], 20));
+            let rep = w.run(&mut scene);
+            let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+            let (mut lit, mut dark, mut grazing) = (0, 0, 0);
+            for (v, r) in store.iter() {
+                let c = v.map(voxel_centre);
+                let l = normalize(sub(light, c)).unwrap();
+                let n = r.normal_vector();
+                let ndl = dot_unit(n, l);
+                let vis = r.light(0);
+                if ndl > 0 {
+                    assert_eq!(
+                        vis,
+                        LightVisibility::Visible,
+                        "{sep:?} light {light:?}: voxel {v:?} N·L = {ndl} self-shadowed"
+                    );
+                    lit += 1;
+                    if i64::from(ndl) < i64::from(NORMAL_ONE) * 523 / 10_000 {
+                        grazing += 1; // within 3° of grazing
+                    }
+                    // illum = C·Kd·(Ia + I·N·L), within rounding.
+                    let ia = i128::from(SCALAR_ONE / 2);
+                    let want = |c: u8| -> i128 {
+                        let tot = ia * (1 << 16) + ia * (1 << 16) * i128::from(ndl) / (1 << 30);
+                        (i128::from(c) * i128::from(SCALAR_ONE * 3 / 4) * tot + (1 << 47)) >> 48
+                    };
+                    for k in 0..3 {
+                        let d = i128::from(r.illum[k]) - want(r.color[k]);
+                        assert!(d.abs() <= 1, "illum {:?} at {v:?}", r.illum);
+                    }
+                } else {
+                    assert_eq!(vis, LightVisibility::Occluded, "{v:?} faces away");
+                    dark += 1;
+                    // Ambient only.
+                    assert_eq!(r.illum[0], AMBIENT_ONLY);
+                }
+            }
+            assert!(lit > 1000 && dark > 1000, "{lit} lit, {dark} dark");
+            assert!(grazing > 0);
+            assert_eq!(rep.records as usize, store.len());
+            assert_eq!(rep.visible, lit);
+            assert_eq!(rep.facing_away, dark);
+            assert_eq!(rep.rays, lit);
+        }
+    }
+}
+
+/// The same scene with the rule switched off (no slab): shadow rays from
+/// lit voxels run into the sphere's own layer, so the test above is not
+/// vacuous.
+#[test]
+fn without_the_rule_a_sphere_has_acne() {
+    let e = Extent::cube(64).unwrap();
+    let light = vox([300, 250, 400]);
+    let vz = |s: &mut dyn VoxelSink| {
+        testkit::sphere(e, vox([32, 32, 32]), 20 * VOXEL, Separation::TwentySix, s);
+    };
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &vz)], LIM);
+    let mut w = World::new(&[light]);
+    w.objects.push(sphere_obj([32, 32, 32], 20));
+    let off = LightParams {
+        slab: i64::MIN,
+        ..LightParams::default()
+    };
+    let rep = w.run_with(&mut scene, &off);
+    std::println!("rule off: {rep:?}");
+    assert!(rep.occluded * 10 > rep.rays, "{rep:?}");
+}
+
+#[test]
+fn a_small_sphere_shadows_a_big_one() {
+    let e = Extent::cube(64).unwrap();
+    let light = vox([32, 32, 1000]);
+    let big = |s: &mut dyn VoxelSink| {
+        testkit::sphere(e, vox([32, 32, 20]), 12 * VOXEL, Separation::Six, s)
+    };
+    let small = |s: &mut dyn VoxelSink| {
+        testkit::sphere(e, vox([32, 32, 45]), 4 * VOXEL, Separation::Six, s)
+    };
+    for blocker_material in [0u16, 1] {
+        let mut scene = testkit::build(
+            e,
+            &[(attrs(0, 0), &big), (attrs(1, blocker_material), &small)],
+            LIM,
+        );
+        let mut w = World::new(&[light]);
+        w.objects.push(sphere_obj([32, 32, 20], 12));
+        w.objects.push(Object {
+            material: blocker_material,
+            ..sphere_obj([32, 32, 45], 4)
+        });
+        w.run(&mut scene);
+        let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+        // The top of the big sphere lies in the small one's shadow.
+        let top = (0..64)
+            .rev()
+            .find_map(|z| store.get_voxel([32, 32, z]).filter(|r| r.object == 0))
+            .unwrap();
+        let want = if blocker_material == 0 {
+            LightVisibility::Occluded
+        } else {
+            LightVisibility::Translucent
+        };
+        assert_eq!(top.light(0), want);
+        // Translucent and occluded lights add no diffuse: ambient only.
+        assert_eq!(top.illum[0], AMBIENT_ONLY);
+        // The big sphere's side, out of the shadow, is lit.
+        let side = store
+            .get_voxel([32 + 11, 32, 24])
+            .or(store.get_voxel([32 + 12, 32, 24]));
+        assert_eq!(side.unwrap().light(0), LightVisibility::Visible);
+    }
+}
+
+#[test]
+fn an_opaque_blocker_behind_a_translucent_one_occludes() {
+    let e = Extent::cube(64).unwrap();
+    let light = vox([32, 32, 1000]);
+    let floor = |s: &mut dyn VoxelSink| {
+        testkit::plate(
+            e,
+            10 * VOXEL + VOXEL / 2,
+            20..44,
+            20..44,
+            false,
+            Separation::Six,
+            s,
+        )
+    };
+    let glass = |s: &mut dyn VoxelSink| {
+        testkit::plate(
+            e,
+            30 * VOXEL + VOXEL / 2,
+            28..36,
+            28..36,
+            false,
+            Separation::Six,
+            s,
+        )
+    };
+    let lid = |s: &mut dyn VoxelSink| {
+        testkit::plate(
+            e,
+            40 * VOXEL + VOXEL / 2,
+            30..34,
+            30..34,
+            false,
+            Separation::Six,
+            s,
+        )
+    };
+    let mut scene = testkit::build(
+        e,
+        &[
+            (attrs(0, 0), &floor),
+            (attrs(1, 1), &glass),
+            (attrs(2, 0), &lid),
+        ],
+        LIM,
+    );
+    let tri = Object {
+        shape: Shape::Triangle(Triangle {
+            vertices: [[0; 3]; 3],
+            normals: None,
+        }),
+        material: 0,
+    };
+    let mut w = World::new(&[light]);
+    w.objects.extend([tri, Object { material: 1, ..tri }, tri]);
+    w.run(&mut scene);
+    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    let at = |x, y| store.get_voxel([x, y, 10]).unwrap().light(0);
+    assert_eq!(at(22, 22), LightVisibility::Visible);
+    assert_eq!(at(29, 29), LightVisibility::Translucent);
+    assert_eq!(at(32, 32), LightVisibility::Occluded);
+}
+
+#[test]
+fn open_surfaces_lit_from_behind_see_the_light_from_their_back() {
+    let e = Extent::cube(32).unwrap();
+    // A plate facing up, the light below it, another plate in between for
+    // half of it.
+    let top = |s: &mut dyn VoxelSink| {
+        testkit::plate(
+            e,
+            20 * VOXEL + VOXEL / 2,
+            4..28,
+            4..28,
+            false,
+            Separation::Six,
+            s,
+        )
+    };
+    let mid = |s: &mut dyn VoxelSink| {
+        testkit::plate(
+            e,
+            10 * VOXEL + VOXEL / 2,
+            4..12,
+            4..28,
+            true,
+            Separation::Six,
+            s,
+        )
+    };
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &top), (attrs(1, 0), &mid)], LIM);
+    let tri = Object {
+        shape: Shape::Triangle(Triangle {
+            vertices: [[0; 3]; 3],
+            normals: None,
+        }),
+        material: 0,
+    };
+    let mut w = World::new(&[vox([16, 16, -2000])]);
+    w.objects.extend([tri, tri]);
+    let rep = w.run(&mut scene);
+    assert_eq!(rep.facing_away, 0);
+    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    let r = store.get_voxel([20, 16, 20]).unwrap();
+    assert_eq!(r.light(0), LightVisibility::Visible);
+    // The light is behind the stored normal: no diffuse in illum.
+    assert_eq!(r.illum[0], AMBIENT_ONLY);
+    let shadowed = store.get_voxel([6, 16, 20]).unwrap();
+    assert_eq!(shadowed.light(0), LightVisibility::Occluded);
+    // A closed shape facing away is occluded without a ray.
+    let cube = Object {
+        shape: Shape::Cuboid(Cuboid {
+            min: [0; 3],
+            max: [1; 3],
+        }),
+        material: 0,
+    };
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &top)], LIM);
+    let mut w = World::new(&[vox([16, 16, -2000])]);
+    w.objects.push(cube);
+    let rep = w.run(&mut scene);
+    assert_eq!(rep.rays, 0);
+    assert!(rep.facing_away > 0);
+}
+
+#[test]
+fn adjacent_pieces_of_one_surface_do_not_shadow_each_other() {
+    // A floor made of two objects (mesh triangles); light at a grazing 4°.
+    let e = Extent::new(96, 32, 16).unwrap();
+    let z = 5 * VOXEL + VOXEL / 3;
+    let a =
+        |s: &mut dyn VoxelSink| testkit::plate(e, z, 0..48, 0..32, false, Separation::TwentySix, s);
+    let b = |s: &mut dyn VoxelSink| {
+        testkit::plate(e, z, 48..96, 0..32, false, Separation::TwentySix, s)
+    };
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &a), (attrs(1, 0), &b)], LIM);
+    let tri = Object {
+        shape: Shape::Triangle(Triangle {
+            vertices: [[0; 3]; 3],
+            normals: None,
+        }),
+        material: 0,
+    };
+    // tan 4° ≈ 0.07: 100 000 voxels away, 7 000 up.
+    let mut w = World::new(&[vox([-100_000, 16, 7_000])]);
+    w.objects.extend([tri, tri]);
+    let rep = w.run(&mut scene);
+    assert_eq!(rep.occluded, 0, "{rep:?}");
+    assert_eq!(rep.visible, rep.records);
+}
+
+#[test]
+fn a_sphere_on_a_floor_casts_a_contact_shadow() {
+    let e = Extent::cube(64).unwrap();
+    let floor = |s: &mut dyn VoxelSink| {
+        testkit::plate(
+            e,
+            10 * VOXEL + VOXEL / 2,
+            0..64,
+            0..64,
+            false,
+            Separation::Six,
+            s,
+        )
+    };
+    let ball = |s: &mut dyn VoxelSink| {
+        testkit::sphere(
+            e,
+            vox([32, 32, 20]).map(|c| c + VOXEL / 2),
+            10 * VOXEL,
+            Separation::Six,
+            s,
+        )
+    };
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &floor), (attrs(1, 0), &ball)], LIM);
+    let tri = Object {
+        shape: Shape::Triangle(Triangle {
+            vertices: [[0; 3]; 3],
+            normals: None,
+        }),
+        material: 0,
+    };
+    let mut w = World::new(&[vox([32, 32, 5000])]);
+    w.objects.extend([tri, sphere_obj([32, 32, 20], 10)]);
+    w.run(&mut scene);
+    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    // Under the ball, around the contact: occluded; far away: visible.
+    for x in [29, 32, 35] {
+        let r = store.get_voxel([x, 32, 10]).unwrap();
+        assert_eq!(r.object, 0);
+        assert_eq!(r.light(0), LightVisibility::Occluded, "x = {x}");
+    }
+    assert_eq!(
+        store.get_voxel([5, 5, 10]).unwrap().light(0),
+        LightVisibility::Visible
+    );
+}
+
+/// A concave object still shadows itself: light grazing through a torus's
+/// hole is blocked by the near side of the ring.
+#[test]
+fn a_torus_shadows_itself() {
+    let e = Extent::cube(64).unwrap();
+    let centre = vox([32, 32, 32]).map(|c| c + VOXEL / 2);
+    let t = |s: &mut dyn VoxelSink| {
+        testkit::torus(e, centre, 18 * VOXEL, 6 * VOXEL, Separation::Six, s)
+    };
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &t)], LIM);
+    let mut w = World::new(&[vox([4000, 32, 32])]);
+    w.objects.push(Object {
+        shape: Shape::Torus(Torus {
+            centre,
+            axis: [0, 0, NORMAL_ONE],
+            major: 18 * VOXEL,
+            minor: 6 * VOXEL,
+        }),
+        material: 0,
+    });
+    w.run(&mut scene);
+    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    // Inner wall on the far (−x) side faces +x, towards the light, but the
+    // near side of the ring is in the way.
+    let inner_far = (0..32)
+        .rev()
+        .find_map(|x| store.get_voxel([x, 32, 32]).map(|r| (x, *r)))
+        .unwrap();
+    assert!(
+        inner_far.1.normal_vector()[0] > NORMAL_ONE / 2,
+        "{inner_far:?}"
+    );
+    assert_eq!(
+        inner_far.1.light(0),
+        LightVisibility::Occluded,
+        "{inner_far:?}"
+    );
+    // Outer wall on the near (+x) side: lit.
+    let outer_near = (32..64)
+        .rev()
+        .find_map(|x| store.get_voxel([x, 32, 32]))
+        .unwrap();
+    assert_eq!(outer_near.light(0), LightVisibility::Visible);
+}
+
+#[test]
+fn missing_tables_and_extent_mismatch() {
+    let e = Extent::cube(16).unwrap();
+    let vz =
+        |s: &mut dyn VoxelSink| testkit::sphere(e, vox([8, 8, 8]), 4 * VOXEL, Separation::Six, s);
+    let mut scene = testkit::build(e, &[(attrs(3, 0), &vz)], LIM);
+    // Object 3 is not in the (empty) table: counted, not a panic.
+    let mut w = World::new(&[vox([8, 8, 100])]);
+    let rep = w.run(&mut scene);
+    assert_eq!(rep.missing, rep.records);
+    let other = Extent::cube(8).unwrap();
+    let plane = vec![0u8; other.len()];
+    let raster = Raster::new(other, &plane).unwrap();
+    let mut store = RecordStoreMut::new(e, &scene.dir, &mut scene.records).unwrap();
+    let mut objs = [Object::UNUSED; 1];
+    let table = ObjectTable::new(&mut objs, &mut []);
+    assert_eq!(
+        illuminate(
+            &raster,
+            &mut store,
+            &table,
+            &w.materials,
+            &w.lights,
+            &LightParams::default()
+        )
+        .unwrap_err(),
+        LightError::ExtentMismatch
+    );
+}
+
+#[test]
+fn far_lights_and_huge_coordinates_do_not_fail() {
+    let e = Extent::cube(16).unwrap();
+    let vz =
+        |s: &mut dyn VoxelSink| testkit::sphere(e, vox([8, 8, 8]), 4 * VOXEL, Separation::Six, s);
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &vz)], LIM);
+    let mut w = World::new(&[
+        [i64::MAX, i64::MIN, 0],
+        [1 << 40, 1 << 41, -(1 << 45)],
+        vox([8, 8, 8]).map(|c| c + VOXEL / 2), // at a voxel centre inside the sphere
+    ]);
+    w.objects.push(sphere_obj([8, 8, 8], 4));
+    let rep = w.run(&mut scene);
+    assert_eq!(rep.records as usize, scene.records.len());
+}

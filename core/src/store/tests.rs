@@ -1,0 +1,521 @@
+//! Unit tests of the record store and the two-pass builder.
+
+use std::collections::HashMap;
+use std::vec;
+use std::vec::Vec;
+
+use super::*;
+use crate::proximity::flag_neighbourhood;
+use crate::voxelize::NORMAL_ONE;
+
+const UP: [i32; 3] = [0, 0, NORMAL_ONE];
+
+fn surfel(distance: u32) -> Surfel {
+    Surfel {
+        normal: UP,
+        distance,
+    }
+}
+
+/// SplitMix64.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: u32) -> u32 {
+        (self.next() % u64::from(n)) as u32
+    }
+}
+
+/// A scripted "voxelizer": a fixed list of offers per object.
+type Script = Vec<Vec<([u32; 3], u32)>>;
+
+fn random_script(extent: Extent, objects: usize, offers: usize, seed: u64) -> Script {
+    let mut rng = Rng(seed);
+    let [nx, ny, nz] = extent.dims();
+    (0..objects)
+        .map(|_| {
+            (0..offers)
+                .map(|_| {
+                    (
+                        [rng.below(nx), rng.below(ny), rng.below(nz)],
+                        rng.below(1 << 16),
+                    )
+                })
+                .collect()
+        })
+        .collect()
+}
+
+struct Scene {
+    plane: Vec<u8>,
+    dir: Vec<u32>,
+    records: Vec<VoxelRecord>,
+    count: CountReport,
+    fill: FillReport,
+}
+
+fn build(extent: Extent, script: &Script) -> Result<Scene, BuildError> {
+    let mut plane = vec![0u8; extent.len()];
+    let mut dir = vec![0u32; directory_len(extent).unwrap()];
+    let mut counter = Counter::new(RasterMut::new(extent, &mut plane).unwrap(), &mut dir)?;
+    for obj in script {
+        for &(v, d) in obj {
+            counter.offer(v, surfel(d));
+        }
+    }
+    let count = counter.report();
+    let sizing = counter.finish()?;
+    assert_eq!(sizing.records() as u64, count.voxels);
+    let mut records = vec![VoxelRecord::default(); sizing.records()];
+    let limits = Limits {
+        objects: script.len() as u32,
+        materials: 1,
+    };
+    let mut filler = sizing.fill(&mut records, limits)?;
+    for (id, obj) in script.iter().enumerate() {
+        filler.begin_object(ObjectAttrs {
+            object: id as u32,
+            material: 0,
+            color: [id as u8, 0, 0],
+        })?;
+        for &(v, d) in obj {
+            filler.offer(v, surfel(d));
+        }
+    }
+    let fill = filler.finish()?.report();
+    Ok(Scene {
+        plane,
+        dir,
+        records,
+        count,
+        fill,
+    })
+}
+
+/// The expected owner of every voxel: smallest quantized distance, first
+/// offer on ties.
+fn brute_force(script: &Script) -> HashMap<[u32; 3], (u32, u16)> {
+    let mut m: HashMap<[u32; 3], (u32, u16)> = HashMap::new();
+    for (id, obj) in script.iter().enumerate() {
+        for &(v, d) in obj {
+            let q = crate::voxel::quantize_distance(d);
+            match m.get(&v) {
+                Some(&(_, old)) if old <= q => {}
+                _ => {
+                    m.insert(v, (id as u32, q));
+                }
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn geometry_of_bricks() {
+    let e = Extent::new(17, 8, 1).unwrap();
+    assert_eq!(brick_dims(e), [3, 1, 1]);
+    assert_eq!(brick_count(e), Some(3));
+    assert_eq!(directory_len(e), Some(4));
+    assert_eq!(brick_of(e, [16, 7, 0]), 2);
+    assert_eq!(brick_origin(e, 2), Some([16, 0, 0]));
+    let e = Extent::new(20, 20, 20).unwrap();
+    assert_eq!(brick_of(e, [9, 17, 8]), 1 + 3 * (2 + 3));
+    assert_eq!(brick_origin(e, 1 + 3 * (2 + 3)), Some([8, 16, 8]));
+    assert_eq!(voxel_at([8, 16, 8], brick_position([9, 17, 8])), [9, 17, 8]);
+}
+
+#[test]
+fn lookups_match_brute_force_on_random_sparse_rasters() {
+    for seed in 0..20u64 {
+        let mut rng = Rng(seed);
+        let extent = Extent::new(1 + rng.below(40), 1 + rng.below(40), 1 + rng.below(40)).unwrap();
+        let objects = 1 + rng.below(4) as usize;
+        let offers = rng.below(3000) as usize;
+        let script = random_script(extent, objects, offers, seed.wrapping_mul(77));
+        let scene = build(extent, &script).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let expect = brute_force(&script);
+        assert_eq!(scene.count.voxels as usize, expect.len(), "seed {seed}");
+        assert_eq!(scene.fill.records as usize, expect.len(), "seed {seed}");
+        assert_eq!(scene.records.len(), expect.len(), "seed {seed}");
+        let store = RecordStore::new(extent, &scene.dir, &scene.records)
+            .unwrap_or_else(|e| panic!("seed {seed}: built store invalid: {e}"));
+        for i in 0..extent.len() {
+            let v = extent.coord(i).unwrap();
+            let got = store.get(i);
+            let opaque = scene.plane[i] & cell::OPAQUE != 0;
+            match expect.get(&v) {
+                Some(&(owner, q)) => {
+                    let r = got.unwrap_or_else(|| panic!("seed {seed}: {v:?} has no record"));
+                    assert_eq!(r.object, owner, "seed {seed}: owner of {v:?}");
+                    assert_eq!(r.distance(), q, "seed {seed}: distance of {v:?}");
+                    assert_eq!(r.color, [owner as u8, 0, 0]);
+                    assert!(opaque);
+                }
+                None => {
+                    assert!(got.is_none(), "seed {seed}: {v:?} should be transparent");
+                    assert!(!opaque);
+                }
+            }
+        }
+        assert!(store.get(extent.len()).is_none());
+        // iter() yields every record once, with its coordinates.
+        let listed: Vec<_> = store.iter().map(|(v, r)| (v, r.object)).collect();
+        assert_eq!(listed.len(), expect.len());
+        for (v, o) in listed {
+            assert_eq!(expect[&v].0, o);
+        }
+    }
+}
+
+#[test]
+fn overlapping_objects_keep_the_nearest_in_either_order() {
+    let e = Extent::cube(8).unwrap();
+    let near = 100u32; // quantizes to 0
+    let far = 40_000u32; // quantizes to 78
+    for order in [[near, far], [far, near]] {
+        let script: Script = vec![vec![([3, 3, 3], order[0])], vec![([3, 3, 3], order[1])]];
+        let s = build(e, &script).unwrap();
+        let store = RecordStore::new(e, &s.dir, &s.records).unwrap();
+        let r = store.get_voxel([3, 3, 3]).unwrap();
+        let want = if order[0] == near { 0 } else { 1 };
+        assert_eq!(r.object, want, "order {order:?}");
+        assert_eq!(s.records.len(), 1);
+        assert_eq!(s.fill.replaced + s.fill.kept, 1);
+    }
+    // Ties keep the first offer.
+    let script: Script = vec![vec![([1, 2, 3], 5)], vec![([1, 2, 3], 5)]];
+    let s = build(e, &script).unwrap();
+    assert_eq!(s.records[0].object, 0);
+    assert_eq!(s.fill.kept, 1);
+}
+
+#[test]
+fn same_object_repeat_offers_keep_the_nearest() {
+    let e = Extent::cube(16).unwrap();
+    let script: Script = vec![vec![
+        ([9, 9, 9], 30_000),
+        ([8, 9, 9], 1_000),
+        ([9, 9, 9], 2_000),
+        ([9, 9, 9], 20_000),
+    ]];
+    let s = build(e, &script).unwrap();
+    let store = RecordStore::new(e, &s.dir, &s.records).unwrap();
+    assert_eq!(store.get_voxel([9, 9, 9]).unwrap().distance(), 4);
+    assert_eq!(s.fill.replaced, 1);
+    assert_eq!(s.fill.kept, 1);
+}
+
+#[test]
+fn offers_outside_the_raster_are_skipped_and_counted() {
+    let e = Extent::new(10, 9, 8).unwrap();
+    let script: Script = vec![vec![
+        ([10, 0, 0], 0),
+        ([0, 9, 0], 0),
+        ([u32::MAX; 3], 0),
+        ([9, 8, 7], 0),
+    ]];
+    let s = build(e, &script).unwrap();
+    assert_eq!(s.count.outside, 3);
+    assert_eq!(s.fill.outside, 3);
+    assert_eq!(s.records.len(), 1);
+}
+
+#[test]
+fn textured_fill_colours_from_centre_and_normal() {
+    let e = Extent::cube(8).unwrap();
+    let mut plane = vec![0u8; e.len()];
+    let mut dir = vec![0u32; directory_len(e).unwrap()];
+    let mut c = Counter::new(RasterMut::new(e, &mut plane).unwrap(), &mut dir).unwrap();
+    for x in 0..8 {
+        c.offer([x, 0, 0], surfel(0));
+    }
+    let sizing = c.finish().unwrap();
+    let mut recs = vec![VoxelRecord::default(); 8];
+    let mut f = sizing
+        .fill(
+            &mut recs,
+            Limits {
+                objects: 1,
+                materials: 1,
+            },
+        )
+        .unwrap();
+    f.begin_object(ObjectAttrs::default()).unwrap();
+    let checker = |p: [i64; 3], n: [i32; 3], base: [u8; 3]| {
+        let x = (p[0] >> crate::fixed::FRAC_BITS) as u8;
+        [x * 10, base[1], (n[2] >> 24) as u8]
+    };
+    {
+        let mut t = f.textured(&checker);
+        for x in 0..8 {
+            t.offer([x, 0, 0], surfel(0));
+        }
+    }
+    let built = f.finish().unwrap();
+    let store = built.store();
+    for x in 0..8u32 {
+        assert_eq!(
+            store.get_voxel([x, 0, 0]).unwrap().color,
+            [x as u8 * 10, 0, 64]
+        );
+    }
+}
+
+#[test]
+fn build_errors() {
+    let e = Extent::cube(16).unwrap();
+    let mut plane = vec![0u8; e.len()];
+    // Wrong directory length.
+    let mut short = vec![0u32; 8];
+    assert_eq!(
+        Counter::new(RasterMut::new(e, &mut plane).unwrap(), &mut short).unwrap_err(),
+        BuildError::DirectoryLength {
+            expected: 9,
+            found: 8
+        }
+    );
+    let mut dir = vec![0u32; 9];
+    let counted = |plane: &mut Vec<u8>, dir: &mut Vec<u32>| {
+        let mut c =
+            Counter::new(RasterMut::new(e, slice_of(plane)).unwrap(), slice_of(dir)).unwrap();
+        c.offer([1, 1, 1], surfel(0));
+        c.offer([9, 1, 1], surfel(0));
+        c.finish().unwrap().records()
+    };
+    assert_eq!(counted(&mut plane, &mut dir), 2);
+
+    // Record storage too small.
+    let mut c = Counter::new(RasterMut::new(e, &mut plane).unwrap(), &mut dir).unwrap();
+    c.offer([1, 1, 1], surfel(0));
+    c.offer([9, 1, 1], surfel(0));
+    let mut one = vec![VoxelRecord::default(); 1];
+    let lim = Limits {
+        objects: 2,
+        materials: 3,
+    };
+    assert_eq!(
+        c.finish().unwrap().fill(&mut one, lim).unwrap_err(),
+        BuildError::RecordStorage {
+            needed: 2,
+            found: 1
+        }
+    );
+
+    // Object and material out of range; offers without an object; extra
+    // voxels; missing voxels.
+    let mut recs = vec![VoxelRecord::default(); 4];
+    fn start<'p, 'd>(e: Extent, plane: &'p mut [u8], dir: &'d mut [u32]) -> Sizing<'p, 'd> {
+        let mut c = Counter::new(RasterMut::new(e, plane).unwrap(), dir).unwrap();
+        c.offer([1, 1, 1], surfel(0));
+        c.offer([9, 1, 1], surfel(0));
+        c.finish().unwrap()
+    }
+    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
+    let attrs = ObjectAttrs {
+        object: 2,
+        material: 0,
+        color: [0; 3],
+    };
+    assert_eq!(
+        f.begin_object(attrs).unwrap_err(),
+        BuildError::ObjectOutOfRange {
+            object: 2,
+            limit: 2
+        }
+    );
+    assert_eq!(
+        f.begin_object(ObjectAttrs {
+            object: 1,
+            material: 3,
+            ..attrs
+        })
+        .unwrap_err(),
+        BuildError::MaterialOutOfRange {
+            material: 3,
+            limit: 3
+        }
+    );
+    f.offer([1, 1, 1], surfel(0));
+    assert_eq!(
+        f.finish().unwrap_err(),
+        BuildError::OfferWithoutObject { offers: 1 }
+    );
+
+    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
+    f.begin_object(ObjectAttrs { object: 1, ..attrs }).unwrap();
+    f.offer([1, 1, 1], surfel(0));
+    f.offer([9, 1, 1], surfel(0));
+    f.offer([2, 1, 1], surfel(0));
+    assert_eq!(
+        f.finish().unwrap_err(),
+        BuildError::PassMismatch { uncounted: 1 }
+    );
+
+    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
+    f.begin_object(ObjectAttrs { object: 1, ..attrs }).unwrap();
+    f.offer([1, 1, 1], surfel(0));
+    assert_eq!(
+        f.finish().unwrap_err(),
+        BuildError::FillIncomplete {
+            filled: 1,
+            expected: 2
+        }
+    );
+}
+
+/// Identity helper: reborrows a `Vec` as a slice (keeps the closures above
+/// short).
+fn slice_of<T>(v: &mut Vec<T>) -> &mut [T] {
+    v.as_mut_slice()
+}
+
+#[test]
+fn corrupt_directories_are_rejected() {
+    let e = Extent::new(16, 8, 8).unwrap(); // 2 bricks
+    let r = |pos: u16| VoxelRecord {
+        key: pos,
+        ..VoxelRecord::default()
+    };
+    let recs = [r(1), r(7), r(3)];
+    assert!(RecordStore::new(e, &[0, 2, 3], &recs).is_ok());
+    assert_eq!(
+        RecordStore::new(e, &[0, 2], &recs).unwrap_err(),
+        StoreError::DirectoryLength {
+            expected: 3,
+            found: 2
+        }
+    );
+    assert_eq!(
+        RecordStore::new(e, &[1, 2, 3], &recs).unwrap_err(),
+        StoreError::DirectoryStart
+    );
+    assert_eq!(
+        RecordStore::new(e, &[0, 2, 4], &recs).unwrap_err(),
+        StoreError::DirectoryEnd {
+            last: 4,
+            records: 3
+        }
+    );
+    assert_eq!(
+        RecordStore::new(e, &[0, 4, 3], &recs).unwrap_err(),
+        StoreError::DirectoryOrder { brick: 0 }
+    );
+    // Unsorted inside a brick.
+    let bad = [r(7), r(1), r(3)];
+    assert_eq!(
+        RecordStore::new(e, &[0, 2, 3], &bad).unwrap_err(),
+        StoreError::BadKey { record: 1 }
+    );
+    // Repeated position.
+    let dup = [r(1), r(1), r(3)];
+    assert_eq!(
+        RecordStore::new(e, &[0, 2, 3], &dup).unwrap_err(),
+        StoreError::BadKey { record: 1 }
+    );
+    // A position outside a partial brick.
+    let e2 = Extent::new(10, 8, 8).unwrap(); // second brick is 2 wide
+    let outside = [r(1), r(2)]; // x = 8 + 2 = 10: outside
+    assert_eq!(
+        RecordStore::new(e2, &[0, 1, 2], &outside).unwrap_err(),
+        StoreError::BadKey { record: 1 }
+    );
+    // A brick claiming more records than it has voxels.
+    let many = vec![VoxelRecord::default(); 513];
+    let e3 = Extent::cube(8).unwrap();
+    assert_eq!(
+        RecordStore::new(e3, &[0, 513], &many).unwrap_err(),
+        StoreError::DirectoryOrder { brick: 0 }
+    );
+    // Random corruption never panics and never validates a wrong store.
+    let script = random_script(e, 2, 200, 5);
+    let s = build(e, &script).unwrap();
+    let mut rng = Rng(9);
+    for _ in 0..2000 {
+        let mut dir = s.dir.clone();
+        let mut recs = s.records.clone();
+        match rng.below(3) {
+            0 => {
+                let i = rng.below(dir.len() as u32) as usize;
+                dir[i] = rng.below(400);
+            }
+            1 => {
+                if !recs.is_empty() {
+                    let i = rng.below(recs.len() as u32) as usize;
+                    recs[i].key = rng.below(1 << 16) as u16;
+                }
+            }
+            _ => {
+                recs.truncate(rng.below(recs.len() as u32 + 1) as usize);
+            }
+        }
+        if let Ok(st) = RecordStore::new(e, &dir, &recs) {
+            for i in 0..e.len() {
+                let _ = st.get(i);
+            }
+        }
+    }
+}
+
+#[test]
+fn proximity_after_build_is_the_26_neighbourhood() {
+    for seed in 0..12u64 {
+        let mut rng = Rng(seed + 100);
+        let extent = Extent::new(1 + rng.below(30), 1 + rng.below(30), 1 + rng.below(30)).unwrap();
+        // Even seeds sparse (per-record pass), odd seeds dense (whole plane).
+        let offers = if seed % 2 == 0 {
+            rng.below(200) as usize
+        } else {
+            extent.len() / 2
+        };
+        let script = random_script(extent, 2, offers, seed);
+        let dense = script.iter().flatten().count() * DENSE_RATIO > extent.len();
+        let s = build(extent, &script).unwrap();
+        if seed % 2 == 1 {
+            assert!(dense && s.records.len() * DENSE_RATIO > extent.len());
+        }
+        // Reference: the whole-plane dilation on the OPAQUE bits alone.
+        let mut reference: Vec<u8> = s.plane.iter().map(|c| c & cell::OPAQUE).collect();
+        flag_neighbourhood(&mut RasterMut::new(extent, &mut reference).unwrap());
+        assert_eq!(s.plane, reference, "seed {seed}");
+        // And the definition: chessboard distance <= 1 from an opaque voxel.
+        let [nx, ny, nz] = extent.dims().map(i64::from);
+        for i in 0..extent.len() {
+            let v = extent.coord(i).unwrap().map(i64::from);
+            let mut near = false;
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let w = [v[0] + dx, v[1] + dy, v[2] + dz];
+                        if w.iter().zip([nx, ny, nz]).all(|(c, n)| (0..n).contains(c)) {
+                            let j = extent.index(w.map(|c| c as u32)).unwrap();
+                            near |= s.plane[j] & cell::OPAQUE != 0;
+                        }
+                    }
+                }
+            }
+            assert_eq!(
+                s.plane[i] & cell::PROXIMITY != 0,
+                near,
+                "seed {seed} voxel {v:?}"
+            );
+            assert_eq!(s.plane[i] & !(cell::OPAQUE | cell::PROXIMITY), 0);
+        }
+    }
+}
+
+#[test]
+fn store_mut_updates_in_place() {
+    let e = Extent::cube(8).unwrap();
+    let script: Script = vec![vec![([1, 2, 3], 0), ([4, 4, 4], 0)]];
+    let mut s = build(e, &script).unwrap();
+    let mut st = RecordStoreMut::new(e, &s.dir, &mut s.records).unwrap();
+    st.get_voxel_mut([4, 4, 4]).unwrap().illum = [1, 2, 3];
+    assert!(st.get_voxel_mut([4, 4, 5]).is_none());
+    assert_eq!(st.as_store().get_voxel([4, 4, 4]).unwrap().illum, [1, 2, 3]);
+}
