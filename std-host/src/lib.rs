@@ -1,1 +1,7 @@
-//! rrt on a host.
+//! rrt on a host: NFF scenes, the camera, shading, fitting the raster to a
+//! scene, exact reference intersections, and (to come) the renderer and
+//! the `rrt` CLI.
+
+#![forbid(unsafe_code)]
+
+pub mod scene;
