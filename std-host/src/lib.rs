@@ -4,4 +4,6 @@
 
 #![forbid(unsafe_code)]
 
+pub mod camera;
+pub mod intersect;
 pub mod scene;
