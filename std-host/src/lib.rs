@@ -7,3 +7,4 @@
 pub mod camera;
 pub mod intersect;
 pub mod scene;
+pub mod shade;
