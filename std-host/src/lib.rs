@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 
 pub mod camera;
+pub mod fit;
 pub mod intersect;
 pub mod scene;
 pub mod shade;
