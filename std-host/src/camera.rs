@@ -94,13 +94,19 @@ impl Camera {
         if !(angle_degrees > 0.0 && angle_degrees < 180.0) {
             return Err(CameraError::Angle(angle_degrees));
         }
-        let forward = (at - from)
-            .try_normalize()
-            .ok_or(CameraError::NoDirection)?;
         if !from.is_finite() {
             return Err(CameraError::NoDirection);
         }
-        let right = forward.cross(up).try_normalize().ok_or(CameraError::NoUp)?;
+        let forward = (at - from)
+            .try_normalize()
+            .ok_or(CameraError::NoDirection)?;
+        // Normalise `up` first, as the parser's check does, so that every
+        // view the parser accepts makes a camera.
+        let up_dir = up.try_normalize().ok_or(CameraError::NoUp)?;
+        let right = forward
+            .cross(up_dir)
+            .try_normalize()
+            .ok_or(CameraError::NoUp)?;
         let up = right.cross(forward);
         let span = f64::from(height.max(2) - 1);
         let pitch = 2.0 * (angle_degrees.to_radians() / 2.0).tan() / span;

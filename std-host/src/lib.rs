@@ -1,10 +1,23 @@
-//! rrt on a host: NFF scenes, the camera, shading, fitting the raster to a
-//! scene, exact reference intersections, and (to come) the renderer and
-//! the `rrt` CLI.
+//! rrt on a host (std, `f64`): everything around the integer core.
+//!
+//! * [`scene`]: NFF scenes in world coordinates and their strict parser,
+//!   with located errors.
+//! * [`camera`]: the pinhole camera of `embree_nff` (rays through pixel
+//!   centres), with supersampling positions.
+//! * [`fit`]: fitting the 3D raster to a scene: world → fixed-point raster
+//!   coordinates, once; the memory estimate and limit.
+//! * [`shade`]: shading maths (SPD intensities, Phong, Whitted secondary
+//!   rays, refraction), matching `embree_nff`.
+//! * [`intersect`]: exact `f64` ray intersections for intersection
+//!   verification and tests.
+//! * `check` (feature `check`): invariant checkers shared by tests and
+//!   fuzz targets.
 
 #![forbid(unsafe_code)]
 
 pub mod camera;
+#[cfg(any(test, feature = "check"))]
+pub mod check;
 pub mod fit;
 pub mod intersect;
 pub mod scene;
