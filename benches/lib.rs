@@ -222,7 +222,7 @@ pub fn camera_rays(n: u32, res: u32) -> Vec<BenchRay> {
     let nn = f64::from(n);
     let c = 0.5 * nn;
     let e = [1.2, 0.9, 0.7];
-    let l = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2] as f64).sqrt();
+    let l: f64 = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
     let eye = e.map(|v| c + nn * v);
     let fwd = e.map(|v| -v / l);
     let up0 = [0.0, 0.0, 1.0];

@@ -1,0 +1,795 @@
+//! Known values, grazing and inside-start rays for every primitive, plus
+//! seeded random rays checked against the implicit surface equations.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::*;
+
+const INF: f64 = f64::INFINITY;
+
+#[track_caller]
+fn close(a: f64, b: f64, tol: f64) {
+    assert!((a - b).abs() <= tol, "{a} vs {b} (tol {tol})");
+}
+
+#[track_caller]
+fn close3(a: DVec3, b: DVec3, tol: f64) {
+    assert!((a - b).length() <= tol, "{a} vs {b} (tol {tol})");
+}
+
+fn ray(o: [f64; 3], d: [f64; 3]) -> Ray {
+    Ray::new(DVec3::from(o), DVec3::from(d))
+}
+
+/// SplitMix64, seeded per case.
+struct Rng(u64);
+impl Rng {
+    fn unit(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.unit()
+    }
+    fn vec(&mut self, lo: f64, hi: f64) -> DVec3 {
+        DVec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
+    }
+}
+
+/// The smallest `t` in `(lo, hi)` where `f(ray.at(t))` changes sign or
+/// touches 0, by fine marching then bisection: a slow, independent oracle.
+fn march(r: &Ray, f: impl Fn(DVec3) -> f64, lo: f64, hi: f64, steps: usize) -> Option<f64> {
+    let dt = (hi - lo) / steps as f64;
+    let mut a = lo;
+    let mut fa = f(r.at(a));
+    for i in 1..=steps {
+        let b = lo + dt * i as f64;
+        let fb = f(r.at(b));
+        if (fa < 0.0) != (fb < 0.0) {
+            let (mut x, mut y) = (a, b);
+            for _ in 0..100 {
+                let m = 0.5 * (x + y);
+                if (f(r.at(m)) < 0.0) == (fa < 0.0) {
+                    x = m;
+                } else {
+                    y = m;
+                }
+            }
+            return Some(0.5 * (x + y));
+        }
+        (a, fa) = (b, fb);
+    }
+    None
+}
+
+// ------------------------------------------------------------------ sphere
+
+#[test]
+fn sphere_known_values() {
+    let h = sphere(
+        &ray([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]),
+        DVec3::ZERO,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    assert_eq!(h.t, 4.0);
+    assert_eq!(h.normal, -DVec3::Z);
+    // t is in units of the direction.
+    let h = sphere(
+        &ray([0.0, 0.0, -5.0], [0.0, 0.0, 2.0]),
+        DVec3::ZERO,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    assert_eq!(h.t, 2.0);
+    // Off-centre: x = 0.6 meets the unit sphere at z = −0.8.
+    let h = sphere(
+        &ray([0.6, 0.0, -5.0], [0.0, 0.0, 1.0]),
+        DVec3::ZERO,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 4.2, 1e-15);
+    close3(h.normal, DVec3::new(0.6, 0.0, -0.8), 1e-15);
+    // Pointing away, or the interval excludes both roots (open bounds).
+    let r = ray([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]);
+    assert!(
+        sphere(
+            &ray([0.0, 0.0, -5.0], [0.0, 0.0, -1.0]),
+            DVec3::ZERO,
+            1.0,
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+    assert!(sphere(&r, DVec3::ZERO, 1.0, 0.0, 4.0).is_none());
+    assert_eq!(sphere(&r, DVec3::ZERO, 1.0, 4.0, INF).unwrap().t, 6.0);
+}
+
+#[test]
+fn sphere_inside_start_hits_far_side_with_outward_normal() {
+    let h = sphere(
+        &ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        DVec3::ZERO,
+        2.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    assert_eq!(h.t, 2.0);
+    assert_eq!(h.normal, DVec3::X);
+    // Starting on the surface and leaving it: no re-hit with tmin > 0.
+    let r = ray([2.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+    assert!(sphere(&r, DVec3::ZERO, 2.0, 1e-9, INF).is_none());
+}
+
+#[test]
+fn sphere_grazing() {
+    // Tangent at (0, 1, 0): a double root, a hit.
+    let h = sphere(
+        &ray([-5.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
+        DVec3::ZERO,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 5.0, 1e-14);
+    close3(h.normal, DVec3::Y, 1e-14);
+    assert!(
+        sphere(
+            &ray([-5.0, 1.0 + 1e-9, 0.0], [1.0, 0.0, 0.0]),
+            DVec3::ZERO,
+            1.0,
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+    let h = sphere(
+        &ray([-5.0, 1.0 - 1e-9, 0.0], [1.0, 0.0, 0.0]),
+        DVec3::ZERO,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 5.0, 1e-4);
+}
+
+#[test]
+fn sphere_far_and_small_keeps_precision() {
+    let c = DVec3::new(0.0, 0.0, 1e6);
+    let h = sphere(&ray([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), c, 1e-3, 0.0, INF).unwrap();
+    close(h.t, 1e6 - 1e-3, 1e-9);
+}
+
+#[test]
+fn sphere_random_rays_land_on_surface() {
+    for seed in 0..2000 {
+        let mut g = Rng(seed);
+        let c = g.vec(-5.0, 5.0);
+        let r = g.range(0.1, 3.0);
+        let o = g.vec(-10.0, 10.0);
+        let target = c + g.vec(-1.0, 1.0) * r;
+        let ry = Ray::new(o, (target - o) * g.range(0.1, 3.0));
+        let f = |p: DVec3| (p - c).length() - r;
+        let expect = march(&ry, f, 0.0, 20.0, 20_000);
+        let got = sphere(&ry, c, r, 0.0, INF);
+        match (got, expect) {
+            (Some(h), Some(t)) => {
+                close(h.t, t, 1e-6 * (1.0 + t));
+                close(f(ry.at(h.t)), 0.0, 1e-9);
+                close3(h.normal, (ry.at(h.t) - c) / r, 1e-9);
+            }
+            (None, None) => {}
+            (got, expect) => panic!("seed {seed}: {got:?} vs {expect:?}"),
+        }
+    }
+}
+
+// ---------------------------------------------------------------- triangle
+
+#[test]
+fn triangle_known_values_and_barycentrics() {
+    let v = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    let h = triangle(&ray([0.25, 0.5, 3.0], [0.0, 0.0, -1.0]), v, None, 0.0, INF).unwrap();
+    assert_eq!(h.t, 3.0);
+    assert_eq!((h.u, h.v), (0.25, 0.5));
+    // Winding v0 → v1 → v2 counter-clockwise seen from +z.
+    assert_eq!(h.normal, DVec3::Z);
+    // From below: the same normal (not flipped).
+    let h = triangle(&ray([0.25, 0.25, -1.0], [0.0, 0.0, 2.0]), v, None, 0.0, INF).unwrap();
+    assert_eq!((h.t, h.normal), (0.5, DVec3::Z));
+}
+
+#[test]
+fn triangle_interpolates_vertex_normals() {
+    let v = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    let n = [
+        DVec3::Z,
+        DVec3::new(1.0, 0.0, 1.0),
+        DVec3::new(0.0, 1.0, 1.0),
+    ];
+    let h = triangle(
+        &ray([0.25, 0.5, 1.0], [0.0, 0.0, -1.0]),
+        v,
+        Some(n),
+        0.0,
+        INF,
+    )
+    .unwrap();
+    let expect = (n[0] * 0.25 + n[1] * 0.25 + n[2] * 0.5).normalize();
+    close3(h.normal, expect, 1e-15);
+    // At a vertex, that vertex's normal.
+    let h = triangle(
+        &ray([1.0, 0.0, 1.0], [0.0, 0.0, -1.0]),
+        v,
+        Some(n),
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close3(h.normal, n[1].normalize(), 1e-15);
+    // Normals that cancel fall back to the face normal.
+    let opposite = [DVec3::Z, -DVec3::Z, DVec3::Z];
+    let h = triangle(
+        &ray([0.5, 0.0, 1.0], [0.0, 0.0, -1.0]),
+        v,
+        Some([opposite[0], opposite[1], DVec3::ZERO]),
+        0.0,
+        INF,
+    )
+    .unwrap();
+    assert_eq!(h.normal, DVec3::Z);
+}
+
+#[test]
+fn triangle_edges_parallel_and_degenerate() {
+    let v = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    let down = [0.0, 0.0, -1.0];
+    // On the hypotenuse u + v = 1 and on the edges: hits.
+    assert!(triangle(&ray([0.5, 0.5, 1.0], down), v, None, 0.0, INF).is_some());
+    assert!(triangle(&ray([0.0, 0.3, 1.0], down), v, None, 0.0, INF).is_some());
+    // Just outside: misses.
+    assert!(triangle(&ray([0.5, 0.5 + 1e-12, 1.0], down), v, None, 0.0, INF).is_none());
+    assert!(triangle(&ray([-1e-12, 0.3, 1.0], down), v, None, 0.0, INF).is_none());
+    // A grazing ray in the triangle's plane, and a zero-area triangle.
+    assert!(triangle(&ray([-1.0, 0.2, 0.0], [1.0, 0.0, 0.0]), v, None, 0.0, INF).is_none());
+    let flat = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
+    assert!(triangle(&ray([0.5, 0.0, 1.0], down), flat, None, 0.0, INF).is_none());
+    // A ray starting on the triangle: excluded by tmin, included below it.
+    let r = ray([0.2, 0.2, 0.0], [0.0, 0.0, 1.0]);
+    assert!(triangle(&r, v, None, 0.0, INF).is_none());
+    assert_eq!(triangle(&r, v, None, -1.0, INF).unwrap().t, 0.0);
+}
+
+#[test]
+fn triangle_random_rays_against_plane_and_barycentrics() {
+    for seed in 0..2000 {
+        let mut g = Rng(seed);
+        let v = [g.vec(-3.0, 3.0), g.vec(-3.0, 3.0), g.vec(-3.0, 3.0)];
+        let o = g.vec(-10.0, 10.0);
+        let target = v[0] + (v[1] - v[0]) * g.range(-0.2, 1.0) + (v[2] - v[0]) * g.range(-0.2, 1.0);
+        let r = Ray::new(o, target - o);
+        let Some(h) = triangle(&r, v, None, 0.0, INF) else {
+            continue;
+        };
+        let p = r.at(h.t);
+        let q = v[0] * (1.0 - h.u - h.v) + v[1] * h.u + v[2] * h.v;
+        close3(p, q, 1e-9 * (1.0 + p.length()));
+        assert!(h.u >= 0.0 && h.v >= 0.0 && h.u + h.v <= 1.0, "seed {seed}");
+        close(h.normal.dot(v[1] - v[0]), 0.0, 1e-9);
+        close(h.normal.dot(v[2] - v[0]), 0.0, 1e-9);
+    }
+}
+
+// -------------------------------------------------------------------- cone
+
+#[test]
+fn cylinder_known_values_inside_start_and_open_ends() {
+    let (b, a) = (DVec3::ZERO, DVec3::new(0.0, 0.0, 2.0));
+    let h = cone(
+        &ray([-5.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+        b,
+        1.0,
+        a,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 4.0, 1e-15);
+    close3(h.normal, -DVec3::X, 1e-15);
+    // Inside: the far wall, normal outward.
+    let h = cone(
+        &ray([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+        b,
+        1.0,
+        a,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 1.0, 1e-15);
+    close3(h.normal, DVec3::X, 1e-15);
+    // Along the axis inside: out through the open ends.
+    assert!(
+        cone(
+            &ray([0.0, 0.0, 1.0], [0.0, 0.0, 1.0]),
+            b,
+            1.0,
+            a,
+            1.0,
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+    // Above or below the finite cylinder: misses.
+    assert!(
+        cone(
+            &ray([-5.0, 0.0, 2.5], [1.0, 0.0, 0.0]),
+            b,
+            1.0,
+            a,
+            1.0,
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+    // Entering through the open top end, then hitting the wall inside.
+    let h = cone(
+        &ray([0.0, 0.0, 3.0], [0.5, 0.0, -1.0]),
+        b,
+        1.0,
+        a,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 2.0, 1e-15);
+    close3(h.normal, DVec3::X, 1e-15);
+    // Radii sign as embree_nff: absolute values.
+    let h = cone(
+        &ray([-5.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+        b,
+        -1.0,
+        a,
+        -1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 4.0, 1e-15);
+}
+
+#[test]
+fn cylinder_grazing() {
+    let (b, a) = (DVec3::ZERO, DVec3::new(0.0, 0.0, 2.0));
+    let h = cone(
+        &ray([-5.0, 1.0, 1.0], [1.0, 0.0, 0.0]),
+        b,
+        1.0,
+        a,
+        1.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 5.0, 1e-12);
+    close3(h.normal, DVec3::Y, 1e-12);
+    assert!(
+        cone(
+            &ray([-5.0, 1.0 + 1e-9, 1.0], [1.0, 0.0, 0.0]),
+            b,
+            1.0,
+            a,
+            1.0,
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+    // Parallel to the axis, on the wall: no isolated intersection.
+    assert!(
+        cone(
+            &ray([1.0, 0.0, -1.0], [0.0, 0.0, 1.0]),
+            b,
+            1.0,
+            a,
+            1.0,
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+}
+
+#[test]
+fn cone_known_values() {
+    // Radius 1 at z = 0 down to a point at z = 1.
+    let (b, a) = (DVec3::ZERO, DVec3::Z);
+    let h = cone(
+        &ray([-5.0, 0.0, 0.5], [1.0, 0.0, 0.0]),
+        b,
+        1.0,
+        a,
+        0.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 4.5, 1e-15);
+    close3(h.normal, DVec3::new(-1.0, 0.0, 1.0).normalize(), 1e-15);
+    // A ray lying on a generator (x = z − 1): no isolated intersection.
+    let h = cone(
+        &ray([-2.0, 0.0, -1.0], [1.0, 0.0, 1.0]),
+        b,
+        1.0,
+        a,
+        0.0,
+        0.0,
+        INF,
+    );
+    assert!(h.is_none(), "{h:?}");
+    // Parallel to that generator, inside it (x = z − 0.5): the quadratic
+    // degenerates to a linear equation; the far side at z = 0.75, t = 2.25.
+    let h = cone(
+        &ray([-2.0, 0.0, -1.5], [1.0, 0.0, 1.0]),
+        b,
+        1.0,
+        a,
+        0.0,
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 2.25, 1e-12);
+    close3(h.normal, DVec3::new(1.0, 0.0, 1.0).normalize(), 1e-12);
+}
+
+#[test]
+fn cone_random_rays_land_on_surface() {
+    for seed in 0..2000 {
+        let mut g = Rng(seed);
+        let b = g.vec(-2.0, 2.0);
+        let a = g.vec(-2.0, 2.0);
+        let (r0, r1) = (g.range(0.0, 1.0), g.range(0.1, 1.0));
+        let o = g.vec(-6.0, 6.0);
+        let target = b + (a - b) * g.range(0.0, 1.0) + g.vec(-1.0, 1.0);
+        let ry = Ray::new(o, target - o);
+        let Some(h) = cone(&ry, b, r0, a, r1, 0.0, INF) else {
+            continue;
+        };
+        let axis = (a - b).normalize();
+        let q = ry.at(h.t) - b;
+        let y = q.dot(axis);
+        let height = (a - b).length();
+        assert!((-1e-9..=height + 1e-9).contains(&y), "seed {seed}");
+        let radius = r0 + (r1 - r0) * y / height;
+        close((q - axis * y).length(), radius, 1e-8);
+        // The normal is perpendicular to the generator through the point.
+        let radial = (q - axis * y).normalize();
+        let generator = (a + radial * r1) - (b + radial * r0);
+        close(h.normal.dot(generator), 0.0, 1e-8);
+        assert!(h.normal.dot(radial) > 0.0, "outward");
+    }
+}
+
+// --------------------------------------------------------------------- box
+
+#[test]
+fn box_known_values_inside_start_and_edges() {
+    let (lo, hi) = (DVec3::ZERO, DVec3::ONE);
+    let h = aabb(&ray([-5.0, 0.5, 0.5], [1.0, 0.0, 0.0]), lo, hi, 0.0, INF).unwrap();
+    assert_eq!((h.t, h.normal), (5.0, -DVec3::X));
+    let h = aabb(&ray([0.5, 0.5, 0.5], [0.0, 1.0, 0.0]), lo, hi, 0.0, INF).unwrap();
+    assert_eq!((h.t, h.normal), (0.5, DVec3::Y));
+    let h = aabb(&ray([0.5, 0.5, 3.0], [0.0, 0.0, -2.0]), lo, hi, 0.0, INF).unwrap();
+    assert_eq!((h.t, h.normal), (1.0, DVec3::Z));
+    // Through an edge into the box.
+    let h = aabb(&ray([-1.0, -1.0, 0.5], [1.0, 1.0, 0.0]), lo, hi, 0.0, INF).unwrap();
+    assert_eq!(h.t, 1.0);
+    // Grazing an edge from outside: touches it at one point.
+    let h = aabb(&ray([0.0, -1.0, 0.5], [1.0, 1.0, 0.0]), lo, hi, 0.0, INF).unwrap();
+    assert_eq!((h.t, h.normal), (1.0, -DVec3::Y));
+    // Past the edge by a hair: misses.
+    assert!(
+        aabb(
+            &ray([0.0, -1.0 - 1e-12, 0.5], [1.0, 1.0, 0.0]),
+            lo,
+            hi,
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+    // In a face's plane: enters the face at its edge.
+    let h = aabb(&ray([-1.0, 0.0, 0.5], [1.0, 0.0, 0.0]), lo, hi, 0.0, INF).unwrap();
+    assert_eq!((h.t, h.normal), (1.0, -DVec3::X));
+    // Misses and the interval.
+    assert!(aabb(&ray([-1.0, 2.0, 0.5], [1.0, 0.0, 0.0]), lo, hi, 0.0, INF).is_none());
+    assert!(aabb(&ray([-5.0, 0.5, 0.5], [-1.0, 0.0, 0.0]), lo, hi, 0.0, INF).is_none());
+    let r = ray([-5.0, 0.5, 0.5], [1.0, 0.0, 0.0]);
+    assert_eq!(aabb(&r, lo, hi, 5.5, INF).unwrap().t, 6.0);
+    assert!(aabb(&r, lo, hi, 0.0, 5.0).is_none());
+}
+
+// ------------------------------------------------------------------- torus
+
+/// R = 2, r = 0.5 about z through the origin.
+fn ring(r: &Ray) -> Option<Hit> {
+    torus(r, DVec3::ZERO, DVec3::Z, 2.0, 0.5, 0.0, INF)
+}
+
+#[test]
+fn torus_known_values() {
+    let h = ring(&ray([-5.0, 0.0, 0.0], [1.0, 0.0, 0.0])).unwrap();
+    close(h.t, 2.5, 1e-12);
+    close3(h.normal, -DVec3::X, 1e-12);
+    // From the centre: the inner side of the tube, facing the hole.
+    let h = ring(&ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0])).unwrap();
+    close(h.t, 1.5, 1e-12);
+    close3(h.normal, -DVec3::X, 1e-12);
+    // From above, down onto the tube's top.
+    let h = ring(&ray([2.0, 0.0, 5.0], [0.0, 0.0, -2.0])).unwrap();
+    close(h.t, 2.25, 1e-12);
+    close3(h.normal, DVec3::Z, 1e-12);
+    // Down the axis, through the hole.
+    assert!(ring(&ray([0.0, 0.0, 5.0], [0.0, 0.0, -1.0])).is_none());
+    // Across the hole at a height above the tube.
+    assert!(ring(&ray([-5.0, 0.0, 0.6], [1.0, 0.0, 0.0])).is_none());
+    // The interval skips the first two roots.
+    let h = torus(
+        &ray([-5.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        DVec3::ZERO,
+        DVec3::Z,
+        2.0,
+        0.5,
+        4.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 6.5, 1e-12);
+}
+
+#[test]
+fn torus_inside_start() {
+    let h = ring(&ray([2.0, 0.0, 0.0], [1.0, 0.0, 0.0])).unwrap();
+    close(h.t, 0.5, 1e-12);
+    close3(h.normal, DVec3::X, 1e-12);
+    let h = ring(&ray([0.0, 2.0, 0.0], [0.0, 0.0, 1.0])).unwrap();
+    close(h.t, 0.5, 1e-12);
+    close3(h.normal, DVec3::Z, 1e-12);
+}
+
+#[test]
+fn torus_grazing() {
+    // Along the top circle's tangent: touches at (2, 0, 0.5) only. The
+    // contact is of order 4 (the quartic behaves like y⁴/16 there), so
+    // rounding of about 1e-16 moves the root by about its fourth root.
+    let h = ring(&ray([2.0, -5.0, 0.5], [0.0, 1.0, 0.0])).unwrap();
+    close(h.t, 5.0, 1e-4);
+    close3(h.normal, DVec3::Z, 1e-4);
+    // Tangent to the outer equator at (2.5, 0, 0).
+    let h = ring(&ray([2.5, -5.0, 0.0], [0.0, 1.0, 0.0])).unwrap();
+    close(h.t, 5.0, 1e-6);
+    close3(h.normal, DVec3::X, 1e-5);
+    // Just outside each: misses.
+    assert!(ring(&ray([2.0, -5.0, 0.5 + 1e-7], [0.0, 1.0, 0.0])).is_none());
+    assert!(ring(&ray([2.5 + 1e-7, -5.0, 0.0], [0.0, 1.0, 0.0])).is_none());
+    // Just inside: two close roots; the nearer one.
+    let h = ring(&ray([2.5 - 1e-6, -5.0, 0.0], [0.0, 1.0, 0.0])).unwrap();
+    assert!(h.t < 5.0 && h.t > 4.99, "{}", h.t);
+}
+
+#[test]
+fn torus_random_rays_against_implicit_surface() {
+    for seed in 0..1500 {
+        let mut g = Rng(seed);
+        let c = g.vec(-3.0, 3.0);
+        let axis = g.vec(-1.0, 1.0).normalize();
+        let (big, small) = (g.range(0.5, 3.0), g.range(0.05, 0.6));
+        let o = g.vec(-8.0, 8.0);
+        let target = c + g.vec(-1.0, 1.0) * (big + small);
+        let r = Ray::new(o, (target - o) * g.range(0.5, 2.0));
+        let f = |p: DVec3| {
+            let q = p - c;
+            let h = q.dot(axis);
+            let rho = (q - axis * h).length();
+            (rho - big).hypot(h) - small
+        };
+        let expect = march(&r, f, 0.0, 40.0, 40_000);
+        match (torus(&r, c, axis, big, small, 0.0, INF), expect) {
+            (Some(h), Some(t)) => {
+                close(h.t, t, 1e-6 * (1.0 + t));
+                close(f(r.at(h.t)), 0.0, 1e-9);
+                // The normal is the direction from the tube's centre circle.
+                let q = r.at(h.t) - c;
+                let hgt = q.dot(axis);
+                let ring_pt = (q - axis * hgt).normalize() * big;
+                close3(h.normal, (q - ring_pt).normalize(), 1e-7);
+            }
+            (None, None) => {}
+            // A graze the marcher's sampling stepped over.
+            (Some(h), None) if f(r.at(h.t)).abs() < 1e-9 => {}
+            (got, expect) => panic!("seed {seed}: {got:?} vs {expect:?}"),
+        }
+    }
+}
+
+#[test]
+fn torus_far_away_keeps_precision() {
+    let c = DVec3::new(1e4, -2e4, 5e3);
+    let r = Ray::new(DVec3::ZERO, c + DVec3::new(-2.5, 0.0, 0.0));
+    let h = torus(&r, c, DVec3::Z, 2.0, 0.5, 0.0, INF).unwrap();
+    // Hits the outer equator at c − (2.5, 0, 0) exactly at t = 1.
+    close(h.t, 1.0, 1e-12);
+}
+
+// ------------------------------------------------------------ Bézier patch
+
+/// Control points on a 3 × 3 square with evenly spaced x and y, so that
+/// `x = 3u`, `y = 3v`, and heights `z[i][j]`.
+fn height_patch(z: [[f64; 4]; 4]) -> PatchControl {
+    let mut c = [[DVec3::ZERO; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            c[i][j] = DVec3::new(i as f64, j as f64, z[i][j]);
+        }
+    }
+    c
+}
+
+/// Interior control points at height 1: `z = 9·u(1−u)·v(1−v)`, top
+/// 0.5625 at the centre.
+fn bump() -> PatchControl {
+    let mut z = [[0.0; 4]; 4];
+    for row in z.iter_mut().take(3).skip(1) {
+        for h in row.iter_mut().take(3).skip(1) {
+            *h = 1.0;
+        }
+    }
+    height_patch(z)
+}
+
+fn bump_height(x: f64, y: f64) -> f64 {
+    let (u, v) = (x / 3.0, y / 3.0);
+    9.0 * u * (1.0 - u) * v * (1.0 - v)
+}
+
+#[test]
+fn flat_patch_known_values() {
+    let flat = height_patch([[0.0; 4]; 4]);
+    let h = bezier_patch(&ray([1.0, 2.0, 5.0], [0.0, 0.0, -1.0]), &flat, 0.0, INF).unwrap();
+    close(h.t, 5.0, 1e-12);
+    close(h.u, 1.0 / 3.0, 1e-12);
+    close(h.v, 2.0 / 3.0, 1e-12);
+    close3(h.normal, DVec3::Z, 1e-12);
+    // Outside the patch's square: a miss.
+    assert!(bezier_patch(&ray([3.5, 2.0, 5.0], [0.0, 0.0, -1.0]), &flat, 0.0, INF).is_none());
+}
+
+#[test]
+fn bump_patch_known_values() {
+    let p = bump();
+    let h = bezier_patch(&ray([1.5, 1.5, 5.0], [0.0, 0.0, -1.0]), &p, 0.0, INF).unwrap();
+    close(h.t, 5.0 - 0.5625, 1e-12);
+    close(h.u, 0.5, 1e-9);
+    close(h.v, 0.5, 1e-9);
+    close3(h.normal, DVec3::Z, 1e-9);
+    // From below (a ray starting "inside" the bump), up through it.
+    let h = bezier_patch(&ray([1.0, 2.0, -1.0], [0.0, 0.0, 1.0]), &p, 0.0, INF).unwrap();
+    close(h.t, 1.0 + bump_height(1.0, 2.0), 1e-12);
+    // Starting on the surface and leaving it: no re-hit.
+    let on = DVec3::new(1.0, 2.0, bump_height(1.0, 2.0));
+    assert!(bezier_patch(&Ray::new(on, DVec3::Z), &p, 1e-9, INF).is_none());
+    // A ray through the bump twice: the nearer hit.
+    let r = ray([-1.0, 1.5, 0.3], [1.0, 0.0, 0.0]);
+    let h = bezier_patch(&r, &p, 0.0, INF).unwrap();
+    // 2.25·u(1−u) = 0.3 → u = (1 − √(1 − 4·0.3/2.25))/2.
+    let u = (1.0 - (1.0 - 4.0 * 0.3 / 2.25f64).sqrt()) / 2.0;
+    close(h.t, 3.0 * u + 1.0, 1e-9);
+}
+
+#[test]
+fn bump_patch_grazing() {
+    // Tangent to the top: touches at (1.5, 1.5, 0.5625) only.
+    let h = bezier_patch(
+        &ray([-1.0, 1.5, 0.5625], [1.0, 0.0, 0.0]),
+        &bump(),
+        0.0,
+        INF,
+    )
+    .unwrap();
+    close(h.t, 2.5, 1e-4);
+    close3(h.normal, DVec3::Z, 1e-3);
+    // Slightly above: a miss.
+    assert!(
+        bezier_patch(
+            &ray([-1.0, 1.5, 0.5626], [1.0, 0.0, 0.0]),
+            &bump(),
+            0.0,
+            INF
+        )
+        .is_none()
+    );
+    // Slightly below: two close roots, the nearer one.
+    for eps in [1e-4, 1e-6] {
+        let z = 0.5625 - eps;
+        let h = bezier_patch(&ray([-1.0, 1.5, z], [1.0, 0.0, 0.0]), &bump(), 0.0, INF).unwrap();
+        let u = 0.5 - (eps / 2.25f64).sqrt();
+        close(h.t, 3.0 * u + 1.0, 1e-6);
+    }
+}
+
+#[test]
+fn bump_patch_random_rays_against_height_field() {
+    let p = bump();
+    for seed in 0..300 {
+        let mut g = Rng(seed);
+        let o = DVec3::new(g.range(-2.0, 5.0), g.range(-2.0, 5.0), g.range(0.7, 3.0));
+        let target = DVec3::new(g.range(-0.5, 3.5), g.range(-0.5, 3.5), g.range(-0.2, 0.6));
+        let r = Ray::new(o, target - o);
+        // The height field, marched over the part of the ray above the
+        // patch's square.
+        let f = |q: DVec3| q.z - bump_height(q.x, q.y);
+        let square = slabs(&r, DVec3::new(0.0, 0.0, -1e9), DVec3::new(3.0, 3.0, 1e9));
+        let expect = square.and_then(|(t0, _, t1, _)| {
+            (t1 > 0.0)
+                .then(|| march(&r, f, t0.max(0.0), t1, 30_000))
+                .flatten()
+        });
+        match (bezier_patch(&r, &p, 0.0, INF), expect) {
+            (Some(h), Some(t)) => {
+                close(h.t, t, 1e-6);
+                let (q, _, _) = patch_eval(&p, h.u, h.v);
+                close3(q, r.at(h.t), 1e-9);
+            }
+            (None, None) => {}
+            (got, expect) => panic!("seed {seed}: {got:?} vs {expect:?}"),
+        }
+    }
+}
+
+#[test]
+fn collapsed_patch_edge_has_a_normal() {
+    // Row u = 0 collapsed to one point (a pole, as in the teapot's lid).
+    let mut c = height_patch([[0.0; 4]; 4]);
+    for j in 0..4 {
+        c[0][j] = DVec3::new(0.0, 1.5, 0.0);
+    }
+    let n = patch_normal(&c, 0.0, 0.5);
+    assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-12);
+    close3(n, DVec3::Z, 1e-9);
+    let h = bezier_patch(&ray([1.5, 1.5, 1.0], [0.0, 0.0, -1.0]), &c, 0.0, INF).unwrap();
+    close(h.t, 1.0, 1e-12);
+}
+
+#[test]
+fn non_finite_input_is_a_miss() {
+    let nan = ray([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0]);
+    let zero = ray([0.0, 0.0, -5.0], [0.0, 0.0, 0.0]);
+    for r in [nan, zero] {
+        assert!(sphere(&r, DVec3::ZERO, 1.0, 0.0, INF).is_none());
+        assert!(triangle(&r, [DVec3::ZERO, DVec3::X, DVec3::Y], None, 0.0, INF).is_none());
+        assert!(cone(&r, DVec3::ZERO, 1.0, DVec3::Z, 1.0, 0.0, INF).is_none());
+        assert!(aabb(&r, -DVec3::ONE, DVec3::ONE, 0.0, INF).is_none());
+        assert!(ring(&r).is_none());
+        assert!(bezier_patch(&r, &bump(), 0.0, INF).is_none());
+    }
+}

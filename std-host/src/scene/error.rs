@@ -1,0 +1,188 @@
+//! Why a scene could not be read.
+
+use std::fmt;
+use std::io;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use super::loc::SourceLoc;
+
+/// What stood where the parser expected a value.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Found {
+    /// A token, as written (shown quoted and escaped, cut to
+    /// [`Found::MAX_SHOWN`] characters).
+    Token(String),
+    /// Nothing more on the line.
+    EndOfLine,
+    /// Nothing more in the file.
+    EndOfFile,
+}
+
+impl Found {
+    /// Longest token shown in a message, in characters.
+    pub const MAX_SHOWN: usize = 40;
+
+    /// The token `text`, cut to [`Found::MAX_SHOWN`] characters (binary
+    /// garbage can make very long tokens).
+    #[must_use]
+    pub fn token(text: &str) -> Self {
+        match text.char_indices().nth(Self::MAX_SHOWN) {
+            Some((cut, _)) => Self::Token(format!("{}…", &text[..cut])),
+            None => Self::Token(text.to_owned()),
+        }
+    }
+}
+
+impl fmt::Display for Found {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Token(t) => write!(f, "{t:?}"),
+            Self::EndOfLine => f.write_str("end of line"),
+            Self::EndOfFile => f.write_str("end of file"),
+        }
+    }
+}
+
+/// An error reading or parsing a scene file. Each message starts with the
+/// file (and line and column, where there is one), then the field.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// The file could not be opened or read.
+    #[error("cannot read {}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: io::Error,
+    },
+    /// The path names a directory.
+    #[error("{}: is a directory, not an NFF file", path.display())]
+    IsDirectory {
+        /// The path.
+        path: PathBuf,
+    },
+    /// The file is larger than [`ParseOptions::max_file_bytes`](super::ParseOptions::max_file_bytes).
+    #[error("{file}: {size} bytes, more than the limit of {limit} bytes for a scene file")]
+    FileTooLarge {
+        /// The file.
+        file: Arc<str>,
+        /// Its size in bytes.
+        size: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// The file holds no directive (it is empty, or only blank lines and
+    /// comments).
+    #[error("{file}: empty file: no NFF directives")]
+    Empty {
+        /// The file.
+        file: Arc<str>,
+    },
+    /// The file is not text: a NUL byte or invalid UTF-8.
+    #[error("{loc}: not a text file: {what}")]
+    NotText {
+        /// Where the first offending byte is.
+        loc: SourceLoc,
+        /// What was found.
+        what: &'static str,
+    },
+    /// A field's value is missing, malformed or out of range.
+    #[error("{loc}: {field}: expected {expected}, found {found}")]
+    BadField {
+        /// Where the offending token (or the end of the line) is.
+        loc: SourceLoc,
+        /// The field, e.g. `sphere radius`.
+        field: &'static str,
+        /// What the field must hold.
+        expected: &'static str,
+        /// What was there.
+        found: Found,
+    },
+    /// A line starts with a word that is not an NFF directive.
+    #[error("{loc}: unknown directive {found}: NFF has b, v, l, f, c, s, p, pp and # comments")]
+    UnknownDirective {
+        /// Where the word is.
+        loc: SourceLoc,
+        /// The word.
+        found: Found,
+    },
+    /// A view keyword (`from`, `at`, ...) outside a `v` block.
+    #[error(
+        "{loc}: `{keyword}` outside a view: it belongs on the lines after `v`, in the order from, at, up, angle, hither, resolution"
+    )]
+    Misplaced {
+        /// Where the keyword is.
+        loc: SourceLoc,
+        /// The keyword.
+        keyword: &'static str,
+    },
+    /// A polygon announces more vertices than the rest of the file can
+    /// hold (each vertex takes a line); refused before allocating.
+    #[error(
+        "{loc}: {field}: {count} vertices announced, but only {remaining} lines remain in the file"
+    )]
+    CountExceedsInput {
+        /// Where the count is.
+        loc: SourceLoc,
+        /// The field.
+        field: &'static str,
+        /// The count.
+        count: u64,
+        /// Lines after the count's line.
+        remaining: u64,
+    },
+    /// The scene would hold more vertices than
+    /// [`ParseOptions::max_vertices`](super::ParseOptions::max_vertices).
+    #[error(
+        "{loc}: {field}: {count} more vertices would make {total}, more than the limit of {limit} vertices per scene"
+    )]
+    TooManyVertices {
+        /// Where the count is.
+        loc: SourceLoc,
+        /// The field.
+        field: &'static str,
+        /// The polygon's vertex count.
+        count: u64,
+        /// The scene's total with it.
+        total: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// Well-formed numbers that do not make a valid object.
+    #[error("{loc}: {field}: {problem}")]
+    Invalid {
+        /// Where the object (or its offending part) is.
+        loc: SourceLoc,
+        /// The field or object.
+        field: &'static str,
+        /// What is wrong.
+        problem: &'static str,
+    },
+    /// A directive that may appear once appears again.
+    #[error("{loc}: {what}: a second one; the first is on line {first_line}")]
+    Duplicate {
+        /// Where the second one is.
+        loc: SourceLoc,
+        /// The directive, e.g. `view (v)`.
+        what: &'static str,
+        /// The line of the first one.
+        first_line: u32,
+    },
+    /// No `v` block.
+    #[error(
+        "{file}: no view: an NFF scene needs a `v` block (v, from, at, up, angle, hither, resolution)"
+    )]
+    MissingView {
+        /// The file.
+        file: Arc<str>,
+    },
+    /// No object.
+    #[error("{file}: no objects: the scene has no s, c, p or pp")]
+    NoObjects {
+        /// The file.
+        file: Arc<str>,
+    },
+}
