@@ -221,8 +221,8 @@ fn clip(o: [f32; 3], d: [f32; 3], n: f32) -> (f32, f32) {
 pub fn camera_rays(n: u32, res: u32) -> Vec<BenchRay> {
     let nn = f64::from(n);
     let c = 0.5 * nn;
-    let e = [1.2, 0.9, 0.7];
-    let l: f64 = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+    let e: [f64; 3] = [1.2, 0.9, 0.7];
+    let l = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
     let eye = e.map(|v| c + nn * v);
     let fwd = e.map(|v| -v / l);
     let up0 = [0.0, 0.0, 1.0];

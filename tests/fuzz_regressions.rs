@@ -39,3 +39,12 @@ fn discrete_ray_inputs_replay() {
         run_ray_case(&case);
     }
 }
+
+#[test]
+fn nff_inputs_replay() {
+    for (name, bytes) in inputs("nff") {
+        if let Err(broken) = rrt_host::check::nff_input(&bytes) {
+            panic!("{name}: {broken}");
+        }
+    }
+}
