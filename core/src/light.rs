@@ -320,27 +320,23 @@ fn shadow_ray<const N: usize>(
 ) -> Result<LightVisibility, LightError> {
     let extent = raster.extent();
     let mut translucent = false;
+    let rule = LeavingSurface {
+        start,
+        c0,
+        side,
+        stored,
+        object,
+        slab: params.slab,
+        same_surface_cos: params.same_surface_cos,
+    };
     let mut test = |index: usize, c: u8| -> bool {
-        if c & cell::OPAQUE == 0 || Some(index) == start {
+        if c & cell::OPAQUE == 0 {
             return false;
         }
         let Some(b) = view.get(index) else {
             return true;
         };
-        let Some(vb) = extent.coord(index) else {
-            return true;
-        };
-        let d = sub(vb.map(voxel_centre), c0);
-        // (c_b − c₀)·N₀ in fixed units: |d| < 2^33, |N| <= 2^30.
-        let height = d
-            .iter()
-            .zip(side.iter())
-            .map(|(a, n)| i128::from(*a).saturating_mul(i128::from(*n)))
-            .fold(0i128, i128::saturating_add)
-            >> 30;
-        let same_surface =
-            b.object == object || dot_unit(b.normal_vector(), stored) >= params.same_surface_cos;
-        if height <= i128::from(params.slab) && same_surface {
+        if rule.ignores(extent, index, b) {
             return false;
         }
         if materials
@@ -407,6 +403,93 @@ fn shadow_ray<const N: usize>(
         (Piece::Clear, true) => LightVisibility::Translucent,
         (Piece::Clear, false) => LightVisibility::Visible,
     })
+}
+
+/// The acne rule of the module docs, for any ray that leaves a surface
+/// voxel: the light pass's shadow rays, and the renderer's reflected,
+/// refracted and render-time shadow rays, so that one rule decides for all
+/// of them which voxels of the surface being left do not count as hits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LeavingSurface {
+    /// Linear index of the voxel the ray leaves (never a hit).
+    pub start: Option<usize>,
+    /// Centre of that voxel, fixed units.
+    pub c0: [i64; 3],
+    /// Unit normal ([`NORMAL_ONE`]-scaled) of the side the ray leaves
+    /// towards: heights are measured along it.
+    pub side: [i32; 3],
+    /// The stored normal of the voxel left (for the same-surface test).
+    pub stored: [i32; 3],
+    /// Object id of the voxel left.
+    pub object: u32,
+    /// Height above the tangent plane, fixed units, below which voxels of
+    /// the same surface are ignored ([`LightParams::slab`]).
+    pub slab: i64,
+    /// [`LightParams::same_surface_cos`].
+    pub same_surface_cos: i32,
+}
+
+impl LeavingSurface {
+    /// The rule for a ray leaving voxel `v` (with record `rec`) towards the
+    /// side of unit normal `side`, with the slab and angle of `params`.
+    ///
+    /// ```
+    /// use rrt_core::light::{LeavingSurface, LightParams};
+    /// use rrt_core::raster::Extent;
+    /// use rrt_core::voxel::{encode_normal, VoxelRecord};
+    /// use rrt_core::voxelize::NORMAL_ONE;
+    /// let e = Extent::cube(8).unwrap();
+    /// let up = [0, 0, NORMAL_ONE];
+    /// let rec = VoxelRecord { object: 3, normal: encode_normal(up), ..Default::default() };
+    /// let rule = LeavingSurface::new(e, [4, 4, 4], up, &rec, &LightParams::default());
+    /// // The neighbour in the same layer is the surface itself; one 3 voxels up is not.
+    /// assert!(rule.ignores(e, e.index([5, 4, 4]).unwrap(), &rec));
+    /// assert!(!rule.ignores(e, e.index([4, 4, 7]).unwrap(), &rec));
+    /// ```
+    #[must_use]
+    pub fn new(
+        extent: Extent,
+        v: [u32; 3],
+        side: [i32; 3],
+        rec: &VoxelRecord,
+        params: &LightParams,
+    ) -> Self {
+        Self {
+            start: extent.index(v),
+            c0: v.map(voxel_centre),
+            side,
+            stored: rec.normal_vector(),
+            object: rec.object,
+            slab: params.slab,
+            same_surface_cos: params.same_surface_cos,
+        }
+    }
+
+    /// Whether the opaque voxel at `index` with record `b` is part of the
+    /// surface being left, and so no hit: the start voxel itself, or a
+    /// voxel at most `slab` above the tangent plane that belongs to the
+    /// same object or to a surface oriented like this one.
+    #[must_use]
+    pub fn ignores(&self, extent: Extent, index: usize, b: &VoxelRecord) -> bool {
+        if Some(index) == self.start {
+            return true;
+        }
+        let Some(vb) = extent.coord(index) else {
+            return false;
+        };
+        let d = sub(vb.map(voxel_centre), self.c0);
+        // (c_b − c₀)·N₀ in fixed units: |d| < 2^33, |N| <= 2^30.
+        let height = d
+            .iter()
+            .zip(self.side.iter())
+            .map(|(a, n)| i128::from(*a).saturating_mul(i128::from(*n)))
+            .fold(0i128, i128::saturating_add)
+            >> 30;
+        if height > i128::from(self.slab) {
+            return false;
+        }
+        b.object == self.object || dot_unit(b.normal_vector(), self.stored) >= self.same_surface_cos
+    }
 }
 
 fn walk_piece<T: FnMut(usize, u8) -> bool>(
