@@ -18,11 +18,18 @@
 
 #![forbid(unsafe_code)]
 
+pub mod build;
 pub mod camera;
 #[cfg(any(test, feature = "check"))]
 pub mod check;
 pub mod cli;
 pub mod fit;
 pub mod intersect;
+pub mod output;
+pub mod plane;
+pub mod rasterfile;
+pub mod render;
 pub mod scene;
 pub mod shade;
+pub mod trace;
+pub mod world;

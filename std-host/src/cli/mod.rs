@@ -1,8 +1,12 @@
 //! The `rrt` command line. The binary (`src/bin/rrt.rs`) only parses the
 //! arguments and prints errors; each subcommand lives in its own module here.
 
+pub mod common;
+pub mod info;
 pub mod num;
 pub mod ray;
+pub mod render;
+pub mod voxelize;
 
 use std::io::Write;
 
@@ -18,6 +22,14 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, clap::Subcommand)]
 pub enum Command {
+    /// Render an NFF scene or a saved raster to a PNG (no scene: the
+    /// built-in 91-sphereflake to rrt.png).
+    Render(render::RenderArgs),
+    /// Voxelize an NFF scene once and save the raster, with light
+    /// visibility and precomputed illumination, for `rrt render`.
+    Voxelize(voxelize::VoxelizeArgs),
+    /// Print what a saved raster holds.
+    Info(info::InfoArgs),
     /// Trace one discrete ray and list its voxels, one `x y z` per line.
     Ray(ray::RayArgs),
 }
@@ -33,9 +45,39 @@ pub enum CliError {
         /// What is wrong.
         message: String,
     },
-    /// Writing the output failed.
+    /// Writing the report failed.
     #[error("cannot write output")]
     Io(#[from] std::io::Error),
+    /// The output file cannot be written.
+    #[error("cannot write {}", path.display())]
+    Output {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The scene file.
+    #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
+    /// Voxelizing the scene.
+    #[error(transparent)]
+    Build(#[from] crate::build::BuildError),
+    /// The view.
+    #[error(transparent)]
+    Camera(#[from] crate::camera::CameraError),
+    /// Setting up the tracer.
+    #[error(transparent)]
+    Trace(#[from] crate::trace::TraceError),
+    /// Rendering.
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    /// Writing the image.
+    #[error(transparent)]
+    Png(#[from] crate::output::OutputError),
+    /// A saved raster.
+    #[error(transparent)]
+    RasterFile(#[from] crate::rasterfile::RasterFileError),
 }
 
 /// Runs a parsed command line, writing reports to `out`.
@@ -45,5 +87,8 @@ pub enum CliError {
 pub fn run(cli: &Cli, out: &mut impl Write) -> Result<(), CliError> {
     match &cli.command {
         Command::Ray(args) => ray::run(args, out),
+        Command::Render(args) => render::run(args, out),
+        Command::Voxelize(args) => voxelize::run(args, out),
+        Command::Info(args) => info::run(args, out),
     }
 }

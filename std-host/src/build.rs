@@ -1,0 +1,541 @@
+//! From a scene to a voxelized raster: the paper's preprocessing phase.
+//!
+//! [`build`] runs the whole pipeline:
+//! 1. **fit** ([`crate::fit`]): the raster's frame, the memory estimate
+//!    against the limit, every object and light in fixed point;
+//! 2. **allocate** the plane ([`Plane`]: an anonymous map with huge pages)
+//!    and the brick directory;
+//! 3. **count pass**: every object through its core voxelizer into the
+//!    [`Counter`], with the separation the chosen rays need
+//!    ([`Separation::for_rays`]); the exact record count is then checked
+//!    against the memory limit before the records are allocated;
+//! 4. **fill pass**: every object again, named with its object id,
+//!    material and colour; [`Filler::finish`] sorts the bricks and sets the
+//!    proximity flags;
+//! 5. **light visibility** ([`rrt_core::light::illuminate`]): one discrete
+//!    shadow ray per record and light, the two visibility bits and the
+//!    precomputed ambient + diffuse illumination (SPD intensities
+//!    `I = sqrt(nl)/(2·nl)`, ambient the same).
+//!
+//! The result, a [`VoxelScene`], holds everything view-independent: the
+//! renderer ([`crate::trace`]) and the saved-raster file
+//! ([`crate::rasterfile`]) both start from it.
+//!
+//! Materials are deduplicated (NFF files repeat identical `f` lines): the
+//! record's 16-bit material index then names a distinct material, and at
+//! most [`MAX_MATERIALS`] distinct ones are accepted.
+
+#![deny(missing_docs)]
+
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+use indicatif::ProgressBar;
+use rrt_core::connectivity::Connectivity;
+use rrt_core::light::{LightError, LightParams, LightReport, illuminate};
+use rrt_core::object_table::{
+    self, Light, Lights, MAX_LIGHTS, Materials, Object, ObjectTable, SCALAR_ONE,
+};
+use rrt_core::raster::{Extent, Raster, RasterMut};
+use rrt_core::store::{self, Counter, Limits, ObjectAttrs, RecordStore, StoreError, directory_len};
+use rrt_core::voxel::VoxelRecord;
+use rrt_core::voxelize::error::VoxelizeError;
+use rrt_core::voxelize::{Separation, VoxelSink, cone, sphere, triangle};
+
+use crate::fit::{self, Bytes, FitError, FitOptions, Fitted, RasterFrame, Source};
+use crate::plane::Plane;
+use crate::scene::{Material, Scene, SourceLoc, View};
+use crate::shade;
+use crate::world::{WorldLight, WorldObject};
+
+/// Most distinct materials a scene may have (the record's index is 16
+/// bits; the table is kept small enough to copy per render).
+pub const MAX_MATERIALS: usize = 4096;
+
+/// A voxelized scene: the raster, its records and everything the renderer
+/// needs besides the view.
+#[derive(Debug)]
+pub struct VoxelScene {
+    /// World ↔ raster mapping and the raster's dimensions.
+    pub frame: RasterFrame,
+    /// The separation the surfaces were voxelized with: rays of a
+    /// connectivity that needs more (26-connected rays need
+    /// [`Separation::TwentySix`]) could pass through them.
+    pub separation: Separation,
+    /// One cell per voxel ([`rrt_core::raster::cell`]).
+    pub plane: Plane,
+    /// The brick directory of the record store.
+    pub directory: Vec<u32>,
+    /// The voxel records, sorted by brick and position.
+    pub records: Vec<VoxelRecord>,
+    /// The world object table, indexed by [`VoxelRecord::object`].
+    pub objects: Vec<WorldObject>,
+    /// Distinct materials, indexed by [`VoxelRecord::material`].
+    pub materials: Vec<Material>,
+    /// Lights, in file order (light `i` is bit pair `i` of the records).
+    pub lights: Vec<WorldLight>,
+    /// Background colour.
+    pub background: DVec3,
+    /// The scene's view (the renderer may override it).
+    pub view: View,
+}
+
+impl VoxelScene {
+    /// The raster's dimensions.
+    #[must_use]
+    pub fn extent(&self) -> Extent {
+        self.frame.extent
+    }
+
+    /// The raster (the plane over the extent).
+    ///
+    /// # Errors
+    /// Only if the plane does not match the extent, which the constructors
+    /// rule out.
+    pub fn raster(&self) -> Result<Raster<'_>, rrt_core::RasterError> {
+        Raster::new(self.frame.extent, &self.plane)
+    }
+
+    /// The record store, validated (O(bricks + records)).
+    ///
+    /// # Errors
+    /// The first broken store invariant.
+    pub fn store(&self) -> Result<RecordStore<'_>, StoreError> {
+        RecordStore::new(self.frame.extent, &self.directory, &self.records)
+    }
+
+    /// The SPD intensity of each light and of the ambient term.
+    #[must_use]
+    pub fn intensity(&self) -> f64 {
+        shade::light_intensity(self.lights.len())
+    }
+
+    /// Bytes held by the plane, directory and records.
+    #[must_use]
+    pub fn memory(&self) -> u64 {
+        let dir = self.directory.len().saturating_mul(4);
+        let rec = self
+            .records
+            .len()
+            .saturating_mul(std::mem::size_of::<VoxelRecord>());
+        u64::try_from(self.plane.len().saturating_add(dir).saturating_add(rec)).unwrap_or(u64::MAX)
+    }
+}
+
+/// How to build.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildOptions {
+    /// Raster size, bounds and memory limit.
+    pub fit: FitOptions,
+    /// The rays the raster is built for: decides the separation.
+    pub connectivity: Connectivity,
+    /// Shadow rays of the light pass.
+    pub light: LightParams,
+}
+
+impl BuildOptions {
+    /// `raster` voxels along the longest axis, for adaptive rays, default
+    /// limits.
+    #[must_use]
+    pub fn new(raster: u32) -> Self {
+        Self {
+            fit: FitOptions {
+                solid_spheres: false,
+                ..FitOptions::new(raster)
+            },
+            connectivity: Connectivity::Adaptive,
+            light: LightParams::default(),
+        }
+    }
+}
+
+/// What the build did, and how long each phase took.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildReport {
+    /// Objects voxelized.
+    pub objects: usize,
+    /// Objects dropped by the fit (degenerate in fixed point, or outside
+    /// explicit bounds).
+    pub dropped: usize,
+    /// Voxel offers in the count pass.
+    pub offers: u64,
+    /// Records (non-transparent voxels).
+    pub records: usize,
+    /// The light pass's counts.
+    pub light: LightReport,
+    /// Fit, allocation and both voxelization passes (with proximity flags).
+    pub voxelize: Duration,
+    /// The light pass.
+    pub lights: Duration,
+}
+
+/// Why a scene could not be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BuildError {
+    /// The raster could not be fitted (size, bounds, memory estimate).
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    /// More lights than the records have visibility bits for.
+    #[error(
+        "{loc}: light {index}: rrt supports at most {MAX_LIGHTS} lights (2 visibility bits each in a voxel record)"
+    )]
+    TooManyLights {
+        /// The first light too many.
+        loc: SourceLoc,
+        /// Its index (from 1).
+        index: usize,
+    },
+    /// More distinct materials than the table holds.
+    #[error("{loc}: material {count}: rrt supports at most {MAX_MATERIALS} distinct materials")]
+    TooManyMaterials {
+        /// The first material too many.
+        loc: SourceLoc,
+        /// Its number among the distinct ones.
+        count: usize,
+    },
+    /// A voxelizer refused an object.
+    #[error("{loc}: {what}: cannot voxelize: {source}")]
+    Voxelize {
+        /// Where the object is defined.
+        loc: SourceLoc,
+        /// What it is.
+        what: &'static str,
+        /// Why.
+        #[source]
+        source: VoxelizeError,
+    },
+    /// The exact record count exceeds the memory limit.
+    #[error("raster {dims}: the scene has {records} surface voxels; plane, directory and records need {}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), Bytes(*limit))]
+    TooMuchMemory {
+        /// Voxels per axis.
+        dims: fit::Dims,
+        /// Records counted.
+        records: usize,
+        /// Bytes needed.
+        needed: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// Memory could not be had from the system.
+    #[error("cannot allocate {} for the {what}", Bytes(*bytes))]
+    Alloc {
+        /// What.
+        what: &'static str,
+        /// How much.
+        bytes: u64,
+        /// The system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The core builder refused (a pass mismatch: a bug, reported).
+    #[error("scene builder: {0}")]
+    Store(#[from] store::BuildError),
+    /// The light pass failed.
+    #[error("light visibility: {0}")]
+    Light(#[from] LightError),
+    /// The raster or store did not validate (a bug, reported).
+    #[error("raster: {0}")]
+    Raster(String),
+}
+
+/// The location and kind of a fitted object's source.
+fn source_loc(scene: &Scene, source: Source) -> (SourceLoc, &'static str) {
+    let fallback = || SourceLoc::new(scene.file.clone(), 0, 0);
+    match source {
+        Source::Sphere(i) => (
+            scene
+                .spheres
+                .get(i)
+                .map_or_else(fallback, |s| s.loc.clone()),
+            "sphere",
+        ),
+        Source::Cone(i) => (
+            scene.cones.get(i).map_or_else(fallback, |c| c.loc.clone()),
+            "cone",
+        ),
+        Source::Polygon { polygon, .. } => (
+            scene
+                .polygons
+                .get(polygon)
+                .map_or_else(fallback, |p| p.loc.clone()),
+            "polygon",
+        ),
+    }
+}
+
+/// Voxelizes one fitted object into `sink` through the core voxelizers:
+/// sphere shells, triangles (flat or with interpolated normals) and open
+/// cones, as NFF defines them.
+///
+/// # Errors
+/// The voxelizer's refusal.
+pub fn voxelize_shape(
+    shape: &fit::Shape,
+    separation: Separation,
+    extent: Extent,
+    sink: &mut dyn VoxelSink,
+) -> Result<u64, VoxelizeError> {
+    match shape {
+        fit::Shape::Sphere(s) => sphere::surface(s, separation, extent, sink),
+        fit::Shape::Triangle(t) => triangle::triangle(t, separation, extent, sink),
+        fit::Shape::Cone(c) => cone::surface(c, separation, extent, sink),
+    }
+}
+
+/// A scalar in `[0, ∞)` as the core's 16.16 fixed point, saturating.
+fn scalar(v: f64) -> u32 {
+    let s = (v * f64::from(SCALAR_ONE)).round();
+    if s.is_nan() || s <= 0.0 {
+        0
+    } else if s >= f64::from(u32::MAX) {
+        u32::MAX
+    } else {
+        s as u32
+    }
+}
+
+/// The core's fixed-point material.
+fn core_material(m: &Material) -> object_table::Material {
+    object_table::Material {
+        color: [m.colour.x, m.colour.y, m.colour.z].map(scalar),
+        kd: scalar(m.kd),
+        ks: scalar(m.ks),
+        shine: scalar(m.shine),
+        transmission: scalar(m.transmittance),
+        ior: scalar(m.ior),
+    }
+}
+
+/// Distinct materials of `scene` and, per scene material, its index among
+/// them.
+fn distinct_materials(scene: &Scene) -> Result<(Vec<Material>, Vec<u16>), BuildError> {
+    let mut seen: HashMap<[u64; 8], u16> = HashMap::new();
+    let mut list = Vec::new();
+    let mut index = Vec::with_capacity(scene.materials.len());
+    for m in &scene.materials {
+        let key = [
+            m.colour.x,
+            m.colour.y,
+            m.colour.z,
+            m.kd,
+            m.ks,
+            m.shine,
+            m.transmittance,
+            m.ior,
+        ]
+        .map(f64::to_bits);
+        let i = match seen.get(&key) {
+            Some(&i) => i,
+            None => {
+                if list.len() >= MAX_MATERIALS {
+                    return Err(BuildError::TooManyMaterials {
+                        loc: m
+                            .loc
+                            .clone()
+                            .unwrap_or_else(|| SourceLoc::new(scene.file.clone(), 0, 0)),
+                        count: list.len() + 1,
+                    });
+                }
+                // Below MAX_MATERIALS = 4096: fits u16.
+                let i = u16::try_from(list.len()).unwrap_or(u16::MAX);
+                seen.insert(key, i);
+                list.push(Material {
+                    loc: None,
+                    ..m.clone()
+                });
+                i
+            }
+        };
+        index.push(i);
+    }
+    Ok((list, index))
+}
+
+/// A fitted shape as an object of the core's table (the light pass reads
+/// only whether it is closed).
+fn core_shape(shape: &fit::Shape) -> object_table::Shape {
+    match *shape {
+        fit::Shape::Sphere(s) => object_table::Shape::Sphere(s),
+        fit::Shape::Triangle(t) => object_table::Shape::Triangle(t),
+        fit::Shape::Cone(c) => object_table::Shape::Cone(c),
+    }
+}
+
+fn alloc_err(what: &'static str, bytes: usize) -> impl FnOnce(std::io::Error) -> BuildError {
+    move |source| BuildError::Alloc {
+        what,
+        bytes: u64::try_from(bytes).unwrap_or(u64::MAX),
+        source,
+    }
+}
+
+/// Builds the voxelized scene (module docs). `progress` shows the passes
+/// (pass [`ProgressBar::hidden`] for none).
+///
+/// # Errors
+/// [`BuildError`]: the fit's refusals, too many lights or materials, a
+/// voxelizer's refusal with the object's location, the memory limit, an
+/// allocation failure.
+pub fn build(
+    scene: &Scene,
+    opts: &BuildOptions,
+    progress: &ProgressBar,
+) -> Result<(VoxelScene, BuildReport), BuildError> {
+    let t0 = Instant::now();
+    if let Some(l) = scene.lights.get(MAX_LIGHTS) {
+        return Err(BuildError::TooManyLights {
+            loc: l.loc.clone(),
+            index: MAX_LIGHTS + 1,
+        });
+    }
+    let (materials, material_index) = distinct_materials(scene)?;
+    let fitted: Fitted = fit::fit(scene, &opts.fit)?;
+    let frame = fitted.frame;
+    let extent = frame.extent;
+    let separation = Separation::for_rays(opts.connectivity);
+    let mat_of = |scene_material: usize| material_index.get(scene_material).copied().unwrap_or(0);
+
+    let mut plane = Plane::zeroed(extent.len()).map_err(alloc_err("raster plane", extent.len()))?;
+    let dir_len =
+        directory_len(extent).ok_or_else(|| BuildError::Raster("too many bricks".into()))?;
+    let mut directory = vec![0u32; dir_len];
+
+    let n = fitted.objects.len();
+    progress.set_length(u64::try_from(2 * n).unwrap_or(u64::MAX));
+    progress.set_message("voxelizing (count pass)");
+    let raster =
+        RasterMut::new(extent, &mut plane).map_err(|e| BuildError::Raster(e.to_string()))?;
+    let mut counter = Counter::new(raster, &mut directory)?;
+    for o in &fitted.objects {
+        voxelize_shape(&o.shape, separation, extent, &mut counter).map_err(|source| {
+            let (loc, what) = source_loc(scene, o.source);
+            BuildError::Voxelize { loc, what, source }
+        })?;
+        progress.inc(1);
+    }
+    let offers = counter.report().offers;
+    let sizing = counter.finish()?;
+    let records_n = sizing.records();
+    let needed = u64::try_from(
+        extent
+            .len()
+            .saturating_add(dir_len.saturating_mul(4))
+            .saturating_add(sizing.record_bytes()),
+    )
+    .unwrap_or(u64::MAX);
+    if needed > opts.fit.max_memory {
+        return Err(BuildError::TooMuchMemory {
+            dims: fit::Dims(extent.dims()),
+            records: records_n,
+            needed,
+            limit: opts.fit.max_memory,
+        });
+    }
+    let mut records = vec![VoxelRecord::default(); records_n];
+    let limits = Limits {
+        objects: u32::try_from(n).unwrap_or(u32::MAX),
+        materials: u32::try_from(materials.len()).unwrap_or(u32::MAX),
+    };
+    progress.set_message("voxelizing (fill pass)");
+    let mut filler = sizing.fill(&mut records, limits)?;
+    for (id, o) in fitted.objects.iter().enumerate() {
+        let material = mat_of(o.material);
+        let colour = materials
+            .get(usize::from(material))
+            .map_or([0; 3], |m| core_material(m).color_u8());
+        filler.begin_object(ObjectAttrs {
+            object: u32::try_from(id).unwrap_or(u32::MAX),
+            material,
+            color: colour,
+        })?;
+        voxelize_shape(&o.shape, separation, extent, &mut filler).map_err(|source| {
+            let (loc, what) = source_loc(scene, o.source);
+            BuildError::Voxelize { loc, what, source }
+        })?;
+        progress.inc(1);
+    }
+    let mut built = filler.finish()?;
+    let voxelize = t0.elapsed();
+
+    // Light visibility and precomputed illumination.
+    let t1 = Instant::now();
+    progress.set_message("light visibility");
+    let mut storage = vec![Object::UNUSED; n];
+    let mut table = ObjectTable::new(&mut storage, &mut []);
+    for o in &fitted.objects {
+        // The storage holds exactly the n objects: no push can fail.
+        let _ = table.push(Object {
+            shape: core_shape(&o.shape),
+            material: mat_of(o.material),
+        });
+    }
+    let mut core_materials: Box<Materials<MAX_MATERIALS>> = Box::default();
+    for m in &materials {
+        let _ = core_materials.push(core_material(m));
+    }
+    let intensity = scalar(shade::light_intensity(scene.lights.len()));
+    let mut lights = Lights::new(intensity);
+    for l in &fitted.lights {
+        let c = l.colour;
+        let _ = lights.push(Light {
+            position: l.position,
+            color: [c.x, c.y, c.z].map(scalar),
+            intensity,
+        });
+    }
+    let light_report = {
+        let (raster, mut store) = built.split();
+        illuminate(
+            &raster,
+            &mut store,
+            &table,
+            &core_materials,
+            &lights,
+            &opts.light,
+        )?
+    };
+    let lights_time = t1.elapsed();
+
+    let objects = fitted
+        .objects
+        .iter()
+        .map(|o| {
+            WorldObject::from_fitted(scene, o, mat_of(o.material))
+                .ok_or_else(|| BuildError::Raster("fitted object without its source".into()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let world_lights = scene
+        .lights
+        .iter()
+        .map(|l| WorldLight {
+            position: l.position,
+            colour: l.rgb(),
+        })
+        .collect();
+    let report = BuildReport {
+        objects: n,
+        dropped: fitted.dropped.degenerate + fitted.dropped.outside,
+        offers,
+        records: records_n,
+        light: light_report,
+        voxelize,
+        lights: lights_time,
+    };
+    Ok((
+        VoxelScene {
+            frame,
+            separation,
+            plane,
+            directory,
+            records,
+            objects,
+            materials,
+            lights: world_lights,
+            background: scene.background,
+            view: scene.view.clone(),
+        },
+        report,
+    ))
+}

@@ -1,0 +1,296 @@
+//! Arguments and helpers shared by `rrt render`, `rrt voxelize` and
+//! `rrt info`.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::CliError;
+use super::ray::ConnectivityArg;
+use crate::build::{BuildOptions, BuildReport, VoxelScene, build};
+use crate::fit::{FitOptions, default_max_memory};
+use crate::rasterfile;
+use crate::scene::{Bounds, Scene, View};
+
+/// The built-in scene: SPD `balls2.nff`, the paper's 91-sphereflake.
+pub const DEFAULT_SCENE: &str = include_str!("../../scenes/balls2.nff");
+/// The name the built-in scene goes by in messages.
+pub const DEFAULT_SCENE_NAME: &str = "balls2.nff (built-in)";
+/// Voxels along the longest axis unless `--raster` says otherwise.
+pub const DEFAULT_RASTER: u32 = 1024;
+
+/// How to voxelize a scene.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RasterArgs {
+    /// Voxels along the scene's longest axis [default: 1024].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub raster: Option<u32>,
+    /// Connectivity of the discrete rays (the surfaces are voxelized thick
+    /// enough for it).
+    #[arg(long, value_enum, default_value_t = ConnectivityArg::Adaptive)]
+    pub connectivity: ConnectivityArg,
+    /// World box to voxelize, `X0,Y0,Z0,X1,Y1,Z1` (default: all geometry).
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_bounds, allow_hyphen_values = true)]
+    pub bounds: Option<Bounds>,
+    /// Refuse rasters needing more memory than this (bytes, or with K, M,
+    /// G, T suffixes; binary units) [default: half of the machine's RAM].
+    #[arg(long, value_name = "SIZE", value_parser = parse_memory)]
+    pub max_memory: Option<u64>,
+}
+
+impl RasterArgs {
+    /// The build options these arguments ask for.
+    #[must_use]
+    pub fn build_options(&self) -> BuildOptions {
+        let mut o = BuildOptions::new(self.raster.unwrap_or(DEFAULT_RASTER));
+        o.connectivity = self.connectivity.into();
+        o.fit = FitOptions {
+            bounds: self.bounds,
+            max_memory: self.max_memory.unwrap_or_else(default_max_memory),
+            ..o.fit
+        };
+        o
+    }
+}
+
+/// Parses `X0,Y0,Z0,X1,Y1,Z1`.
+///
+/// # Errors
+/// A message naming the bad part.
+pub fn parse_bounds(s: &str) -> Result<Bounds, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 6 {
+        return Err(format!(
+            "expected six comma-separated numbers X0,Y0,Z0,X1,Y1,Z1, found {s:?}"
+        ));
+    }
+    let mut v = [0f64; 6];
+    for (slot, p) in v.iter_mut().zip(&parts) {
+        *slot = p
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("expected a finite number, found {p:?}"))?;
+    }
+    let b = Bounds {
+        min: DVec3::new(v[0], v[1], v[2]),
+        max: DVec3::new(v[3], v[4], v[5]),
+    };
+    if !b.min.cmplt(b.max).all() {
+        return Err(format!(
+            "expected X0 < X1, Y0 < Y1 and Z0 < Z1, found {s:?}"
+        ));
+    }
+    Ok(b)
+}
+
+/// Parses a byte count: digits with an optional K, M, G or T suffix
+/// (binary units, an optional trailing `B` or `iB`).
+///
+/// # Errors
+/// A message for a malformed or overflowing size.
+pub fn parse_memory(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let t = t
+        .strip_suffix("iB")
+        .or_else(|| t.strip_suffix('B'))
+        .unwrap_or(t);
+    let (digits, shift) = match t.chars().last() {
+        Some('K' | 'k') => (&t[..t.len() - 1], 10),
+        Some('M' | 'm') => (&t[..t.len() - 1], 20),
+        Some('G' | 'g') => (&t[..t.len() - 1], 30),
+        Some('T' | 't') => (&t[..t.len() - 1], 40),
+        _ => (t, 0),
+    };
+    let n: u64 = digits
+        .parse()
+        .map_err(|_| format!("expected a size like 512M or 8G, found {s:?}"))?;
+    n.checked_mul(1u64 << shift)
+        .filter(|&v| v > 0)
+        .ok_or_else(|| format!("{s:?} is not a usable size"))
+}
+
+/// Parses `X,Y,Z` as a finite world vector.
+///
+/// # Errors
+/// A message naming the bad part.
+pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
+    let v = super::num::triple(s, |p| {
+        p.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("expected a finite number, found {p:?}"))
+    })?;
+    Ok(DVec3::from(v))
+}
+
+/// View overrides.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ViewArgs {
+    /// Eye position, `X,Y,Z` (overrides the scene's `from`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub from: Option<DVec3>,
+    /// Point looked at, `X,Y,Z`.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub at: Option<DVec3>,
+    /// Up direction, `X,Y,Z`.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<DVec3>,
+    /// Angle in degrees between the centres of the outer pixel rows.
+    #[arg(long, value_name = "DEGREES")]
+    pub angle: Option<f64>,
+}
+
+impl ViewArgs {
+    /// `view` with the overrides applied.
+    #[must_use]
+    pub fn apply(&self, view: &View) -> View {
+        View {
+            from: self.from.unwrap_or(view.from),
+            at: self.at.unwrap_or(view.at),
+            up: self.up.unwrap_or(view.up),
+            angle: self.angle.unwrap_or(view.angle),
+            ..view.clone()
+        }
+    }
+}
+
+/// A progress bar on stderr when `show` and stderr is a terminal; hidden
+/// otherwise.
+#[must_use]
+pub fn progress(show: bool) -> ProgressBar {
+    if !show || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(0);
+    if let Ok(style) =
+        ProgressStyle::with_template("{msg:24} [{bar:40}] {pos}/{len} {elapsed_precise}")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// Reads an NFF scene (the built-in one for `None`).
+///
+/// # Errors
+/// The parser's located error.
+pub fn read_scene(path: Option<&Path>) -> Result<(Scene, Duration), CliError> {
+    let t = Instant::now();
+    let scene = match path {
+        Some(p) => Scene::load(p)?,
+        None => Scene::parse(DEFAULT_SCENE_NAME, DEFAULT_SCENE.as_bytes())?,
+    };
+    Ok((scene, t.elapsed()))
+}
+
+/// Where a render's scene comes from.
+#[derive(Debug)]
+pub enum Loaded {
+    /// Voxelized now from an NFF scene.
+    Built {
+        /// The voxelized scene.
+        scene: VoxelScene,
+        /// What the build did.
+        report: BuildReport,
+        /// Parse time.
+        parse: Duration,
+    },
+    /// Read from a saved raster.
+    Saved {
+        /// The voxelized scene.
+        scene: VoxelScene,
+        /// Load time.
+        load: Duration,
+    },
+}
+
+/// Loads `path` as a saved raster when it starts with the raster magic,
+/// else parses and voxelizes it as NFF (the built-in scene for `None`).
+///
+/// # Errors
+/// The parser's, builder's or raster file's error; `--raster` or
+/// `--bounds` given for a saved raster.
+pub fn load_or_build(
+    path: Option<&PathBuf>,
+    raster: &RasterArgs,
+    show_progress: bool,
+) -> Result<Loaded, CliError> {
+    if let Some(p) = path
+        && rasterfile::is_raster_file(p)
+    {
+        for (given, arg) in [
+            (raster.raster.is_some(), "--raster"),
+            (raster.bounds.is_some(), "--bounds"),
+        ] {
+            if given {
+                return Err(CliError::Arg {
+                    arg,
+                    message: format!(
+                        "{} is a saved raster; its resolution and bounds were fixed by `rrt voxelize`",
+                        p.display()
+                    ),
+                });
+            }
+        }
+        let t = Instant::now();
+        let scene = rasterfile::load(p)?;
+        return Ok(Loaded::Saved {
+            scene,
+            load: t.elapsed(),
+        });
+    }
+    let (scene, parse) = read_scene(path.map(PathBuf::as_path))?;
+    let bar = progress(show_progress);
+    let built = build(&scene, &raster.build_options(), &bar);
+    bar.finish_and_clear();
+    let (vs, report) = built?;
+    Ok(Loaded::Built {
+        scene: vs,
+        report,
+        parse,
+    })
+}
+
+/// Seconds with three decimals.
+#[must_use]
+pub fn secs(d: Duration) -> String {
+    format!("{:.3} s", d.as_secs_f64())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_sizes() {
+        assert_eq!(parse_memory("1024"), Ok(1024));
+        assert_eq!(parse_memory("8G"), Ok(8 << 30));
+        assert_eq!(parse_memory("512MiB"), Ok(512 << 20));
+        assert_eq!(parse_memory("3kB"), Ok(3 << 10));
+        assert!(parse_memory("0").is_err());
+        assert!(parse_memory("lots").is_err());
+        assert!(parse_memory("99999999999T").is_err());
+    }
+
+    #[test]
+    fn bounds_need_six_ordered_numbers() {
+        let b = parse_bounds("-1,-2,-3,1,2,3").unwrap();
+        assert_eq!(b.min, DVec3::new(-1.0, -2.0, -3.0));
+        assert!(parse_bounds("1,2,3").is_err());
+        assert!(parse_bounds("0,0,0,1,1,0").is_err());
+        assert!(parse_bounds("0,0,0,1,1,nan").is_err());
+    }
+
+    #[test]
+    fn builtin_scene_parses() {
+        let (s, _) = read_scene(None).unwrap();
+        assert_eq!(s.spheres.len(), 91);
+        assert_eq!(&*s.file, DEFAULT_SCENE_NAME);
+    }
+}

@@ -1,0 +1,67 @@
+//! `rrt info`: what a saved raster holds.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use super::CliError;
+use crate::fit::Bytes;
+use crate::rasterfile;
+use rrt_core::voxelize::Separation;
+
+/// Arguments of `rrt info`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct InfoArgs {
+    /// A raster saved by `rrt voxelize`.
+    pub file: PathBuf,
+}
+
+/// Runs `rrt info`, writing the report to `out`.
+///
+/// # Errors
+/// [`CliError`] for a file that is not a valid raster.
+pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
+    let i = rasterfile::info(&args.file)?;
+    let [nx, ny, nz] = i.dims;
+    let max =
+        i.origin + glam::DVec3::new(f64::from(nx), f64::from(ny), f64::from(nz)) * i.voxel_size;
+    let voxels = u64::from(nx) * u64::from(ny) * u64::from(nz);
+    writeln!(
+        out,
+        "file: {} ({}, format version {})",
+        args.file.display(),
+        Bytes(i.file_bytes),
+        rasterfile::VERSION
+    )?;
+    writeln!(out, "dimensions: {nx}×{ny}×{nz} voxels ({voxels})")?;
+    writeln!(
+        out,
+        "world bounds: [{}, {}, {}] to [{}, {}, {}]",
+        i.origin.x, i.origin.y, i.origin.z, max.x, max.y, max.z
+    )?;
+    writeln!(out, "voxel size: {}", i.voxel_size)?;
+    writeln!(
+        out,
+        "separation: {}",
+        match i.separation {
+            Separation::Six => "6-tunnel-free (six, adaptive rays)",
+            Separation::TwentySix => "26-tunnel-free (all rays)",
+        }
+    )?;
+    writeln!(
+        out,
+        "voxels: {} surface voxels ({:.3}% of the raster)",
+        i.records,
+        100.0 * i.records as f64 / voxels.max(1) as f64
+    )?;
+    writeln!(
+        out,
+        "objects: {}, materials: {}, lights: {}",
+        i.objects, i.materials, i.lights
+    )?;
+    writeln!(
+        out,
+        "memory: {} (plane, brick directory, records)",
+        Bytes(i.memory)
+    )?;
+    Ok(())
+}

@@ -1,0 +1,129 @@
+//! `rrt render`: an NFF scene or a saved raster to a PNG.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use super::CliError;
+use super::common::{Loaded, RasterArgs, ViewArgs, load_or_build, progress, secs};
+use crate::camera::Camera;
+use crate::output::PngOutput;
+use crate::render::{RenderOptions, check_sizes, render};
+use crate::trace::{TraceOptions, Tracer};
+
+/// Arguments of `rrt render`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RenderArgs {
+    /// An NFF scene or a raster saved by `rrt voxelize` [default: the
+    /// built-in 91-sphereflake, SPD balls2].
+    pub scene: Option<PathBuf>,
+    /// The PNG to write.
+    #[arg(short, long, value_name = "OUT.png", default_value = "rrt.png")]
+    pub output: PathBuf,
+    /// Image width in pixels [default: the scene's resolution].
+    #[arg(long, value_name = "W")]
+    pub width: Option<u32>,
+    /// Image height in pixels [default: the scene's resolution].
+    #[arg(long, value_name = "H")]
+    pub height: Option<u32>,
+    /// Voxelization.
+    #[command(flatten)]
+    pub raster: RasterArgs,
+    /// Depth of the ray tree (the eye ray counts as 1).
+    #[arg(long, value_name = "D", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub depth: u32,
+    /// Intersection verification: check each discrete hit against the
+    /// object's exact geometry, use the true point and normal.
+    #[arg(long)]
+    pub verify: bool,
+    /// K×K rays per pixel, box-filtered.
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    pub supersample: u32,
+    /// Render threads [default: one per core].
+    #[arg(long, value_name = "T", default_value_t = 0)]
+    pub threads: usize,
+    /// View overrides.
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// No progress bars and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Runs `rrt render`, writing the summary line to `out`.
+///
+/// # Errors
+/// [`CliError`]: bad sizes, an unwritable output, the scene's, builder's,
+/// tracer's or encoder's error.
+pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
+    // Sizes given on the command line are checked before any work.
+    check_sizes(
+        args.width.unwrap_or(1),
+        args.height.unwrap_or(1),
+        args.supersample,
+    )?;
+    let png = PngOutput::create(&args.output)?;
+    let loaded = load_or_build(args.scene.as_ref(), &args.raster, !args.quiet)?;
+    let scene = match &loaded {
+        Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
+    };
+    let view = args.view.apply(&scene.view);
+    let [rw, rh] = view.resolution;
+    let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
+    check_sizes(w, h, args.supersample)?;
+    let camera = Camera::new(&view, w, h)?;
+    let tracer = Tracer::new(
+        scene,
+        TraceOptions {
+            connectivity: args.raster.connectivity.into(),
+            depth: args.depth,
+            verify: args.verify,
+            ..TraceOptions::default()
+        },
+    )?;
+    let bar = progress(!args.quiet);
+    let rendered = render(
+        &tracer,
+        &camera,
+        &RenderOptions {
+            supersample: args.supersample,
+            threads: args.threads,
+        },
+        &bar,
+    );
+    bar.finish_and_clear();
+    let (image, stats, time) = rendered?;
+    png.write(&image)?;
+    if !args.quiet {
+        let d = scene.extent().dims();
+        let prep = match &loaded {
+            Loaded::Built { report, parse, .. } => format!(
+                "parse {}, voxelize {}, light visibility {}",
+                secs(*parse),
+                secs(report.voxelize),
+                secs(report.lights)
+            ),
+            Loaded::Saved { load, .. } => format!("load {}", secs(*load)),
+        };
+        let rays = stats.rays().max(1);
+        writeln!(
+            out,
+            "{}: {w}×{h}, raster {}×{}×{} ({}{}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow; {:.1} steps/ray; {} hits, {} false hits",
+            args.output.display(),
+            d[0],
+            d[1],
+            d[2],
+            rrt_core::Connectivity::from(args.raster.connectivity).name(),
+            if args.verify { ", verified" } else { "" },
+            args.depth,
+            secs(time),
+            stats.primary,
+            stats.reflected,
+            stats.refracted,
+            stats.shadow,
+            stats.steps as f64 / rays as f64,
+            stats.hits,
+            stats.false_hits,
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,92 @@
+//! `rrt voxelize`: voxelize an NFF scene once and save the raster.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use super::CliError;
+use super::common::{Loaded, RasterArgs, load_or_build, secs};
+use crate::fit::Bytes;
+use crate::rasterfile;
+
+/// Arguments of `rrt voxelize`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct VoxelizeArgs {
+    /// The NFF scene [default: the built-in 91-sphereflake].
+    pub scene: Option<PathBuf>,
+    /// The raster file to write.
+    #[arg(short, long, value_name = "FILE.rrt")]
+    pub output: PathBuf,
+    /// Voxelization.
+    #[command(flatten)]
+    pub raster: RasterArgs,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Runs `rrt voxelize`, writing a summary line to `out`.
+///
+/// # Errors
+/// [`CliError`]: the scene's or builder's error, a saved raster given as
+/// the scene, an unwritable output.
+pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
+    if let Some(p) = &args.scene
+        && rasterfile::is_raster_file(p)
+    {
+        return Err(CliError::Arg {
+            arg: "SCENE",
+            message: format!(
+                "{} is already a saved raster; give an NFF scene",
+                p.display()
+            ),
+        });
+    }
+    // Fail on an unwritable output before voxelizing (and remove the empty
+    // file again if voxelizing fails).
+    let existed = args.output.exists();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&args.output)
+        .map_err(|source| CliError::Output {
+            path: args.output.clone(),
+            source,
+        })?;
+    let loaded = load_or_build(args.scene.as_ref(), &args.raster, !args.quiet);
+    if loaded.is_err() && !existed {
+        let _ = std::fs::remove_file(&args.output);
+    }
+    let Loaded::Built {
+        scene,
+        report,
+        parse,
+    } = loaded?
+    else {
+        return Err(CliError::Arg {
+            arg: "SCENE",
+            message: "expected an NFF scene".into(),
+        });
+    };
+    let t = std::time::Instant::now();
+    let bytes = rasterfile::save(&scene, &args.output)?;
+    if !args.quiet {
+        let d = scene.extent().dims();
+        writeln!(
+            out,
+            "{}: raster {}×{}×{}, {} objects, {} surface voxels, {}: parse {}, voxelize {}, light visibility {}, save {}",
+            args.output.display(),
+            d[0],
+            d[1],
+            d[2],
+            report.objects,
+            report.records,
+            Bytes(bytes),
+            secs(parse),
+            secs(report.voxelize),
+            secs(report.lights),
+            secs(t.elapsed()),
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,904 @@
+//! Saved rasters: a voxelized scene in one versioned, checksummed file, so
+//! that the view-independent work (voxelization, light visibility,
+//! precomputed illumination) is done once and the scene rendered from any
+//! view (the paper's point).
+//!
+//! # Layout (version 1)
+//! All integers and floats are little-endian; floats are IEEE 754 `f64`.
+//!
+//! ```text
+//! offset  size  field
+//!      0     8  magic "RRTRASTR"
+//!      8     4  version (1)
+//!     12     4  section count (7)
+//!     16   168  section table: 7 × { kind u32, crc32 u32, offset u64, length u64 }
+//!    184     4  crc32 of bytes 0..184
+//!    188     4  zero
+//!    192        sections, in table order, each starting at a multiple of 64
+//! ```
+//!
+//! | kind | section | contents |
+//! |---|---|---|
+//! | 1 | meta | `nx ny nz` u32; separation u8 (6 or 26) + 3 zero bytes; world origin 3×f64; voxel size f64; background 3×f64; view: from, at, up 3×f64 each, angle f64, hither f64, resolution 2×u32; counts: records u64, objects u64, materials u32, lights u32 (188 bytes) |
+//! | 2 | plane | one cell per voxel, x fastest ([`rrt_core::raster`]) |
+//! | 3 | directory | brick directory, `bricks + 1` × u32 ([`rrt_core::store`]) |
+//! | 4 | records | the 20-byte [`VoxelRecord`]s, field by field as in [`rrt_core::voxel`] |
+//! | 5 | objects | per object 168 bytes: kind u32 (1 sphere, 2 cone, 3 triangle, 4 triangle with vertex normals), material u32, 20 × f64: sphere centre, radius; cone base, base radius, apex, apex radius; triangle v0 v1 v2, then n0 n1 n2; unused slots 0 |
+//! | 6 | materials | per material 8 × f64: colour r g b, Kd, Ks, Shine, T, index of refraction |
+//! | 7 | lights | per light 6 × f64: position, colour |
+//!
+//! The crc32 (IEEE, `crc32fast`) of each section is in its table entry.
+//!
+//! # Loading
+//! [`load`] refuses, with the file's name and what is wrong: a file that is
+//! not a raster, another version, a header or section whose checksum does
+//! not match (corrupt), a section that ends past the end of the file
+//! (truncated) or whose length disagrees with the counts, and contents
+//! that break an invariant (dimensions, the record store's directory and
+//! sort order, object and material indices, non-finite numbers). Sizes are
+//! checked against the file's length before anything is allocated.
+//!
+//! The file is read, not memory-mapped: the checksums read every byte
+//! anyway, and a plane read into anonymous memory gets huge pages
+//! ([`Plane`]), which a file mapping does not.
+
+#![deny(missing_docs)]
+
+use std::fs::File;
+use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use rrt_core::object_table::MAX_LIGHTS;
+use rrt_core::raster::Extent;
+use rrt_core::store::{RecordStore, directory_len};
+use rrt_core::voxel::VoxelRecord;
+use rrt_core::voxelize::Separation;
+
+use crate::build::{MAX_MATERIALS, VoxelScene};
+use crate::fit::RasterFrame;
+use crate::plane::Plane;
+use crate::scene::{Material, SourceLoc, View};
+use crate::world::{WorldLight, WorldObject, WorldShape};
+
+/// The file's first bytes.
+pub const MAGIC: [u8; 8] = *b"RRTRASTR";
+/// The version this code writes and reads.
+pub const VERSION: u32 = 1;
+const SECTIONS: usize = 7;
+const HEADER_LEN: u64 = 192;
+const META_LEN: u64 = 188;
+const OBJECT_LEN: u64 = 168;
+const MATERIAL_LEN: u64 = 64;
+const LIGHT_LEN: u64 = 48;
+const RECORD_LEN: u64 = 20;
+const NAMES: [&str; SECTIONS] = [
+    "meta",
+    "plane",
+    "directory",
+    "records",
+    "objects",
+    "materials",
+    "lights",
+];
+
+/// Why a raster file could not be written or read.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RasterFileError {
+    /// An I/O error.
+    #[error("{}: {what}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What was being done.
+        what: &'static str,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Not a raster file.
+    #[error("{}: not an rrt raster file (no RRTRASTR header)", path.display())]
+    NotRaster {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Another version.
+    #[error("{}: raster file version {found}; this rrt reads version {VERSION}", path.display())]
+    Version {
+        /// The file.
+        path: PathBuf,
+        /// The version found.
+        found: u32,
+    },
+    /// The file ends early.
+    #[error("{}: truncated: {what}", path.display())]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// What is missing.
+        what: String,
+    },
+    /// A checksum does not match.
+    #[error("{}: corrupt: the {section} checksum does not match", path.display())]
+    Checksum {
+        /// The file.
+        path: PathBuf,
+        /// Which section (or the header).
+        section: &'static str,
+    },
+    /// The contents break an invariant.
+    #[error("{}: corrupt: {what}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        what: String,
+    },
+}
+
+/// Little-endian writer helpers.
+#[derive(Default)]
+struct Buf(Vec<u8>);
+
+impl Buf {
+    fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    fn vec(&mut self, v: DVec3) {
+        self.f64(v.x);
+        self.f64(v.y);
+        self.f64(v.z);
+    }
+}
+
+/// Little-endian reader over a section.
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn new(bytes: &'a [u8]) -> Self {
+        Self { bytes, at: 0 }
+    }
+    fn take<const N: usize>(&mut self) -> [u8; N] {
+        let mut out = [0u8; N];
+        if let Some(s) = self.bytes.get(self.at..self.at + N) {
+            out.copy_from_slice(s);
+        }
+        self.at += N;
+        out
+    }
+    fn u8(&mut self) -> u8 {
+        self.take::<1>()[0]
+    }
+    fn u32(&mut self) -> u32 {
+        u32::from_le_bytes(self.take())
+    }
+    fn u64(&mut self) -> u64 {
+        u64::from_le_bytes(self.take())
+    }
+    fn f64(&mut self) -> f64 {
+        f64::from_le_bytes(self.take())
+    }
+    fn vec(&mut self) -> DVec3 {
+        DVec3::new(self.f64(), self.f64(), self.f64())
+    }
+}
+
+fn meta_bytes(s: &VoxelScene) -> Vec<u8> {
+    let mut b = Buf::default();
+    for d in s.frame.extent.dims() {
+        b.u32(d);
+    }
+    b.0.push(match s.separation {
+        Separation::Six => 6,
+        Separation::TwentySix => 26,
+    });
+    b.0.extend_from_slice(&[0; 3]);
+    b.vec(s.frame.origin);
+    b.f64(s.frame.voxel_size);
+    b.vec(s.background);
+    b.vec(s.view.from);
+    b.vec(s.view.at);
+    b.vec(s.view.up);
+    b.f64(s.view.angle);
+    b.f64(s.view.hither);
+    b.u32(s.view.resolution[0]);
+    b.u32(s.view.resolution[1]);
+    b.u64(s.records.len() as u64);
+    b.u64(s.objects.len() as u64);
+    b.u32(u32::try_from(s.materials.len()).unwrap_or(u32::MAX));
+    b.u32(u32::try_from(s.lights.len()).unwrap_or(u32::MAX));
+    debug_assert_eq!(b.0.len() as u64, META_LEN);
+    b.0
+}
+
+fn objects_bytes(s: &VoxelScene) -> Vec<u8> {
+    let mut b = Buf::default();
+    for o in &s.objects {
+        let mut slots = [0f64; 20];
+        fn put(slots: &mut [f64; 20], at: usize, v: DVec3) {
+            slots[at] = v.x;
+            slots[at + 1] = v.y;
+            slots[at + 2] = v.z;
+        }
+        let kind = match o.shape {
+            WorldShape::Sphere { centre, radius } => {
+                put(&mut slots, 0, centre);
+                slots[3] = radius;
+                1
+            }
+            WorldShape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+            } => {
+                put(&mut slots, 0, base);
+                slots[3] = base_radius;
+                put(&mut slots, 4, apex);
+                slots[7] = apex_radius;
+                2
+            }
+            WorldShape::Triangle { vertices, normals } => {
+                for (k, v) in vertices.iter().enumerate() {
+                    put(&mut slots, 3 * k, *v);
+                }
+                match normals {
+                    Some(n) => {
+                        for (k, v) in n.iter().enumerate() {
+                            put(&mut slots, 9 + 3 * k, *v);
+                        }
+                        4
+                    }
+                    None => 3,
+                }
+            }
+        };
+        b.u32(kind);
+        b.u32(u32::from(o.material));
+        for v in slots {
+            b.f64(v);
+        }
+    }
+    b.0
+}
+
+fn materials_bytes(s: &VoxelScene) -> Vec<u8> {
+    let mut b = Buf::default();
+    for m in &s.materials {
+        b.vec(m.colour);
+        for v in [m.kd, m.ks, m.shine, m.transmittance, m.ior] {
+            b.f64(v);
+        }
+    }
+    b.0
+}
+
+fn lights_bytes(s: &VoxelScene) -> Vec<u8> {
+    let mut b = Buf::default();
+    for l in &s.lights {
+        b.vec(l.position);
+        b.vec(l.colour);
+    }
+    b.0
+}
+
+fn record_bytes(r: &VoxelRecord, out: &mut Vec<u8>) {
+    out.extend_from_slice(&r.object.to_le_bytes());
+    out.extend_from_slice(&r.normal[0].to_le_bytes());
+    out.extend_from_slice(&r.normal[1].to_le_bytes());
+    out.extend_from_slice(&r.color);
+    out.extend_from_slice(&r.illum);
+    out.extend_from_slice(&r.lights.to_le_bytes());
+    out.extend_from_slice(&r.material.to_le_bytes());
+    out.extend_from_slice(&r.key.to_le_bytes());
+}
+
+fn record_from(b: &[u8]) -> VoxelRecord {
+    let mut c = Cursor::new(b);
+    let object = c.u32();
+    let n0 = i16::from_le_bytes(c.take());
+    let n1 = i16::from_le_bytes(c.take());
+    let color = c.take::<3>();
+    let illum = c.take::<3>();
+    let lights = u16::from_le_bytes(c.take());
+    let material = u16::from_le_bytes(c.take());
+    let key = u16::from_le_bytes(c.take());
+    VoxelRecord {
+        object,
+        normal: [n0, n1],
+        color,
+        illum,
+        lights,
+        material,
+        key,
+    }
+}
+
+/// A writer that checksums and counts what passes through.
+struct Checked<W: Write> {
+    inner: W,
+    crc: crc32fast::Hasher,
+    len: u64,
+}
+
+impl<W: Write> Checked<W> {
+    fn put(&mut self, b: &[u8]) -> std::io::Result<()> {
+        self.crc.update(b);
+        self.len += b.len() as u64;
+        self.inner.write_all(b)
+    }
+}
+
+/// Writes `scene` to `path` (module docs for the layout).
+///
+/// # Errors
+/// [`RasterFileError::Io`] naming the file.
+pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
+    let io = |what| {
+        move |source| RasterFileError::Io {
+            path: path.to_path_buf(),
+            what,
+            source,
+        }
+    };
+    let mut file = File::create(path).map_err(io("cannot create"))?;
+    let mut w = BufWriter::with_capacity(1 << 20, &mut file);
+    w.write_all(&[0u8; HEADER_LEN as usize])
+        .map_err(io("cannot write"))?;
+    let mut table = Vec::with_capacity(SECTIONS);
+    let mut offset = HEADER_LEN;
+    for kind in 1..=SECTIONS as u32 {
+        let mut c = Checked {
+            inner: &mut w,
+            crc: crc32fast::Hasher::new(),
+            len: 0,
+        };
+        let r: std::io::Result<()> = match kind {
+            1 => c.put(&meta_bytes(scene)),
+            2 => c.put(&scene.plane),
+            3 => {
+                let mut b = Vec::with_capacity(scene.directory.len() * 4);
+                for d in &scene.directory {
+                    b.extend_from_slice(&d.to_le_bytes());
+                }
+                c.put(&b)
+            }
+            4 => {
+                let mut b = Vec::with_capacity(1 << 20);
+                let mut r = Ok(());
+                for chunk in scene.records.chunks(1 << 15) {
+                    b.clear();
+                    for rec in chunk {
+                        record_bytes(rec, &mut b);
+                    }
+                    r = c.put(&b);
+                    if r.is_err() {
+                        break;
+                    }
+                }
+                r
+            }
+            5 => c.put(&objects_bytes(scene)),
+            6 => c.put(&materials_bytes(scene)),
+            _ => c.put(&lights_bytes(scene)),
+        };
+        r.map_err(io("cannot write"))?;
+        let (len, crc) = (c.len, c.crc.finalize());
+        table.push((kind, crc, offset, len));
+        offset += len;
+        let pad = offset.next_multiple_of(64) - offset;
+        w.write_all(&vec![0u8; pad as usize])
+            .map_err(io("cannot write"))?;
+        offset += pad;
+    }
+    w.flush().map_err(io("cannot write"))?;
+    drop(w);
+    let mut h = Vec::with_capacity(HEADER_LEN as usize);
+    h.extend_from_slice(&MAGIC);
+    h.extend_from_slice(&VERSION.to_le_bytes());
+    h.extend_from_slice(&(SECTIONS as u32).to_le_bytes());
+    for (kind, crc, off, len) in &table {
+        h.extend_from_slice(&kind.to_le_bytes());
+        h.extend_from_slice(&crc.to_le_bytes());
+        h.extend_from_slice(&off.to_le_bytes());
+        h.extend_from_slice(&len.to_le_bytes());
+    }
+    let hcrc = crc32fast::hash(&h);
+    h.extend_from_slice(&hcrc.to_le_bytes());
+    h.extend_from_slice(&[0; 4]);
+    file.seek(SeekFrom::Start(0)).map_err(io("cannot write"))?;
+    file.write_all(&h).map_err(io("cannot write"))?;
+    file.sync_all().map_err(io("cannot write"))?;
+    Ok(offset)
+}
+
+/// Whether the file at `path` starts with the raster magic.
+#[must_use]
+pub fn is_raster_file(path: &Path) -> bool {
+    let mut magic = [0u8; 8];
+    File::open(path)
+        .and_then(|mut f| f.read_exact(&mut magic))
+        .is_ok_and(|()| magic == MAGIC)
+}
+
+/// The summary `rrt info` prints, read from the header and meta section
+/// only.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Info {
+    /// Voxels per axis.
+    pub dims: [u32; 3],
+    /// World position of the raster's lowest corner.
+    pub origin: DVec3,
+    /// World length of a voxel's edge.
+    pub voxel_size: f64,
+    /// The voxelization's separation.
+    pub separation: Separation,
+    /// Records (non-transparent voxels).
+    pub records: u64,
+    /// Objects.
+    pub objects: u64,
+    /// Distinct materials.
+    pub materials: u32,
+    /// Lights.
+    pub lights: u32,
+    /// The file's length.
+    pub file_bytes: u64,
+    /// Memory for plane, directory and records once loaded.
+    pub memory: u64,
+}
+
+struct Header {
+    file_len: u64,
+    sections: [(u32, u64, u64); SECTIONS],
+}
+
+fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> {
+    let p = || path.to_path_buf();
+    let file_len = file
+        .metadata()
+        .map_err(|source| RasterFileError::Io {
+            path: p(),
+            what: "cannot read",
+            source,
+        })?
+        .len();
+    let mut h = [0u8; HEADER_LEN as usize];
+    let got = read_up_to(file, &mut h).map_err(|source| RasterFileError::Io {
+        path: p(),
+        what: "cannot read",
+        source,
+    })?;
+    if got < 12 && got > 0 && (MAGIC.starts_with(&h[..got.min(8)])) {
+        return Err(RasterFileError::Truncated {
+            path: p(),
+            what: format!("{got} bytes, shorter than the {HEADER_LEN}-byte header"),
+        });
+    }
+    if got < 8 || h[..8] != MAGIC {
+        return Err(RasterFileError::NotRaster { path: p() });
+    }
+    let mut c = Cursor::new(&h[8..]);
+    let version = c.u32();
+    if version != VERSION {
+        return Err(RasterFileError::Version {
+            path: p(),
+            found: version,
+        });
+    }
+    if (got as u64) < HEADER_LEN {
+        return Err(RasterFileError::Truncated {
+            path: p(),
+            what: format!("{got} bytes, shorter than the {HEADER_LEN}-byte header"),
+        });
+    }
+    let stored = u32::from_le_bytes([h[184], h[185], h[186], h[187]]);
+    if crc32fast::hash(&h[..184]) != stored {
+        return Err(RasterFileError::Checksum {
+            path: p(),
+            section: "header",
+        });
+    }
+    let count = c.u32();
+    if count as usize != SECTIONS {
+        return Err(RasterFileError::Invalid {
+            path: p(),
+            what: format!("{count} sections, expected {SECTIONS}"),
+        });
+    }
+    let mut sections = [(0u32, 0u64, 0u64); SECTIONS];
+    let mut end = HEADER_LEN;
+    for (k, s) in sections.iter_mut().enumerate() {
+        let kind = c.u32();
+        let crc = c.u32();
+        let off = c.u64();
+        let len = c.u64();
+        if kind as usize != k + 1 || off < end {
+            return Err(RasterFileError::Invalid {
+                path: p(),
+                what: format!("section table entry {} is out of order", k + 1),
+            });
+        }
+        let stop = off
+            .checked_add(len)
+            .ok_or_else(|| RasterFileError::Invalid {
+                path: p(),
+                what: format!("{} section length overflows", NAMES[k]),
+            })?;
+        if stop > file_len {
+            return Err(RasterFileError::Truncated {
+                path: p(),
+                what: format!(
+                    "the {} section ends at byte {stop}, the file has {file_len}",
+                    NAMES[k]
+                ),
+            });
+        }
+        end = stop;
+        *s = (crc, off, len);
+    }
+    Ok(Header { file_len, sections })
+}
+
+fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut got = 0;
+    while got < buf.len() {
+        match file.read(&mut buf[got..]) {
+            Ok(0) => break,
+            Ok(n) => got += n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(got)
+}
+
+/// Reads section `k` into `buf` (whose length is the section's) and checks
+/// its checksum.
+fn read_section(
+    file: &mut File,
+    path: &Path,
+    h: &Header,
+    k: usize,
+    buf: &mut [u8],
+) -> Result<(), RasterFileError> {
+    let (crc, off, _) = h.sections[k];
+    let io = |source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot read",
+        source,
+    };
+    file.seek(SeekFrom::Start(off)).map_err(io)?;
+    file.read_exact(buf).map_err(io)?;
+    if crc32fast::hash(buf) != crc {
+        return Err(RasterFileError::Checksum {
+            path: path.to_path_buf(),
+            section: NAMES[k],
+        });
+    }
+    Ok(())
+}
+
+struct Meta {
+    dims: [u32; 3],
+    separation: Separation,
+    origin: DVec3,
+    voxel_size: f64,
+    background: DVec3,
+    view: View,
+    records: u64,
+    objects: u64,
+    materials: u32,
+    lights: u32,
+}
+
+fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFileError> {
+    let invalid = |what: String| RasterFileError::Invalid {
+        path: path.to_path_buf(),
+        what,
+    };
+    if h.sections[0].2 != META_LEN {
+        return Err(invalid(format!(
+            "meta section of {} bytes, expected {META_LEN}",
+            h.sections[0].2
+        )));
+    }
+    let mut b = vec![0u8; META_LEN as usize];
+    read_section(file, path, h, 0, &mut b)?;
+    let mut c = Cursor::new(&b);
+    let dims = [c.u32(), c.u32(), c.u32()];
+    let separation = match c.u8() {
+        6 => Separation::Six,
+        26 => Separation::TwentySix,
+        s => return Err(invalid(format!("separation {s}, expected 6 or 26"))),
+    };
+    c.take::<3>();
+    let origin = c.vec();
+    let voxel_size = c.f64();
+    let background = c.vec();
+    let from = c.vec();
+    let at = c.vec();
+    let up = c.vec();
+    let angle = c.f64();
+    let hither = c.f64();
+    let resolution = [c.u32(), c.u32()];
+    let m = Meta {
+        dims,
+        separation,
+        origin,
+        voxel_size,
+        background,
+        view: View {
+            from,
+            at,
+            up,
+            angle,
+            hither,
+            resolution,
+            loc: SourceLoc::new(path.display().to_string(), 0, 0),
+        },
+        records: c.u64(),
+        objects: c.u64(),
+        materials: c.u32(),
+        lights: c.u32(),
+    };
+    Extent::new(dims[0], dims[1], dims[2]).map_err(|e| invalid(e.to_string()))?;
+    if !(origin.is_finite() && voxel_size > 0.0 && voxel_size.is_finite() && background.is_finite())
+    {
+        return Err(invalid("world frame or background is not finite".into()));
+    }
+    if !(from.is_finite() && at.is_finite() && up.is_finite() && angle.is_finite()) {
+        return Err(invalid("view is not finite".into()));
+    }
+    if m.lights as usize > MAX_LIGHTS {
+        return Err(invalid(format!(
+            "{} lights, at most {MAX_LIGHTS}",
+            m.lights
+        )));
+    }
+    if m.materials as usize > MAX_MATERIALS || m.materials == 0 {
+        return Err(invalid(format!(
+            "{} materials, expected 1 to {MAX_MATERIALS}",
+            m.materials
+        )));
+    }
+    Ok(m)
+}
+
+/// The header and meta section of a raster file.
+///
+/// # Errors
+/// As [`load`], for the header and meta section.
+pub fn info(path: &Path) -> Result<Info, RasterFileError> {
+    let mut file = File::open(path).map_err(|source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot open",
+        source,
+    })?;
+    let h = read_header(&mut file, path)?;
+    let m = read_meta(&mut file, path, &h)?;
+    Ok(Info {
+        dims: m.dims,
+        origin: m.origin,
+        voxel_size: m.voxel_size,
+        separation: m.separation,
+        records: m.records,
+        objects: m.objects,
+        materials: m.materials,
+        lights: m.lights,
+        file_bytes: h.file_len,
+        memory: h.sections[1].2
+            + h.sections[2].2
+            + m.records * std::mem::size_of::<VoxelRecord>() as u64,
+    })
+}
+
+/// Loads a raster file (module docs).
+///
+/// # Errors
+/// [`RasterFileError`] naming the file and what is wrong.
+pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
+    let invalid = |what: String| RasterFileError::Invalid {
+        path: path.to_path_buf(),
+        what,
+    };
+    let mut file = File::open(path).map_err(|source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot open",
+        source,
+    })?;
+    let h = read_header(&mut file, path)?;
+    let m = read_meta(&mut file, path, &h)?;
+    let extent =
+        Extent::new(m.dims[0], m.dims[1], m.dims[2]).map_err(|e| invalid(e.to_string()))?;
+    let expect = |k: usize, len: u64| -> Result<usize, RasterFileError> {
+        if h.sections[k].2 != len {
+            return Err(invalid(format!(
+                "{} section of {} bytes, the counts say {len}",
+                NAMES[k], h.sections[k].2
+            )));
+        }
+        usize::try_from(len).map_err(|_| invalid(format!("{} section too large", NAMES[k])))
+    };
+    // Every length below is checked against the section table, whose
+    // sections all lie inside the file: no allocation exceeds its size.
+    let plane_len = expect(1, extent.len() as u64)?;
+    let dir_n = directory_len(extent).ok_or_else(|| invalid("too many bricks".into()))?;
+    let dir_len = expect(2, dir_n as u64 * 4)?;
+    let rec_len = expect(3, m.records.saturating_mul(RECORD_LEN))?;
+    let obj_len = expect(4, m.objects.saturating_mul(OBJECT_LEN))?;
+    let mat_len = expect(5, u64::from(m.materials) * MATERIAL_LEN)?;
+    let light_len = expect(6, u64::from(m.lights) * LIGHT_LEN)?;
+
+    let mut plane = Plane::zeroed(plane_len).map_err(|source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot allocate the raster plane",
+        source,
+    })?;
+    read_section(&mut file, path, &h, 1, &mut plane)?;
+    let mut b = vec![0u8; dir_len];
+    read_section(&mut file, path, &h, 2, &mut b)?;
+    let directory: Vec<u32> = b
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    drop(b);
+    let records = read_records(&mut file, path, &h, rec_len)?;
+
+    let mut b = vec![0u8; mat_len];
+    read_section(&mut file, path, &h, 5, &mut b)?;
+    let materials: Vec<Material> = b
+        .chunks_exact(MATERIAL_LEN as usize)
+        .map(|chunk| {
+            let mut c = Cursor::new(chunk);
+            Material {
+                colour: c.vec(),
+                kd: c.f64(),
+                ks: c.f64(),
+                shine: c.f64(),
+                transmittance: c.f64(),
+                ior: c.f64(),
+                loc: None,
+            }
+        })
+        .collect();
+    for (i, mt) in materials.iter().enumerate() {
+        let ok = mt.colour.is_finite()
+            && [mt.kd, mt.ks, mt.shine, mt.transmittance, mt.ior]
+                .iter()
+                .all(|v| v.is_finite() && *v >= 0.0)
+            && mt.transmittance <= 1.0;
+        if !ok {
+            return Err(invalid(format!("material {i} has a value out of range")));
+        }
+    }
+    let mut b = vec![0u8; obj_len];
+    read_section(&mut file, path, &h, 4, &mut b)?;
+    let mut objects = Vec::with_capacity(b.len() / OBJECT_LEN as usize);
+    for (i, chunk) in b.chunks_exact(OBJECT_LEN as usize).enumerate() {
+        let mut c = Cursor::new(chunk);
+        let kind = c.u32();
+        let material = c.u32();
+        let s: Vec<f64> = (0..20).map(|_| c.f64()).collect();
+        let v = |k: usize| DVec3::new(s[k], s[k + 1], s[k + 2]);
+        let shape = match kind {
+            1 => WorldShape::Sphere {
+                centre: v(0),
+                radius: s[3],
+            },
+            2 => WorldShape::Cone {
+                base: v(0),
+                base_radius: s[3],
+                apex: v(4),
+                apex_radius: s[7],
+            },
+            3 | 4 => WorldShape::Triangle {
+                vertices: [v(0), v(3), v(6)],
+                normals: (kind == 4).then(|| [v(9), v(12), v(15)]),
+            },
+            k => return Err(invalid(format!("object {i} has unknown kind {k}"))),
+        };
+        let material = u16::try_from(material)
+            .ok()
+            .filter(|&mt| usize::from(mt) < materials.len())
+            .ok_or_else(|| {
+                invalid(format!(
+                    "object {i} names material {material}, beyond the table"
+                ))
+            })?;
+        if !shape.is_valid() {
+            return Err(invalid(format!("object {i} has non-finite geometry")));
+        }
+        objects.push(WorldObject { shape, material });
+    }
+    let mut b = vec![0u8; light_len];
+    read_section(&mut file, path, &h, 6, &mut b)?;
+    let lights: Vec<WorldLight> = b
+        .chunks_exact(LIGHT_LEN as usize)
+        .map(|chunk| {
+            let mut c = Cursor::new(chunk);
+            WorldLight {
+                position: c.vec(),
+                colour: c.vec(),
+            }
+        })
+        .collect();
+    if lights
+        .iter()
+        .any(|l| !(l.position.is_finite() && l.colour.is_finite()))
+    {
+        return Err(invalid("a light is not finite".into()));
+    }
+    RecordStore::new(extent, &directory, &records).map_err(|e| invalid(e.to_string()))?;
+    for (i, r) in records.iter().enumerate() {
+        if r.object as usize >= objects.len() || usize::from(r.material) >= materials.len() {
+            return Err(invalid(format!(
+                "record {i} names object {} and material {}, beyond the tables",
+                r.object, r.material
+            )));
+        }
+    }
+    Ok(VoxelScene {
+        frame: RasterFrame {
+            extent,
+            origin: m.origin,
+            voxel_size: m.voxel_size,
+        },
+        separation: m.separation,
+        plane,
+        directory,
+        records,
+        objects,
+        materials,
+        lights,
+        background: m.background,
+        view: m.view,
+    })
+}
+
+fn read_records(
+    file: &mut File,
+    path: &Path,
+    h: &Header,
+    len: usize,
+) -> Result<Vec<VoxelRecord>, RasterFileError> {
+    let (crc, off, _) = h.sections[3];
+    let io = |source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot read",
+        source,
+    };
+    file.seek(SeekFrom::Start(off)).map_err(io)?;
+    let n = len / RECORD_LEN as usize;
+    let mut records = Vec::with_capacity(n);
+    let mut hasher = crc32fast::Hasher::new();
+    let mut buf = vec![0u8; (1 << 15) * RECORD_LEN as usize];
+    let mut left = len;
+    while left > 0 {
+        let take = left.min(buf.len());
+        file.read_exact(&mut buf[..take]).map_err(io)?;
+        hasher.update(&buf[..take]);
+        records.extend(
+            buf[..take]
+                .chunks_exact(RECORD_LEN as usize)
+                .map(record_from),
+        );
+        left -= take;
+    }
+    if hasher.finalize() != crc {
+        return Err(RasterFileError::Checksum {
+            path: path.to_path_buf(),
+            section: "records",
+        });
+    }
+    Ok(records)
+}

@@ -1,0 +1,227 @@
+//! The image: primary rays for every pixel, in parallel, deterministic.
+//!
+//! The image is cut into tiles of [`TILE_W`] × [`TILE_H`] pixels, which
+//! rayon hands to its threads; each tile is cut into 4×2 pixel blocks
+//! traced through [`Tracer::trace_block`] (eight rays: the lanes of a ray
+//! packet). With supersampling `K`, each pixel gets `K × K` rays at the
+//! sub-pixel offsets of [`crate::camera::sample_offset`] (row by row), and
+//! their colours are averaged (a box filter) before the 8-bit conversion.
+//!
+//! **Determinism.** Every pixel's colour depends only on its own rays, and
+//! its samples are summed in a fixed order; tiles are written back by
+//! index. The image is therefore byte-identical for every thread count.
+//! The ray counts are integer sums, identical as well.
+
+#![deny(missing_docs)]
+
+use std::time::{Duration, Instant};
+
+use glam::DVec3;
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+
+use crate::camera::{Camera, sample_offset};
+use crate::intersect::Ray;
+use crate::shade;
+use crate::trace::{BLOCK, BLOCK_H, BLOCK_W, RayStats, Tracer};
+
+/// Tile width in pixels (a multiple of the block width).
+pub const TILE_W: u32 = 32;
+/// Tile height in pixels (a multiple of the block height).
+pub const TILE_H: u32 = 8;
+/// Largest image side accepted.
+pub const MAX_SIDE: u32 = 32768;
+/// Largest supersampling factor accepted (K × K rays per pixel).
+pub const MAX_SUPERSAMPLE: u32 = 16;
+/// Most primary rays one render may trace (`width · height · K²`).
+pub const MAX_PRIMARY_RAYS: u64 = 1 << 32;
+
+/// An 8-bit RGB image, rows top to bottom.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `3 · width · height` bytes, RGB.
+    pub rgb: Vec<u8>,
+}
+
+/// How to render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderOptions {
+    /// Rays per pixel along each axis (`K × K` in all).
+    pub supersample: u32,
+    /// Worker threads; 0 for rayon's default (one per core).
+    pub threads: usize,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            supersample: 1,
+            threads: 0,
+        }
+    }
+}
+
+/// Why rendering failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// A size out of range.
+    #[error("{what}: {message}")]
+    Size {
+        /// The option.
+        what: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// The thread pool could not be started.
+    #[error("cannot start {threads} render threads")]
+    Threads {
+        /// How many.
+        threads: usize,
+        /// Why.
+        #[source]
+        source: rayon::ThreadPoolBuildError,
+    },
+}
+
+/// Checks image size and supersampling against the limits.
+///
+/// # Errors
+/// [`RenderError::Size`] naming the option.
+pub fn check_sizes(width: u32, height: u32, supersample: u32) -> Result<(), RenderError> {
+    for (what, v) in [("width", width), ("height", height)] {
+        if !(1..=MAX_SIDE).contains(&v) {
+            return Err(RenderError::Size {
+                what,
+                message: format!("expected 1 to {MAX_SIDE} pixels, found {v}"),
+            });
+        }
+    }
+    if !(1..=MAX_SUPERSAMPLE).contains(&supersample) {
+        return Err(RenderError::Size {
+            what: "supersample",
+            message: format!(
+                "expected 1 to {MAX_SUPERSAMPLE} rays per pixel side, found {supersample}"
+            ),
+        });
+    }
+    let rays = u64::from(width) * u64::from(height) * u64::from(supersample).pow(2);
+    if rays > MAX_PRIMARY_RAYS {
+        return Err(RenderError::Size {
+            what: "supersample",
+            message: format!(
+                "{width}×{height} pixels with {supersample}×{supersample} rays each is {rays} primary rays, more than {MAX_PRIMARY_RAYS}"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Renders the camera's image with `tracer`. `progress` counts tiles.
+///
+/// # Errors
+/// [`RenderError`]: sizes out of range, no threads.
+pub fn render(
+    tracer: &Tracer<'_>,
+    camera: &Camera,
+    opts: &RenderOptions,
+    progress: &ProgressBar,
+) -> Result<(Image, RayStats, Duration), RenderError> {
+    let (w, h, k) = (camera.width, camera.height, opts.supersample);
+    check_sizes(w, h, k)?;
+    let tiles_x = w.div_ceil(TILE_W);
+    let tiles_y = h.div_ceil(TILE_H);
+    let tiles = u64::from(tiles_x) * u64::from(tiles_y);
+    progress.set_length(tiles);
+    progress.set_message("rendering");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .map_err(|source| RenderError::Threads {
+            threads: opts.threads,
+            source,
+        })?;
+    let t0 = Instant::now();
+    let done: Vec<(Vec<[u8; 3]>, RayStats)> = pool.install(|| {
+        (0..tiles)
+            .into_par_iter()
+            .map(|t| {
+                let tx = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0);
+                let ty = u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
+                let r = render_tile(tracer, camera, k, tx * TILE_W, ty * TILE_H);
+                progress.inc(1);
+                r
+            })
+            .collect()
+    });
+    let elapsed = t0.elapsed();
+    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
+    let mut stats = RayStats::default();
+    for (t, (pixels, s)) in done.iter().enumerate() {
+        stats.add(s);
+        let t = t as u64;
+        let x0 = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0) * TILE_W;
+        let y0 = u32::try_from(t / u64::from(tiles_x)).unwrap_or(0) * TILE_H;
+        let tw = TILE_W.min(w - x0);
+        for (j, row) in pixels.chunks(tw as usize).enumerate() {
+            let y = y0 as usize + j;
+            let at = 3 * (y * w as usize + x0 as usize);
+            for (i, p) in row.iter().enumerate() {
+                rgb[at + 3 * i..at + 3 * i + 3].copy_from_slice(p);
+            }
+        }
+    }
+    Ok((
+        Image {
+            width: w,
+            height: h,
+            rgb,
+        },
+        stats,
+        elapsed,
+    ))
+}
+
+/// One tile's pixels, row by row, and its ray counts.
+fn render_tile(
+    tracer: &Tracer<'_>,
+    camera: &Camera,
+    k: u32,
+    x0: u32,
+    y0: u32,
+) -> (Vec<[u8; 3]>, RayStats) {
+    let x1 = (x0 + TILE_W).min(camera.width);
+    let y1 = (y0 + TILE_H).min(camera.height);
+    let tw = (x1 - x0) as usize;
+    let mut sums = vec![DVec3::ZERO; tw * (y1 - y0) as usize];
+    let mut stats = RayStats::default();
+    for by in (y0..y1).step_by(BLOCK_H as usize) {
+        for bx in (x0..x1).step_by(BLOCK_W as usize) {
+            let lane_pixel = |lane: u32| {
+                let (x, y) = (bx + lane % BLOCK_W, by + lane / BLOCK_W);
+                (x < x1 && y < y1).then_some((x, y))
+            };
+            for j in 0..k {
+                for i in 0..k {
+                    let (ox, oy) = (sample_offset(i, k), sample_offset(j, k));
+                    let rays: [Option<Ray>; BLOCK] = std::array::from_fn(|lane| {
+                        let (x, y) = lane_pixel(lane as u32)?;
+                        Some(camera.ray(f64::from(x) + ox, f64::from(y) + oy))
+                    });
+                    let colours = tracer.trace_block(&rays, &mut stats);
+                    for (lane, c) in colours.iter().enumerate() {
+                        if let Some((x, y)) = lane_pixel(lane as u32) {
+                            sums[(y - y0) as usize * tw + (x - x0) as usize] += *c;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let n = f64::from(k * k);
+    (sums.iter().map(|s| shade::to_rgb8(*s / n)).collect(), stats)
+}
