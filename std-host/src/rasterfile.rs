@@ -19,7 +19,7 @@
 //!
 //! | kind | section | contents |
 //! |---|---|---|
-//! | 1 | meta | `nx ny nz` u32; separation u8 (6 or 26) + 3 zero bytes; world origin 3×f64; voxel size f64; background 3×f64; view: from, at, up 3×f64 each, angle f64, hither f64, resolution 2×u32; counts: records u64, objects u64, materials u32, lights u32 (188 bytes) |
+//! | 1 | meta | `nx ny nz` u32; separation u8 (6 or 26) + 3 zero bytes; world origin 3×f64; voxel size f64; background 3×f64; view: from, at, up 3×f64 each, angle f64, hither f64, resolution 2×u32; counts: records u64, objects u64, materials u32, lights u32 (192 bytes) |
 //! | 2 | plane | one cell per voxel, x fastest ([`rrt_core::raster`]) |
 //! | 3 | directory | brick directory, `bricks + 1` × u32 ([`rrt_core::store`]) |
 //! | 4 | records | the 20-byte [`VoxelRecord`]s, field by field as in [`rrt_core::voxel`] |
@@ -67,7 +67,7 @@ pub const MAGIC: [u8; 8] = *b"RRTRASTR";
 pub const VERSION: u32 = 1;
 const SECTIONS: usize = 7;
 const HEADER_LEN: u64 = 192;
-const META_LEN: u64 = 188;
+const META_LEN: u64 = 192;
 const OBJECT_LEN: u64 = 168;
 const MATERIAL_LEN: u64 = 64;
 const LIGHT_LEN: u64 = 48;

@@ -212,6 +212,28 @@ fn rgb(c: [u8; 3]) -> DVec3 {
     DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])) / 255.0
 }
 
+/// Intersection verification of a discrete hit at voxel `v` by the world
+/// ray `ray` (unit direction): the exact intersection with `object` whose
+/// point lies in the voxel's box grown by one voxel on every side, with
+/// `t > tmin`; `None` for a false hit (module docs).
+#[must_use]
+pub fn verify(
+    frame: &RasterFrame,
+    object: &WorldObject,
+    ray: &Ray,
+    v: [u32; 3],
+    tmin: f64,
+) -> Option<crate::intersect::Hit> {
+    let lo = DVec3::from(v.map(f64::from));
+    let o_r = frame.world_to_raster(ray.origin);
+    let vs = frame.voxel_size;
+    let (a, b) = slab(o_r, ray.dir, lo - 1.0, lo + 2.0)?;
+    object
+        .shape
+        .intersect(ray, (a * vs).max(tmin), b * vs)
+        .filter(|hit| hit.normal.is_finite())
+}
+
 /// The renderer over one voxelized scene.
 #[derive(Clone, Debug)]
 pub struct Tracer<'s> {
@@ -408,13 +430,7 @@ impl<'s> Tracer<'s> {
         if self.opts.verify
             && let Some(obj) = self.objects.get(usize::try_from(rec.object).ok()?)
         {
-            let window = slab(o_r, ray.dir, lo - 1.0, lo + 2.0);
-            let hit = window.and_then(|(a, b)| {
-                obj.shape
-                    .intersect(ray, (a * vs).max(tmin), b * vs)
-                    .filter(|hit| hit.normal.is_finite())
-            });
-            return match hit {
+            return match verify(&self.frame, obj, ray, v, tmin) {
                 Some(hit) => Some(SurfaceHit {
                     voxel: v,
                     rec: *rec,
@@ -663,17 +679,6 @@ impl<'s> Tracer<'s> {
     pub fn trace_primary(&self, ray: &Ray, stats: &mut RayStats) -> DVec3 {
         stats.primary += 1;
         self.trace(ray, 1, None, stats)
-    }
-
-    /// Walks `ray` to its first accepted hit and reports the hit voxel, its
-    /// object id and how many discrete hits verification rejected on the
-    /// way (for `rrt ray --raster`).
-    #[must_use]
-    pub fn probe(&self, ray: &Ray) -> (Option<([u32; 3], u32)>, RayStats) {
-        let mut stats = RayStats::default();
-        let walk = self.first_walk(ray);
-        let h = self.resolve(ray, walk, 0.0, None, &mut stats);
-        (h.map(|h| (h.voxel, h.rec.object)), stats)
     }
 }
 

@@ -12,9 +12,15 @@ use super::num::{decimal_to_fixed, triple};
 /// Arguments of `rrt ray`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RayArgs {
-    /// Raster dimensions in voxels, `NX,NY,NZ` (each 1..=65536).
-    #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_dims)]
-    pub dims: [u32; 3],
+    /// Raster dimensions in voxels, `NX,NY,NZ` (each 1..=65536), for a ray
+    /// through an empty raster.
+    #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_dims, required_unless_present = "raster", conflicts_with = "raster")]
+    pub dims: Option<[u32; 3]>,
+    /// A raster saved by `rrt voxelize`: walk the ray through its scene
+    /// (origin and direction in its voxel units), report each hit voxel,
+    /// its object id and whether intersection verification accepts it.
+    #[arg(long, value_name = "FILE.rrt")]
+    pub raster: Option<std::path::PathBuf>,
     /// Ray origin in voxel units (voxel i spans [i, i+1)); decimals allowed.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_origin, allow_hyphen_values = true)]
     pub origin: [i64; 3],
@@ -88,7 +94,10 @@ fn parse_dir(s: &str) -> Result<[i32; 3], String> {
 /// # Errors
 /// [`CliError`] for a bad raster or an output error.
 pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
-    let [nx, ny, nz] = args.dims;
+    if let Some(path) = &args.raster {
+        return run_saved(args, path, out);
+    }
+    let [nx, ny, nz] = args.dims.unwrap_or([1, 1, 1]);
     let extent = Extent::new(nx, ny, nz).map_err(|e| CliError::Arg {
         arg: "--dims",
         message: e.to_string(),
@@ -111,6 +120,79 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
     for v in ray.path(args.connectivity.into()) {
         let [x, y, z] = extent.coord(v.index).unwrap_or_default();
         writeln!(out, "{x} {y} {z}")?;
+    }
+    writeln!(out, "miss")?;
+    Ok(())
+}
+
+/// `rrt ray --raster FILE.rrt`: the voxels up to each hit, then
+/// `hit X Y Z object ID verify accepted|rejected`; after a rejected (false)
+/// hit the walk resumes, as the renderer's does; `miss` if the ray leaves
+/// the raster without an accepted hit.
+fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Result<(), CliError> {
+    use rrt_core::raster::cell;
+    let scene = crate::rasterfile::load(path)?;
+    let mode: Connectivity = args.connectivity.into();
+    if mode == Connectivity::TwentySix
+        && scene.separation != rrt_core::voxelize::Separation::TwentySix
+    {
+        return Err(crate::trace::TraceError::Separation.into());
+    }
+    let extent = scene.extent();
+    let [ox, oy, oz] = args.origin;
+    let [dx, dy, dz] = args.dir;
+    writeln!(
+        out,
+        "origin_fx={ox},{oy},{oz} dir_fx={dx},{dy},{dz} frac_bits={FRAC_BITS} voxel=corner"
+    )?;
+    let ray = DiscreteRay::new(extent, args.origin, args.dir).map_err(|e| CliError::Arg {
+        arg: "--origin",
+        message: e.to_string(),
+    })?;
+    let Some(ray) = ray else {
+        writeln!(out, "miss")?;
+        return Ok(());
+    };
+    let raster = scene
+        .raster()
+        .map_err(|e| crate::trace::TraceError::Raster(e.to_string()))?;
+    let store = scene
+        .store()
+        .map_err(|e| crate::trace::TraceError::Raster(e.to_string()))?;
+    // The continuous ray in the world, for verification.
+    let one = f64::from(1u32 << FRAC_BITS);
+    let o = glam::DVec3::from(args.origin.map(|v| v as f64 / one));
+    let d = glam::DVec3::from(args.dir.map(|v| f64::from(v) / one));
+    let world = crate::intersect::Ray::new(
+        scene.frame.raster_to_world(o),
+        d.normalize_or(glam::DVec3::X),
+    );
+    for v in ray.voxels(&raster, mode).map_err(|e| CliError::Arg {
+        arg: "--raster",
+        message: e.to_string(),
+    })? {
+        let [x, y, z] = extent.coord(v.index).unwrap_or_default();
+        writeln!(out, "{x} {y} {z}")?;
+        if v.cell & cell::OPAQUE == 0 {
+            continue;
+        }
+        let Some(rec) = store.get(v.index) else {
+            continue;
+        };
+        let accepted = scene
+            .objects
+            .get(rec.object as usize)
+            .and_then(|obj| crate::trace::verify(&scene.frame, obj, &world, [x, y, z], 0.0))
+            .is_some();
+        writeln!(
+            out,
+            "hit {x} {y} {z} object {} verify {}",
+            rec.object,
+            if accepted { "accepted" } else { "rejected" }
+        )?;
+        if accepted {
+            return Ok(());
+        }
     }
     writeln!(out, "miss")?;
     Ok(())

@@ -1,0 +1,407 @@
+//! The renderer end to end: determinism across thread counts, saved rasters
+//! (round trip, corruption), intersection verification on known false
+//! hits, and a fidelity floor against `embree_nff`'s images.
+
+use std::path::{Path, PathBuf};
+
+use clap::Parser;
+use glam::DVec3;
+use indicatif::ProgressBar;
+use rrt_core::Connectivity;
+use rrt_host::build::{BuildOptions, VoxelScene, build};
+use rrt_host::camera::Camera;
+use rrt_host::cli::{Cli, run};
+use rrt_host::output::png_bytes;
+use rrt_host::rasterfile;
+use rrt_host::render::{Image, RenderOptions, render};
+use rrt_host::scene::Scene;
+use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(name)
+}
+
+/// The built-in scene (SPD balls2), kept in the host crate.
+fn balls2() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../std-host/scenes/balls2.nff")
+}
+
+/// A fresh temporary folder for one test.
+fn temp_dir(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rrt-test-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn voxelize(scene: &Scene, raster: u32, mode: Connectivity) -> VoxelScene {
+    let mut o = BuildOptions::new(raster);
+    o.connectivity = mode;
+    o.fit.max_memory = 1 << 30;
+    build(scene, &o, &ProgressBar::hidden()).unwrap().0
+}
+
+fn draw(
+    vs: &VoxelScene,
+    w: u32,
+    h: u32,
+    trace: TraceOptions,
+    k: u32,
+    threads: usize,
+) -> (Image, RayStats) {
+    let tracer = Tracer::new(vs, trace).unwrap();
+    let cam = Camera::new(&vs.view, w, h).unwrap();
+    let opts = RenderOptions {
+        supersample: k,
+        threads,
+    };
+    let (img, stats, _) = render(&tracer, &cam, &opts, &ProgressBar::hidden()).unwrap();
+    (img, stats)
+}
+
+fn cli(args: &[&str]) -> Result<String, String> {
+    let c = Cli::try_parse_from(std::iter::once("rrt").chain(args.iter().copied()))
+        .map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    run(&c, &mut out).map_err(|e| {
+        let mut msg = e.to_string();
+        let mut src = std::error::Error::source(&e);
+        while let Some(s) = src {
+            msg.push_str(&format!(": {s}"));
+            src = s.source();
+        }
+        msg
+    })?;
+    Ok(String::from_utf8(out).unwrap())
+}
+
+/// PSNR in dB of two RGB images of the same size.
+fn psnr(a: &[u8], b: &[u8]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let mse = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
+        .sum::<f64>()
+        / a.len() as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0f64 * 255.0 / mse).log10()
+    }
+}
+
+fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
+    let img = image::open(path).unwrap().to_rgb8();
+    (img.width(), img.height(), img.into_raw())
+}
+
+/// The PNG is byte-identical for 1, 2 and 3 threads (and so are the ray
+/// counts), with and without verification and supersampling, on an image
+/// whose size is not a multiple of the tile or block.
+#[test]
+fn png_is_identical_for_every_thread_count() {
+    let scene = Scene::load(data("balls1.nff")).unwrap();
+    let vs = voxelize(&scene, 160, Connectivity::Adaptive);
+    for (verify, k) in [(false, 1), (true, 2)] {
+        let trace = TraceOptions {
+            verify,
+            ..TraceOptions::default()
+        };
+        let (one, s1) = draw(&vs, 70, 45, trace, k, 1);
+        let png1 = png_bytes(&one).unwrap();
+        for threads in [2, 3] {
+            let (img, s) = draw(&vs, 70, 45, trace, k, threads);
+            assert_eq!(
+                png_bytes(&img).unwrap(),
+                png1,
+                "{threads} threads, verify {verify}, supersample {k}"
+            );
+            assert_eq!(s, s1);
+        }
+        assert_eq!(s1.primary, 70 * 45 * u64::from(k * k));
+        assert!(s1.hits > 0 && s1.reflected > 0);
+    }
+}
+
+/// `rrt voxelize` then `rrt render FILE.rrt` writes the same PNG as
+/// `rrt render SCENE` with the same raster; view overrides apply to a saved
+/// raster; `rrt info` reports it.
+#[test]
+fn saved_raster_renders_like_the_scene() {
+    let dir = temp_dir("roundtrip");
+    let rrt = dir.join("b1.rrt");
+    let (direct, saved) = (dir.join("direct.png"), dir.join("saved.png"));
+    let scene = data("balls1.nff");
+    let s = scene.to_str().unwrap();
+    let common = ["--width", "48", "--height", "40", "-q"];
+    cli(&[
+        "voxelize",
+        s,
+        "-o",
+        rrt.to_str().unwrap(),
+        "--raster",
+        "128",
+        "-q",
+    ])
+    .unwrap();
+    let mut a = vec![
+        "render",
+        s,
+        "-o",
+        direct.to_str().unwrap(),
+        "--raster",
+        "128",
+        "--verify",
+    ];
+    a.extend(common);
+    cli(&a).unwrap();
+    let mut b = vec![
+        "render",
+        rrt.to_str().unwrap(),
+        "-o",
+        saved.to_str().unwrap(),
+        "--verify",
+    ];
+    b.extend(common);
+    cli(&b).unwrap();
+    assert_eq!(
+        std::fs::read(&direct).unwrap(),
+        std::fs::read(&saved).unwrap()
+    );
+
+    // The loaded scene equals the built one.
+    let built = voxelize(&Scene::load(&scene).unwrap(), 128, Connectivity::Adaptive);
+    let loaded = rasterfile::load(&rrt).unwrap();
+    assert_eq!(&built.plane[..], &loaded.plane[..]);
+    assert_eq!(built.directory, loaded.directory);
+    assert_eq!(built.records, loaded.records);
+    assert_eq!(built.objects, loaded.objects);
+    assert_eq!(built.frame, loaded.frame);
+    assert_eq!(built.lights, loaded.lights);
+
+    // Another view of the saved raster.
+    let moved = dir.join("moved.png");
+    let mut c = vec![
+        "render",
+        rrt.to_str().unwrap(),
+        "-o",
+        moved.to_str().unwrap(),
+        "--from",
+        "-2.1,1.3,1.7",
+        "--angle",
+        "50",
+    ];
+    c.extend(common);
+    cli(&c).unwrap();
+    assert_ne!(
+        std::fs::read(&moved).unwrap(),
+        std::fs::read(&saved).unwrap()
+    );
+    let mut view = loaded.view.clone();
+    view.from = DVec3::new(-2.1, 1.3, 1.7);
+    view.angle = 50.0;
+    let tracer = Tracer::new(&loaded, TraceOptions::default()).unwrap();
+    let cam = Camera::new(&view, 48, 40).unwrap();
+    let (img, _, _) = render(
+        &tracer,
+        &cam,
+        &RenderOptions::default(),
+        &ProgressBar::hidden(),
+    )
+    .unwrap();
+    assert_eq!(read_png(&moved).2, img.rgb);
+
+    let info = cli(&["info", rrt.to_str().unwrap()]).unwrap();
+    let d = loaded.extent().dims();
+    assert!(
+        info.contains(&format!("dimensions: {}×{}×{} voxels", d[0], d[1], d[2])),
+        "{info}"
+    );
+    assert!(
+        info.contains(&format!("voxels: {} surface voxels", loaded.records.len())),
+        "{info}"
+    );
+    assert!(
+        info.contains("objects: 12, materials: 2, lights: 3"),
+        "{info}"
+    );
+    assert!(info.contains("voxel size: "), "{info}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Truncated, corrupt, wrong-version and foreign files are refused with a
+/// message naming the file and the problem; none panics.
+#[test]
+fn damaged_raster_files_are_refused() {
+    let dir = temp_dir("damaged");
+    let good = dir.join("good.rrt");
+    let scene = Scene::load(data("tetra.nff")).unwrap();
+    let vs = voxelize(&scene, 48, Connectivity::Adaptive);
+    rasterfile::save(&vs, &good).unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    let load = |name: &str, b: &[u8]| -> String {
+        let p = dir.join(name);
+        std::fs::write(&p, b).unwrap();
+        let e = rasterfile::load(&p).unwrap_err().to_string();
+        assert!(e.starts_with(&p.display().to_string()), "{e}");
+        // `rrt render` says the same (a file with the magic is a raster).
+        if b.starts_with(b"RRTRASTR") {
+            let out = dir.join("x.png");
+            let r = cli(&[
+                "render",
+                p.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "-q",
+            ]);
+            assert!(r.unwrap_err().contains(&e), "{name}");
+        }
+        e
+    };
+    assert!(rasterfile::load(&good).is_ok());
+
+    let e = load("half.rrt", &bytes[..bytes.len() / 2]);
+    assert!(e.contains("truncated"), "{e}");
+    let e = load("header-only.rrt", &bytes[..100]);
+    assert!(e.contains("truncated"), "{e}");
+
+    let mut v2 = bytes.clone();
+    v2[8] = 2;
+    let e = load("v2.rrt", &v2);
+    assert!(
+        e.contains("raster file version 2; this rrt reads version 1"),
+        "{e}"
+    );
+
+    let mut bad_header = bytes.clone();
+    bad_header[20] ^= 0x40;
+    let e = load("header.rrt", &bad_header);
+    assert!(e.contains("corrupt: the header checksum"), "{e}");
+
+    // A flipped bit in the plane and one near the end (records or tables).
+    let mut plane = bytes.clone();
+    plane[384 + 100] ^= 1;
+    let e = load("plane.rrt", &plane);
+    assert!(e.contains("corrupt: the plane checksum"), "{e}");
+    let mut tail = bytes.clone();
+    let n = tail.len();
+    tail[n - 70] ^= 0x10;
+    let e = load("tail.rrt", &tail);
+    assert!(e.contains("corrupt:") && e.contains("checksum"), "{e}");
+
+    let e = load("nff.rrt", &std::fs::read(data("tetra.nff")).unwrap());
+    assert!(e.contains("not an rrt raster file"), "{e}");
+    let e = load("empty.rrt", b"");
+    assert!(e.contains("not an rrt raster file"), "{e}");
+    let e = load("magic.rrt", b"RRTRAS");
+    assert!(e.contains("truncated"), "{e}");
+
+    let e = cli(&["info", dir.join("missing.rrt").to_str().unwrap()]).unwrap_err();
+    assert!(e.contains("missing.rrt: cannot open"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A sphere in a coarse raster: rays just outside its silhouette hit the
+/// voxel shell (a false hit, Figure 3's point B) and verification rejects
+/// them. `rrt ray --raster` shows one such ray, and a render counts them.
+#[test]
+fn verification_rejects_known_false_hits() {
+    let dir = temp_dir("verify");
+    let nff = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 30\nhither 0\nresolution 64 64\n\
+               l 5 5 10\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\n";
+    let scene = Scene::parse("sphere.nff", nff.as_bytes()).unwrap();
+    // Raster 20 with 2 voxels of margin: 16 voxels over the diameter, the
+    // sphere's centre at voxel coordinate 10, radius 8 voxels.
+    let vs = voxelize(&scene, 20, Connectivity::Adaptive);
+    assert_eq!(vs.extent().dims(), [20, 20, 20]);
+    let rrt = dir.join("sphere.rrt");
+    rasterfile::save(&vs, &rrt).unwrap();
+    // Along +x at (y, z) = (17.99, 10.95): 8.046 voxels from the sphere's
+    // axis, so the continuous ray misses it, through the voxel (9, 17, 10),
+    // whose centre segment along y crosses the sphere (from 7.04 to 8.03
+    // voxels from its centre): a shell voxel.
+    let out = cli(&[
+        "ray",
+        "--raster",
+        rrt.to_str().unwrap(),
+        "--origin",
+        "0,17.99,10.95",
+        "--dir",
+        "1,0,0",
+        "--connectivity",
+        "six",
+    ])
+    .unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("hit ") && l.ends_with("object 0 verify rejected")),
+        "{out}"
+    );
+    assert_eq!(lines.last(), Some(&"miss"), "{out}");
+    // Through the middle: the first hit is accepted.
+    let out = cli(&[
+        "ray",
+        "--raster",
+        rrt.to_str().unwrap(),
+        "--origin",
+        "0,10.2,10.1",
+        "--dir",
+        "1,0,0",
+    ])
+    .unwrap();
+    assert!(
+        out.lines()
+            .last()
+            .unwrap()
+            .ends_with("object 0 verify accepted"),
+        "{out}"
+    );
+
+    let (basic, sb) = draw(&vs, 64, 64, TraceOptions::default(), 1, 1);
+    let verified_opts = TraceOptions {
+        verify: true,
+        ..TraceOptions::default()
+    };
+    let (verified, sv) = draw(&vs, 64, 64, verified_opts, 1, 1);
+    assert_eq!(sb.false_hits, 0);
+    assert!(sv.false_hits > 0, "{sv:?}");
+    // Every false hit on a lone sphere is a silhouette ray that misses it:
+    // the verified image has that many fewer sphere pixels.
+    let lit = |img: &Image| img.rgb.chunks(3).filter(|p| p[0] > 0).count() as u64;
+    assert_eq!(sb.hits - sv.hits, lit(&basic) - lit(&verified));
+    assert!(sv.hits < sb.hits);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Fidelity floor against `embree_nff` (256², depth 3; the images and the
+/// command that made them are in `tests/data/README.md`), with a raster of
+/// twice the image's size. The floors sit about 1.5 dB under what was
+/// measured when they were set (printed by the test).
+#[test]
+fn psnr_floor_against_embree_nff() {
+    let cases: [(&str, PathBuf, f64, f64); 3] = [
+        // (ground truth, scene, basic floor, verified floor)
+        ("tetra-256.png", data("tetra.nff"), 27.5, 50.0),
+        ("balls1-256.png", data("balls1.nff"), 22.0, 27.0),
+        ("balls2-256.png", balls2(), 19.0, 23.5),
+    ];
+    for (gt, scene, basic_floor, verified_floor) in cases {
+        let (w, h, expect) = read_png(&data("embree").join(gt));
+        let vs = voxelize(&Scene::load(&scene).unwrap(), 512, Connectivity::Adaptive);
+        for (verify, floor) in [(false, basic_floor), (true, verified_floor)] {
+            let opts = TraceOptions {
+                verify,
+                ..TraceOptions::default()
+            };
+            let (img, _) = draw(&vs, w, h, opts, 1, 0);
+            let p = psnr(&img.rgb, &expect);
+            eprintln!("{gt}: raster 512, verify {verify}: PSNR {p:.2} dB (floor {floor})");
+            assert!(p >= floor, "{gt} verify {verify}: PSNR {p:.2} dB < {floor}");
+        }
+    }
+}
