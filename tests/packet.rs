@@ -278,3 +278,25 @@ fn random_walk_scripts_equal_their_scalar_rays() {
             .unwrap_or_else(|v| panic!("seed {seed} ({:?}): {v}, script {script:?}", p.bundle));
     }
 }
+
+/// Replays the inputs of the cargo-fuzz target `packet` kept in
+/// `tests/fuzz_regressions/packet/` through the fuzzer's own decoding and
+/// checker (see the README there).
+#[test]
+fn packet_fuzz_inputs_replay() {
+    use arbitrary::{Arbitrary, Unstructured};
+    use rrt_tests::packet_case::{PacketCase, run_packet_case};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz_regressions/packet");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no inputs in {}", dir.display());
+    for path in files {
+        let bytes = std::fs::read(&path).unwrap();
+        let case = PacketCase::arbitrary_take_rest(Unstructured::new(&bytes))
+            .unwrap_or_else(|e| panic!("{}: does not decode: {e}", path.display()));
+        run_packet_case(&case);
+    }
+}
