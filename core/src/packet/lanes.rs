@@ -89,12 +89,12 @@ impl I64x8 {
         }
     }
 
-    /// Lanewise bitwise `self & o`.
+    /// Lanewise bitwise `self | o`.
     #[inline(always)]
-    pub(crate) fn and(self, o: Self) -> Self {
+    pub(crate) fn or(self, o: Self) -> Self {
         Self {
-            lo: self.lo & o.lo,
-            hi: self.hi & o.hi,
+            lo: self.lo | o.lo,
+            hi: self.hi | o.hi,
         }
     }
 
