@@ -259,11 +259,7 @@ struct RaySet {
     count: u64,
 }
 
-fn ray_set(
-    name: &'static str,
-    scene: &Scene,
-    rays: &[([i64; 3], [i32; 3])],
-) -> RaySet {
+fn ray_set(name: &'static str, scene: &Scene, rays: &[([i64; 3], [i32; 3])]) -> RaySet {
     let mut scalar = Vec::new();
     let mut packets = Vec::new();
     for chunk in rays.chunks(LANES) {
@@ -393,7 +389,11 @@ fn main() {
     for &n in &sizes {
         let t = Instant::now();
         let scene = voxelize(&flake, n);
-        let opaque = scene.plane.iter().filter(|&&c| c & cell::OPAQUE != 0).count();
+        let opaque = scene
+            .plane
+            .iter()
+            .filter(|&&c| c & cell::OPAQUE != 0)
+            .count();
         eprintln!(
             "sphereflake: {} spheres in {:?} voxels, {:.1}% opaque, built in {:.1?}",
             flake.len(),
@@ -407,7 +407,11 @@ fn main() {
         let sets: Vec<RaySet> = [
             ("coherent", "coherent 512² camera, 4×2 blocks", camera),
             ("random", "incoherent random", random.clone()),
-            ("sorted", "incoherent, sorted by frame", sorted_by_frame(&random)),
+            (
+                "sorted",
+                "incoherent, sorted by frame",
+                sorted_by_frame(&random),
+            ),
         ]
         .into_iter()
         .filter(|(key, _, _)| want.is_empty() || want.split(',').any(|w| w.trim() == *key))

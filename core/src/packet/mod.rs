@@ -163,7 +163,7 @@ impl RayPacket8 {
         let mut inc = [[0i64; LANES]; 3];
         let mut off = [[0i64; LANES]; 3];
         let mut thr = [[0i64; LANES]; 2];
-        for (lane, ray) in (0u8..).zip(rays.iter()) {
+        for (lane, ray) in (0u8..8).zip(rays.iter()) {
             let Some(ray) = ray else { continue };
             if ray.extent() != extent {
                 return Err(LaneError {
@@ -213,7 +213,7 @@ impl RayPacket8 {
         dirs: [[i32; 3]; LANES],
     ) -> Result<Self, LaneError> {
         let mut rays = [None; LANES];
-        for (lane, ((slot, &o), &d)) in (0u8..).zip(rays.iter_mut().zip(&origins).zip(&dirs)) {
+        for (lane, ((slot, &o), &d)) in (0u8..8).zip(rays.iter_mut().zip(&origins).zip(&dirs)) {
             *slot = DiscreteRay::new(extent, o, d).map_err(|error| LaneError { lane, error })?;
         }
         Self::from_rays(extent, rays)
@@ -231,7 +231,7 @@ impl RayPacket8 {
         to: [[i64; 3]; LANES],
     ) -> Result<Self, LaneError> {
         let mut rays = [None; LANES];
-        for (lane, ((slot, &f), &t)) in (0u8..).zip(rays.iter_mut().zip(&from).zip(&to)) {
+        for (lane, ((slot, &f), &t)) in (0u8..8).zip(rays.iter_mut().zip(&from).zip(&to)) {
             *slot =
                 DiscreteRay::segment(extent, f, t).map_err(|error| LaneError { lane, error })?;
         }

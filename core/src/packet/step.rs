@@ -89,13 +89,13 @@ const fn rem_of(v: i64) -> u32 {
 /// `0xff` in byte `l` for each lane `l` of `lanes`.
 #[inline(always)]
 fn lane_bytes(lanes: u8) -> u64 {
-    let mut out = 0u64;
-    for (l, &bit) in BIT.iter().enumerate() {
+    let mut bytes = [0u8; LANES];
+    for (b, &bit) in bytes.iter_mut().zip(BIT.iter()) {
         if lanes & bit != 0 {
-            out |= 0xff << (l * 8);
+            *b = 0xff;
         }
     }
-    out
+    u64::from_le_bytes(bytes)
 }
 
 /// The lanes whose byte in `bytes` is non-zero.
@@ -123,9 +123,16 @@ fn proximity_bits(cells: u64) -> u8 {
 /// How a packet walk decides which lanes hit.
 pub(super) trait LaneTest {
     /// Bitmask of the lanes in `live` whose current voxel is a hit;
-    /// `cells` holds lane `l`'s cell in byte `l`, `live_bytes` is
-    /// [`lane_bytes`] of `live`.
-    fn hits(&mut self, live: u8, live_bytes: u64, index: &[i64; LANES], cells: u64) -> u8;
+    /// `cells` holds lane `l`'s cell, `any` is the OR of all eight cells,
+    /// `live_bytes` is [`lane_bytes`] of `live`.
+    fn hits(
+        &mut self,
+        live: u8,
+        live_bytes: u64,
+        index: &[i64; LANES],
+        cells: &[u8; LANES],
+        any: u8,
+    ) -> u8;
 }
 
 /// A caller's test, called once per live lane and voxel, lanes in order.
@@ -133,10 +140,9 @@ pub(super) struct Closure<T>(pub(super) T);
 
 impl<T: FnMut(usize, usize, u8) -> bool> LaneTest for Closure<T> {
     #[inline(always)]
-    fn hits(&mut self, live: u8, _: u64, index: &[i64; LANES], cells: u64) -> u8 {
+    fn hits(&mut self, live: u8, _: u64, index: &[i64; LANES], cells: &[u8; LANES], _: u8) -> u8 {
         let mut out = 0u8;
-        let cells = cells.to_le_bytes();
-        for (lane, ((&bit, &i), &c)) in BIT.iter().zip(index).zip(cells.iter()).enumerate() {
+        for (lane, ((&bit, &i), &c)) in (0..LANES).zip(BIT.iter().zip(index).zip(cells.iter())) {
             if live & bit != 0 && (self.0)(lane, index_of(i), c) {
                 out |= bit;
             }
@@ -150,8 +156,18 @@ pub(super) struct CellBits(pub(super) u8);
 
 impl LaneTest for CellBits {
     #[inline(always)]
-    fn hits(&mut self, _: u8, live_bytes: u64, _: &[i64; LANES], cells: u64) -> u8 {
-        let m = cells & u64::from_le_bytes([self.0; LANES]) & live_bytes;
+    fn hits(
+        &mut self,
+        _: u8,
+        live_bytes: u64,
+        _: &[i64; LANES],
+        cells: &[u8; LANES],
+        any: u8,
+    ) -> u8 {
+        if any & self.0 == 0 {
+            return 0;
+        }
+        let m = u64::from_le_bytes(*cells) & u64::from_le_bytes([self.0; LANES]) & live_bytes;
         if m == 0 { 0 } else { nonzero_bytes(m) }
     }
 }
@@ -187,10 +203,6 @@ struct Book {
     tie: u8,
     /// Lanes still fresh (entry voxel not visited) at the walk's start.
     fresh: u8,
-    /// Lanes that have taken at least one step in this walk.
-    stepped: u8,
-    /// Voxels visited per live lane in this walk.
-    visits: u32,
 }
 
 /// The moves of one step of every lane, and what they lead to.
@@ -289,12 +301,17 @@ fn six_tie(last: u8, e: [i64; 3], inc: [i64; 3]) -> bool {
     }
 }
 
-/// The whole walk state.
-struct Walker<'p> {
+/// The whole walk state. Its address never escapes the inlined loop (the
+/// cold write-back gets copies), so the compiler keeps it in registers.
+struct Walker<'p, 'b> {
     plane: &'p [u8],
     v: Lanes,
     k: Consts,
-    book: Book,
+    book: &'b Book,
+    /// Lanes that have taken at least one step in this walk.
+    stepped: u8,
+    /// Voxels visited per live lane in this walk.
+    visits: u32,
     /// Move masks of each lane's latest step (valid in `book.stepped`).
     last: [Mask8; 3],
     /// Current tie bits (Adaptive; incoming elsewhere).
@@ -307,75 +324,96 @@ struct Walker<'p> {
     end: PacketEnd,
 }
 
-impl Walker<'_> {
-    /// Writes lanes `lanes` back into their scalar rays, from state `v`
-    /// whose latest step moved `last` and left `tie`, and parks them.
-    #[cold]
-    #[inline(never)]
+/// Writes lanes `lanes` back into their scalar rays, from state `v` whose
+/// latest step moved `last` and left `tie`.
+#[cold]
+#[inline(never)]
+#[allow(clippy::too_many_arguments)] // the walk state, passed by value on purpose
+fn write_back<const MODE: u8>(
+    pk: &mut RayPacket8,
+    b: &Book,
+    lanes: u8,
+    v: Lanes,
+    last: [Mask8; 3],
+    tie: u8,
+    stepped: u8,
+    visits: u32,
+    done: bool,
+) {
+    let e = v.e.map(I64x8::to_array);
+    let rem = v.rem.map(I64x8::to_array);
+    let idx = v.idx.to_array();
+    let moved = last.map(Mask8::bits);
+    for (lane, (slot, &bit)) in (0..LANES).zip(pk.rays.iter_mut().zip(BIT.iter())) {
+        if lanes & bit == 0 {
+            continue;
+        }
+        let Some(ray) = slot.as_mut() else { continue };
+        let get = |a: &[i64; LANES]| a.get(lane).copied().unwrap_or(0);
+        let stepped = stepped & bit != 0;
+        let last = if stepped {
+            let [ma, mb, mc] = moved.map(|m| m & bit != 0);
+            u8::from(ma) | (u8::from(mb) << 1) | (u8::from(mc) << 2)
+        } else {
+            b.last.get(lane).copied().unwrap_or(0)
+        };
+        let rem = rem.map(|r| get(&r));
+        let mut err = e.map(|x| get(&x));
+        let inc = ray.params().inc;
+        if MODE == TWENTY_SIX
+            && let Some(e3) = err.get_mut(2)
+        {
+            // Each b crossing added inc_c, each c crossing took inc_b.
+            let nb = get(&b.rb).wrapping_sub(rem[1]);
+            let nc = get(&b.rc).wrapping_sub(rem[2]);
+            *e3 = get(&b.e3)
+                .wrapping_add(nb.wrapping_mul(inc[2]))
+                .wrapping_sub(nc.wrapping_mul(inc[1]));
+        }
+        let tie = match MODE {
+            ADAPTIVE => tie & bit != 0,
+            _ if !stepped => b.tie & bit != 0,
+            SIX => six_tie(last, err, inc),
+            _ => false,
+        };
+        ray.set_state(State {
+            index: index_of(get(&idx)),
+            err,
+            rem: rem.map(rem_of),
+            // Wrapping like the scalar's per-visit `wrapping_add(1)`.
+            steps: b.steps.get(lane).copied().unwrap_or(0).wrapping_add(visits),
+            last,
+            tie,
+            fresh: b.fresh & bit != 0 && visits == 0,
+            done,
+        });
+    }
+}
+
+impl Walker<'_, '_> {
+    /// Ends lanes `lanes`: writes them back (from state `v` whose latest
+    /// step moved `last` and left `tie`) and parks them.
+    #[inline(always)]
     fn end_lanes<const MODE: u8>(
         &mut self,
         pk: &mut RayPacket8,
         lanes: u8,
-        v: &Lanes,
-        last: &[Mask8; 3],
+        v: Lanes,
+        last: [Mask8; 3],
         tie: u8,
         done: bool,
     ) {
-        let e = v.e.map(I64x8::to_array);
-        let rem = v.rem.map(I64x8::to_array);
-        let idx = v.idx.to_array();
-        let moved = last.map(Mask8::bits);
-        let b = &self.book;
-        for (lane, (slot, &bit)) in pk.rays.iter_mut().zip(BIT.iter()).enumerate() {
-            if lanes & bit == 0 {
-                continue;
-            }
-            let Some(ray) = slot.as_mut() else { continue };
-            let get = |a: &[i64; LANES]| a.get(lane).copied().unwrap_or(0);
-            let stepped = b.stepped & bit != 0;
-            let last = if stepped {
-                let [ma, mb, mc] = moved.map(|m| m & bit != 0);
-                u8::from(ma) | (u8::from(mb) << 1) | (u8::from(mc) << 2)
-            } else {
-                b.last.get(lane).copied().unwrap_or(0)
-            };
-            let rem = rem.map(|r| get(&r));
-            let mut err = e.map(|x| get(&x));
-            let inc = ray.params().inc;
-            if MODE == TWENTY_SIX
-                && let Some(e3) = err.get_mut(2)
-            {
-                // Each b crossing added inc_c, each c crossing took inc_b.
-                let nb = get(&b.rb).wrapping_sub(rem[1]);
-                let nc = get(&b.rc).wrapping_sub(rem[2]);
-                *e3 = get(&b.e3)
-                    .wrapping_add(nb.wrapping_mul(inc[2]))
-                    .wrapping_sub(nc.wrapping_mul(inc[1]));
-            }
-            let tie = match MODE {
-                ADAPTIVE => tie & bit != 0,
-                _ if !stepped => b.tie & bit != 0,
-                SIX => six_tie(last, err, inc),
-                _ => false,
-            };
-            ray.set_state(State {
-                index: index_of(get(&idx)),
-                err,
-                rem: rem.map(rem_of),
-                // Wrapping like the scalar's per-visit `wrapping_add(1)`.
-                steps: b
-                    .steps
-                    .get(lane)
-                    .copied()
-                    .unwrap_or(0)
-                    .wrapping_add(b.visits),
-                last,
-                tie,
-                fresh: b.fresh & bit != 0 && b.visits == 0,
-                done,
-            });
-        }
-        // Park the lanes.
+        write_back::<MODE>(
+            pk,
+            self.book,
+            lanes,
+            v,
+            last,
+            tie,
+            self.stepped,
+            self.visits,
+            done,
+        );
         let keep = Mask8::from_bits(!lanes);
         self.k.inc = self.k.inc.map(|x| keep.keep(x));
         self.k.off = self.k.off.map(|x| keep.keep(x));
@@ -392,41 +430,48 @@ impl Walker<'_> {
         let ia = self.v.idx.to_array();
         let mut cells = [0u8; LANES];
         let mut oob = 0u8;
+        let mut any = 0u8;
         for ((slot, &i), &bit) in cells.iter_mut().zip(ia.iter()).zip(BIT.iter()) {
             match self.plane.get(index_of(i)) {
-                Some(&c) => *slot = c,
+                Some(&c) => {
+                    *slot = c;
+                    any |= c;
+                }
                 None => oob |= bit,
             }
         }
-        let cells = u64::from_le_bytes(cells);
         let oob = oob & self.live;
         if oob != 0 {
             // Unreachable for lanes set up on this extent; the scalar ends
             // the ray there, after the step, without counting a visit.
             let (v, last) = (self.v, self.last);
-            self.end_lanes::<MODE>(pk, oob, &v, &last, self.tie, true);
+            self.end_lanes::<MODE>(pk, oob, v, last, self.tie, true);
             self.end.exit |= oob;
         }
         if self.live == 0 {
             return false;
         }
         self.left = self.left.wrapping_sub(1);
-        self.book.visits = self.book.visits.wrapping_add(1);
-        let hits = test.hits(self.live, self.live_bytes, &ia, cells) & self.live;
+        self.visits = self.visits.wrapping_add(1);
+        let hits = test.hits(self.live, self.live_bytes, &ia, &cells, any) & self.live;
         if hits != 0 {
             let (v, last) = (self.v, self.last);
-            self.end_lanes::<MODE>(pk, hits, &v, &last, self.tie, false);
+            self.end_lanes::<MODE>(pk, hits, v, last, self.tie, false);
             self.end.hit |= hits;
             if self.live == 0 {
                 return false;
             }
         }
         if MODE == ADAPTIVE {
-            self.prox = proximity_bits(cells);
+            self.prox = if any & cell::PROXIMITY == 0 {
+                0
+            } else {
+                proximity_bits(u64::from_le_bytes(cells))
+            };
         }
         if self.left == 0 {
             let (v, last, live) = (self.v, self.last, self.live);
-            self.end_lanes::<MODE>(pk, live, &v, &last, self.tie, false);
+            self.end_lanes::<MODE>(pk, live, v, last, self.tie, false);
             self.end.budget |= live;
             return false;
         }
@@ -455,7 +500,7 @@ impl Walker<'_> {
         if exits != 0 {
             // Written back before the step, with the old moves and ties.
             let (v, last) = (self.v, self.last);
-            self.end_lanes::<MODE>(pk, exits, &v, &last, self.tie, true);
+            self.end_lanes::<MODE>(pk, exits, v, last, self.tie, true);
             self.end.exit |= exits;
             if self.live == 0 {
                 return false;
@@ -493,7 +538,7 @@ impl Walker<'_> {
         if MODE == ADAPTIVE {
             self.tie = (self.tie & !stepping) | (s.tie & stepping);
         }
-        self.book.stepped |= stepping;
+        self.stepped |= stepping;
         true
     }
 }
@@ -516,8 +561,6 @@ pub(super) fn run<const MODE: u8, T: LaneTest>(
         rc: [0; LANES],
         tie: 0,
         fresh: 0,
-        stepped: 0,
-        visits: 0,
     };
     let mut prox = 0u8;
     let mut e = [[0i64; LANES]; 3];
@@ -525,7 +568,7 @@ pub(super) fn run<const MODE: u8, T: LaneTest>(
     let mut idx = [0i64; LANES];
 
     // ---- load: the scalar stepper's prologue, lane by lane ----
-    for (lane, (slot, &bit)) in pk.rays.iter_mut().zip(BIT.iter()).enumerate() {
+    for (lane, (slot, &bit)) in (0..LANES).zip(pk.rays.iter_mut().zip(BIT.iter())) {
         let Some(ray) = slot else { continue };
         let s = *ray.state();
         if s.done {
@@ -599,7 +642,9 @@ pub(super) fn run<const MODE: u8, T: LaneTest>(
             off: pk.off.map(|x| keep.keep(x)),
             thr: pk.thr,
         },
-        book,
+        book: &book,
+        stepped: 0,
+        visits: 0,
         last: [Mask8::NONE; 3],
         tie,
         prox,
