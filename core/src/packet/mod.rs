@@ -225,6 +225,23 @@ impl RayPacket8 {
     ///
     /// # Errors
     /// The first lane whose [`DiscreteRay::segment`] fails, with its error.
+    ///
+    /// ```
+    /// use rrt_core::discrete_ray::Connectivity;
+    /// use rrt_core::fixed::voxel_centre;
+    /// use rrt_core::packet::RayPacket8;
+    /// use rrt_core::raster::{cell, Extent, Raster};
+    /// let e = Extent::cube(8).unwrap();
+    /// let mut plane = vec![cell::EMPTY; e.len()];
+    /// plane[e.index([4, 4, 4]).unwrap()] = cell::OPAQUE;
+    /// let raster = Raster::new(e, &plane).unwrap();
+    /// // Shadow rays from eight points towards a light at (7, 7, 7).
+    /// let from = core::array::from_fn(|l| [voxel_centre(l as u32); 3]);
+    /// let light = [voxel_centre(7); 3];
+    /// let mut packet = RayPacket8::segments(e, from, [light; 8]).unwrap();
+    /// let blocked = packet.first_hit(&raster, Connectivity::Six).unwrap();
+    /// assert_eq!(blocked, 0b0001_1111); // lanes 0..=4 pass (4, 4, 4)
+    /// ```
     pub fn segments(
         extent: Extent,
         from: [[i64; 3]; LANES],
@@ -322,6 +339,26 @@ impl RayPacket8 {
     ///
     /// # Errors
     /// As [`RayPacket8::walk`].
+    ///
+    /// ```
+    /// use rrt_core::discrete_ray::Connectivity;
+    /// use rrt_core::fixed::{voxel_centre, VOXEL};
+    /// use rrt_core::packet::RayPacket8;
+    /// use rrt_core::raster::{cell, Extent, Raster};
+    /// let e = Extent::cube(8).unwrap();
+    /// let mut plane = vec![cell::EMPTY; e.len()];
+    /// plane[e.index([5, 2, 2]).unwrap()] = cell::PROXIMITY;
+    /// let raster = Raster::new(e, &plane).unwrap();
+    /// let o = [-VOXEL, voxel_centre(2), voxel_centre(2)];
+    /// let mut packet = RayPacket8::new(e, [o; 8], [[VOXEL as i32, 0, 0]; 8]).unwrap();
+    /// // Stop at the first flagged voxel.
+    /// let end = packet.walk_until(&raster, Connectivity::TwentySix, 100, cell::PROXIMITY).unwrap();
+    /// assert_eq!(end.hit, 0xff);
+    /// assert_eq!(packet.hit(7).unwrap().voxel, [5, 2, 2]);
+    /// // Resume: every lane runs to its exit.
+    /// let end = packet.walk_until(&raster, Connectivity::TwentySix, 100, cell::PROXIMITY).unwrap();
+    /// assert_eq!((end.exit, packet.done()), (0xff, 0xff));
+    /// ```
     pub fn walk_until(
         &mut self,
         raster: &Raster<'_>,
