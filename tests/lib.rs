@@ -538,3 +538,5 @@ pub mod fuzz {
         }
     }
 }
+
+pub mod packet_case;

@@ -66,9 +66,13 @@ pub mod discrete_ray;
 pub mod error;
 pub mod fixed;
 pub mod geometry;
+pub mod packet;
 pub mod proximity;
 pub mod raster;
 pub mod voxelize;
+
+#[cfg(any(test, feature = "check"))]
+pub mod check_packet;
 
 pub use connectivity::Connectivity;
 pub use discrete_ray::{DiscreteRay, Face, Hit, WalkEnd};

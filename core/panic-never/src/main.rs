@@ -15,6 +15,7 @@ use core::panic::PanicInfo;
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
+use rrt_core::packet::RayPacket8;
 use rrt_core::proximity::flag_neighbourhood;
 use rrt_core::raster::{Extent, Raster, RasterMut};
 
@@ -92,10 +93,46 @@ fn drive() {
     let end = [i64_at(68), i64_at(76), i64_at(84)];
     let m = mode(input::<1>(92)[0]);
     let budget = u32_at(96);
-    for ray in [
+    let rays = [
         DiscreteRay::new(extent, origin, dir),
         DiscreteRay::segment(extent, origin, end),
-    ] {
+    ];
+    // The packet: both rays in several lanes, walked every way.
+    if let (Ok(a), Ok(b), Ok(raster)) = (rays[0], rays[1], raster) {
+        let lanes = [a, b, None, a, b, a, None, b];
+        if let Ok(mut p) = RayPacket8::from_rays(extent, lanes) {
+            let e = p
+                .walk(&raster, m, budget, |l, i, c| {
+                    (l as u8 ^ i as u8 ^ c) & 3 == 0
+                })
+                .unwrap_or_default();
+            sink(u64::from(e.hit ^ e.exit ^ e.budget));
+            let e = p
+                .walk_until(
+                    &raster,
+                    mode(input::<1>(105)[0]),
+                    budget,
+                    input::<1>(106)[0],
+                )
+                .unwrap_or_default();
+            sink(u64::from(e.hit ^ e.exit ^ e.budget));
+            while let Ok(hits) = p.first_hit(&raster, m) {
+                if hits == 0 {
+                    break;
+                }
+                sink(u64::from(hits));
+            }
+            for lane in 0..8 {
+                if let (Some(h), Some(r)) = (p.hit(lane), p.lane_ray(lane)) {
+                    sink(h.index as u64 ^ u64::from(r.steps()));
+                }
+            }
+        }
+        if let Ok(p) = RayPacket8::new(extent, [origin; 8], [dir; 8]) {
+            sink(u64::from(p.lanes()));
+        }
+    }
+    for ray in rays {
         let Ok(Some(mut ray)) = ray else { continue };
         sink(u64::from(ray.crossings()[0]) ^ ray.driving_axis() as u64);
         if let Some(f) = ray.entry_face() {

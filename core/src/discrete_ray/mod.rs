@@ -268,6 +268,22 @@ impl DiscreteRay {
         params::setup(extent, from, dir, true)
     }
 
+    /// The ray's constants (read by the packet stepper, [`crate::packet`]).
+    pub(crate) const fn params(&self) -> &Params {
+        &self.p
+    }
+
+    /// The ray's stepping state (read by the packet stepper).
+    pub(crate) const fn state(&self) -> &State {
+        &self.s
+    }
+
+    /// Replaces the stepping state: the packet stepper writes each lane's
+    /// state back with this, so that lane and scalar ray stay one value.
+    pub(crate) const fn set_state(&mut self, s: State) {
+        self.s = s;
+    }
+
     /// Walks the ray through `raster` until `test(index, cell)` accepts a
     /// voxel ([`WalkEnd::Hit`]), the ray leaves the raster
     /// ([`WalkEnd::Exit`]), or `budget` voxels have been visited in this call

@@ -308,50 +308,66 @@ fn twenty_six_run<
     let mut last = s.last;
     let [inc_a, inc_b, inc_c] = p.inc;
     let diag = p.diag;
-    let off_a = p.off[0];
+    // Decide on the terms shifted by their thresholds, f = e − thr, so that
+    // f > 0 ⇔ the minor axis crosses no later than the driving axis.
     let [thr_b, thr_c] = p.thr;
+    let mut f1 = e1.wrapping_sub(thr_b);
+    let mut f2 = e2.wrapping_sub(thr_c);
     // Minor axes of the last step (bit 0 = b, bit 1 = c).
     let mut minors = 0usize;
+    // Driving-axis crossings left before the exit.
+    let mut todo = ra;
 
-    let end = loop {
+    // How the loop ended: exits write it, the loop body never does.
+    // The budget is checked before the exit, as in `six_run`: a call that
+    // visited its last budgeted voxel reports Budget, the next one Exit.
+    let mut end = Run::End(WalkEnd::Exit);
+    loop {
         if BUDGETED {
             if *left == 0 {
-                break Run::End(WalkEnd::Budget);
+                end = Run::End(WalkEnd::Budget);
+                break;
             }
             *left = left.wrapping_sub(1);
         }
         // ---- advance: the driving crossing and the minors no later ----
-        if ra == 0 {
-            break Run::End(WalkEnd::Exit);
+        if todo == 0 {
+            break;
         }
-        ra = ra.wrapping_sub(1);
-        let sb = e1 > thr_b;
-        let sc = e2 > thr_c;
-        // All-ones when the minor axis steps, zero otherwise.
-        let mb = i64::from(sb).wrapping_neg();
-        let mc = i64::from(sc).wrapping_neg();
-        e1 = e1.wrapping_add(inc_b).wrapping_sub(inc_a & mb);
-        e2 = e2.wrapping_add(inc_c).wrapping_sub(inc_a & mc);
-        minors = usize::from(sb) | (usize::from(sc) << 1);
-        idx = idx.wrapping_add(*diag.get(minors).unwrap_or(&off_a));
+        todo = todo.wrapping_sub(1);
+        let sb = usize::from(f1 > 0);
+        let sc = usize::from(f2 > 0);
+        // inc_a masked to zero unless the minor axis steps too.
+        let mask = |m: usize| i64::from(m != 0).wrapping_neg();
+        f1 = f1.wrapping_add(inc_b).wrapping_sub(inc_a & mask(sb));
+        f2 = f2.wrapping_add(inc_c).wrapping_sub(inc_a & mask(sc));
+        minors = sb | (sc << 1);
+        // `& 3` keeps the table lookup free of a bounds check.
+        idx = idx.wrapping_add(diag[minors & 3]);
         if BUDGETED {
+            let (mb, mc) = (mask(sb), mask(sc));
             e3 = e3.wrapping_add(inc_c & mb).wrapping_sub(inc_b & mc);
-            rb = rb.wrapping_sub(u32::from(sb));
-            rc = rc.wrapping_sub(u32::from(sc));
+            rb = rb.wrapping_sub(u32::from(sb != 0));
+            rc = rc.wrapping_sub(u32::from(sc != 0));
             steps = steps.wrapping_add(1);
-            last = 1 | (u8::from(sb) << 1) | (u8::from(sc) << 2);
+            last = 1 | (u8::from(sb != 0) << 1) | (u8::from(sc != 0) << 2);
         }
         // ---- visit ----
         let Some(c) = cells(idx) else {
-            break Run::End(WalkEnd::Exit);
+            break;
         };
         if test(idx, c) {
-            break Run::End(WalkEnd::Hit);
+            end = Run::End(WalkEnd::Hit);
+            break;
         }
         if ADAPTIVE && c & cell::PROXIMITY != 0 {
-            break Run::Switch;
+            end = Run::Switch;
+            break;
         }
-    };
+    }
+    e1 = f1.wrapping_add(thr_b);
+    e2 = f2.wrapping_add(thr_c);
+    ra = todo;
 
     let k = start.rem[0].wrapping_sub(ra);
     if !BUDGETED && k > 0 {

@@ -1,0 +1,167 @@
+//! The fuzz case of the cargo-fuzz target `packet` (`fuzz/fuzz_targets/
+//! packet.rs`), shared with the replay test in `tests/packet.rs`: the same
+//! `Arbitrary` decoding and the same checker run in both, so a crash file
+//! found by the fuzzer replays exactly under `cargo test`.
+
+use arbitrary::Arbitrary;
+use rrt_core::check_packet::{Walk, check_packet, check_packet_script};
+use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
+use rrt_core::error::RayError;
+use rrt_core::fixed::VOXEL;
+use rrt_core::packet::{LANES, RayPacket8};
+use rrt_core::proximity::flag_neighbourhood;
+use rrt_core::raster::{Extent, Raster, RasterMut, cell};
+
+/// One fixed-point coordinate, biased towards the interesting ones.
+#[derive(Arbitrary, Debug, Clone, Copy)]
+pub enum At {
+    /// Any value (beyond `ORIGIN_LIMIT` it must be refused).
+    Raw(i64),
+    /// Near the box, in fixed units.
+    Near(i32),
+    /// On a voxel boundary (faces, edges and corners).
+    Lattice(i8),
+    /// At a voxel centre.
+    Centre(i8),
+}
+
+impl At {
+    fn fixed(self) -> i64 {
+        match self {
+            Self::Raw(v) => v,
+            Self::Near(v) => i64::from(v),
+            Self::Lattice(v) => i64::from(v) * VOXEL,
+            Self::Centre(v) => i64::from(v) * VOXEL + VOXEL / 2,
+        }
+    }
+}
+
+/// One direction component.
+#[derive(Arbitrary, Debug, Clone, Copy)]
+pub enum Towards {
+    /// Any `i32`.
+    Raw(i32),
+    /// A few units of the last fractional bit (0 and ±1 included).
+    Small(i8),
+    /// Whole voxels (equal magnitudes give exact diagonals).
+    Voxels(i8),
+}
+
+impl Towards {
+    fn fixed(self) -> i32 {
+        match self {
+            Self::Raw(v) => v,
+            Self::Small(v) => i32::from(v),
+            Self::Voxels(v) => i32::from(v) * (1 << 16),
+        }
+    }
+}
+
+/// A walk: connectivity (mod 3), budget (255 = unlimited) and hit bits.
+#[derive(Arbitrary, Debug, Clone, Copy)]
+pub struct WalkCase {
+    /// 0 Six, 1 TwentySix, 2 Adaptive (mod 3).
+    pub mode: u8,
+    /// Step budget; 255 is `u32::MAX`.
+    pub budget: u8,
+    /// A voxel is a hit when `cell & hit_bits != 0`.
+    pub hit_bits: u8,
+}
+
+impl WalkCase {
+    fn walk(self) -> Walk {
+        Walk {
+            mode: Connectivity::ALL[usize::from(self.mode % 3)],
+            budget: if self.budget == u8::MAX {
+                u32::MAX
+            } else {
+                u32::from(self.budget)
+            },
+            hit_bits: self.hit_bits,
+        }
+    }
+}
+
+/// One lane: a half-line or segment, walked by itself before it joins the
+/// packet (so that lanes start in different states).
+#[derive(Arbitrary, Debug, Clone)]
+pub struct LaneCase {
+    /// Origin (or segment start).
+    pub origin: [At; 3],
+    /// Direction (or segment extent).
+    pub dir: [Towards; 3],
+    /// A segment rather than a half-line.
+    pub segment: bool,
+    /// A scalar walk taken before packing.
+    pub before: Option<WalkCase>,
+}
+
+/// A packet of up to eight lanes over a small raster with arbitrary cells,
+/// and a script of walks.
+#[derive(Arbitrary, Debug, Clone)]
+pub struct PacketCase {
+    /// Raster dimensions, each taken modulo 16, plus one.
+    pub dims: [u8; 3],
+    /// Cell bits, repeated over the plane (OPAQUE and PROXIMITY kept).
+    pub cells: Vec<u8>,
+    /// Recompute the proximity flags from the opaque voxels.
+    pub flag: bool,
+    /// The lanes (`None`: empty).
+    pub lanes: [Option<LaneCase>; LANES],
+    /// Walks run on the packet and the scalar rays (at most 16 are used).
+    pub script: Vec<WalkCase>,
+}
+
+/// Builds the packet of `case` and checks every lane against its scalar
+/// ray in all three modes and through the script; panics on the first
+/// violation (the fuzzer reports the panic as a crash).
+pub fn run_packet_case(case: &PacketCase) {
+    let dims = case.dims.map(|d| u32::from(d % 16) + 1);
+    let Ok(extent) = Extent::new(dims[0], dims[1], dims[2]) else {
+        unreachable!("dims in 1..=16")
+    };
+    let mut plane: Vec<u8> = (0..extent.len())
+        .map(|i| {
+            case.cells
+                .get(i % case.cells.len().max(1))
+                .map_or(0, |b| b & (cell::OPAQUE | cell::PROXIMITY))
+        })
+        .collect();
+    if case.flag {
+        flag_neighbourhood(&mut RasterMut::new(extent, &mut plane).expect("plane length"));
+    }
+    let raster = Raster::new(extent, &plane).expect("plane length");
+    let rays: [Option<DiscreteRay>; LANES] = std::array::from_fn(|lane| {
+        let l = case.lanes[lane].as_ref()?;
+        let origin = l.origin.map(At::fixed);
+        let dir = l.dir.map(Towards::fixed);
+        let set_up = if l.segment {
+            let to = [0, 1, 2].map(|k| origin[k].wrapping_add(i64::from(dir[k])));
+            DiscreteRay::segment(extent, origin, to)
+        } else {
+            DiscreteRay::new(extent, origin, dir)
+        };
+        let mut ray = match set_up {
+            Ok(ray) => ray?,
+            Err(RayError::OriginOutOfRange { .. } | RayError::SegmentTooLong { .. }) => {
+                return None;
+            }
+            Err(e) => panic!("lane {lane}: setup failed for an accepted input: {e:?}"),
+        };
+        if let Some(w) = l.before {
+            let w = w.walk();
+            let bits = w.hit_bits;
+            ray.walk(&raster, w.mode, w.budget, |_, c| c & bits != 0)
+                .expect("same extent");
+        }
+        Some(ray)
+    });
+    let packet = RayPacket8::from_rays(extent, rays).expect("same extent");
+    if let Err(v) = check_packet(&raster, &packet) {
+        panic!("{v}");
+    }
+    let script: Vec<Walk> = case.script.iter().take(16).map(|w| w.walk()).collect();
+    if let Err(v) = check_packet_script(&raster, &packet, &script) {
+        panic!("{v} (script {script:?})");
+    }
+}
