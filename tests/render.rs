@@ -100,7 +100,8 @@ fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
 
 /// The PNG is byte-identical for 1, 2 and 3 threads (and so are the ray
 /// counts), with and without verification and supersampling, on an image
-/// whose size is not a multiple of the tile or block.
+/// whose size is not a multiple of the tile or block; and with the scalar
+/// primary walk instead of ray packets.
 #[test]
 fn png_is_identical_for_every_thread_count() {
     let scene = Scene::load(data("balls1.nff")).unwrap();
@@ -121,6 +122,18 @@ fn png_is_identical_for_every_thread_count() {
             );
             assert_eq!(s, s1);
         }
+        // The scalar primary walk gives the same image as the packets.
+        let scalar = TraceOptions {
+            packets: false,
+            ..trace
+        };
+        let (img, s) = draw(&vs, 70, 45, scalar, k, 2);
+        assert_eq!(
+            png_bytes(&img).unwrap(),
+            png1,
+            "scalar walk, verify {verify}"
+        );
+        assert_eq!(s, s1);
         assert_eq!(s1.primary, 70 * 45 * u64::from(k * k));
         assert!(s1.hits > 0 && s1.reflected > 0);
     }

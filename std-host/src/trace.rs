@@ -60,13 +60,15 @@
 //! intersection with the object left additionally requires `t` above
 //! 1/1000 voxel, so the surface point itself is never its own next hit.
 //!
-//! # For packets
+//! # Packets
 //! [`Tracer::trace_block`] traces eight primary rays (a 4×2 pixel block)
-//! in two stages: first each ray is walked to its first non-transparent
-//! voxel, the plain cell test that `RayPacket8` performs on eight lanes
-//! at once; then each ray's hit is resolved (verification and resumption,
-//! shading, secondary rays) by the scalar code. Replacing stage one by the
-//! packet walk changes nothing else.
+//! in two stages: first every ray is walked to its first non-transparent
+//! voxel, by a [`RayPacket8`] stepping the eight lanes together (or by the
+//! scalar walk, [`TraceOptions::packets`]); then each ray's hit is resolved
+//! (verification and resumption, shading, secondary rays) by the scalar
+//! code, which resumes the very `DiscreteRay` the packet left in its lane.
+//! The packet is bit-identical to the scalar walk, so the image does not
+//! depend on the choice.
 
 #![deny(missing_docs)]
 // `!(x < y)` is deliberate: it is true for NaN, which must be refused too.
@@ -76,6 +78,7 @@ use glam::DVec3;
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, ORIGIN_LIMIT, WalkEnd};
 use rrt_core::fixed::VOXEL;
 use rrt_core::light::{LeavingSurface, LightParams};
+use rrt_core::packet::RayPacket8;
 use rrt_core::raster::{Extent, Raster, cell};
 use rrt_core::store::RecordStore;
 use rrt_core::voxel::{LightVisibility, VoxelRecord};
@@ -107,6 +110,9 @@ pub struct TraceOptions {
     /// The acne rule's slab and angle, and the connectivity of render-time
     /// shadow rays (those of the light pass by default).
     pub light: LightParams,
+    /// Walk primary rays eight at a time in a [`RayPacket8`] (bit-identical
+    /// to the scalar walk, so the image is the same either way).
+    pub packets: bool,
 }
 
 impl Default for TraceOptions {
@@ -116,6 +122,7 @@ impl Default for TraceOptions {
             depth: 3,
             verify: false,
             light: LightParams::default(),
+            packets: true,
         }
     }
 }
@@ -657,7 +664,11 @@ impl<'s> Tracer<'s> {
     /// Stage one walks every ray to its first non-transparent voxel; stage
     /// two resolves and shades each (module docs, *For packets*).
     pub fn trace_block(&self, rays: &[Option<Ray>; BLOCK], stats: &mut RayStats) -> [DVec3; BLOCK] {
-        let walks: [Option<FirstWalk>; BLOCK] = rays.map(|r| r.map(|r| self.first_walk(&r)));
+        let walks = if self.opts.packets {
+            self.first_walks_packet(rays)
+        } else {
+            rays.map(|r| r.map(|r| self.first_walk(&r)))
+        };
         let mut out = [DVec3::ZERO; BLOCK];
         for ((o, r), w) in out.iter_mut().zip(rays).zip(walks) {
             let (Some(r), Some(w)) = (r, w) else {
@@ -673,6 +684,38 @@ impl<'s> Tracer<'s> {
             };
         }
         out
+    }
+
+    /// Stage one for eight rays at once: a [`RayPacket8`] walks every lane
+    /// to its first non-transparent voxel; each lane's ray is left exactly
+    /// as the scalar [`Tracer::first_walk`] leaves it.
+    fn first_walks_packet(&self, rays: &[Option<Ray>; BLOCK]) -> [Option<FirstWalk>; BLOCK] {
+        let lanes: [Option<DiscreteRay>; BLOCK] =
+            std::array::from_fn(|l| rays[l].as_ref().and_then(|r| self.discrete(r)));
+        let hits = RayPacket8::from_rays(self.extent, lanes)
+            .ok()
+            .and_then(|mut p| {
+                let hits = p.first_hit(&self.raster, self.opts.connectivity).ok()?;
+                Some((p, hits))
+            });
+        let Some((packet, hits)) = hits else {
+            // Unreachable in practice (every lane is over this extent); fall
+            // back to the scalar walk.
+            return rays.map(|r| r.map(|r| self.first_walk(&r)));
+        };
+        std::array::from_fn(|l| {
+            rays[l].as_ref()?;
+            let ray = packet.lane_ray(l);
+            Some(FirstWalk {
+                steps: ray.map_or(0, |r| u64::from(r.steps())),
+                end: if hits & (1 << l) != 0 {
+                    WalkEnd::Hit
+                } else {
+                    WalkEnd::Exit
+                },
+                ray,
+            })
+        })
     }
 
     /// Traces one primary ray (unit direction) and returns its colour.
