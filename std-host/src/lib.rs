@@ -12,6 +12,16 @@
 //!   rays, refraction), matching `embree_nff`.
 //! * [`intersect`]: exact `f64` ray intersections for intersection
 //!   verification and tests.
+//! * [`world`]: the world object table (each object's exact geometry),
+//!   materials and lights, indexed by the voxel records.
+//! * [`build`]: the preprocessing pipeline, scene → fitted raster →
+//!   count and fill passes → proximity flags → light visibility, giving a
+//!   [`build::VoxelScene`]; [`plane`]: the plane's huge-page memory.
+//! * [`trace`]: the recursive discrete ray tracer, intersection
+//!   verification, the acne rule for secondary rays.
+//! * [`render`]: tiles on rayon, 4×2 primary blocks (ray packets),
+//!   supersampling, deterministic for any thread count; [`output`]: PNG.
+//! * [`rasterfile`]: saved rasters (versioned, checksummed).
 //! * `check` (feature `check`): invariant checkers shared by tests and
 //!   fuzz targets.
 //! * [`cli`]: the `rrt` command line (the binary only parses arguments).
