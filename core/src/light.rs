@@ -189,6 +189,62 @@ pub fn illuminate<const N: usize>(
     Ok(report)
 }
 
+/// The light pass over one run of records, for hosts that split it
+/// across threads: for the records `first..first + out.len()` of `store`
+/// (fewer if the store ends first), writes into `out` each record with its
+/// visibility bits and illumination set, exactly as [`illuminate`] sets
+/// them. It reads only `store`, whose fields the shadow rays look at
+/// (object, material, normal, position) the pass never changes, so runs
+/// done in any order or in parallel give the records [`illuminate`] gives.
+///
+/// # Errors
+/// [`LightError::ExtentMismatch`] if `raster` and `store` differ in size.
+#[allow(clippy::too_many_arguments)] // the pass's context
+pub fn illuminate_run<const N: usize>(
+    raster: &Raster<'_>,
+    store: &RecordStore<'_>,
+    first: usize,
+    out: &mut [VoxelRecord],
+    objects: &ObjectTable<'_>,
+    materials: &Materials<N>,
+    lights: &Lights,
+    params: &LightParams,
+) -> Result<LightReport, LightError> {
+    let extent = raster.extent();
+    if store.extent() != extent {
+        return Err(LightError::ExtentMismatch);
+    }
+    let mut report = LightReport::default();
+    for (slot, (v, rec)) in out.iter_mut().zip(store.iter_from(first)) {
+        *slot = shade_record(
+            raster,
+            store,
+            extent,
+            objects,
+            materials,
+            lights,
+            params,
+            v,
+            *rec,
+            &mut report,
+        )?;
+    }
+    Ok(report)
+}
+
+impl LightReport {
+    /// Adds the counts of `other` (another run of the same pass).
+    pub fn add(&mut self, other: &Self) {
+        self.records = self.records.saturating_add(other.records);
+        self.rays = self.rays.saturating_add(other.rays);
+        self.visible = self.visible.saturating_add(other.visible);
+        self.translucent = self.translucent.saturating_add(other.translucent);
+        self.occluded = self.occluded.saturating_add(other.occluded);
+        self.facing_away = self.facing_away.saturating_add(other.facing_away);
+        self.missing = self.missing.saturating_add(other.missing);
+    }
+}
+
 #[allow(clippy::too_many_arguments)] // the pass's context, unpacked once
 fn shade_record<const N: usize>(
     raster: &Raster<'_>,

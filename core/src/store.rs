@@ -469,6 +469,46 @@ impl<'a> RecordStore<'a> {
         self.records.is_empty()
     }
 
+    /// The records from index `first` on, with their voxel coordinates, in
+    /// storage order (a brick is found by binary search of the directory):
+    /// for hosts that split a pass over the records into runs.
+    ///
+    /// ```
+    /// use rrt_core::raster::Extent;
+    /// use rrt_core::store::RecordStore;
+    /// use rrt_core::voxel::VoxelRecord;
+    /// let e = Extent::new(16, 8, 8).unwrap();
+    /// // Two bricks: voxel (1, 0, 0) in the first, (9, 0, 0) and (10, 0, 0) in the second.
+    /// let recs = [1u16, 1, 2].map(|key| VoxelRecord { key, ..Default::default() });
+    /// let store = RecordStore::new(e, &[0, 1, 3], &recs).unwrap();
+    /// let from_1: Vec<[u32; 3]> = store.iter_from(1).map(|(v, _)| v).collect();
+    /// assert_eq!(from_1, [[9, 0, 0], [10, 0, 0]]);
+    /// assert_eq!(store.iter_from(3).count(), 0);
+    /// ```
+    pub fn iter_from(
+        &self,
+        first: usize,
+    ) -> impl Iterator<Item = ([u32; 3], &'a VoxelRecord)> + 'a {
+        let extent = self.extent;
+        let dir = self.dir;
+        let records = self.records.get(first..).unwrap_or(&[]);
+        // The brick holding record `first`: the last with dir[b] <= first.
+        let mut b = dir
+            .partition_point(|&d| to_usize(d) <= first)
+            .saturating_sub(1);
+        records.iter().enumerate().map(move |(k, r)| {
+            let k = first.saturating_add(k);
+            while dir
+                .get(b.saturating_add(1))
+                .is_some_and(|&end| to_usize(end) <= k)
+            {
+                b = b.saturating_add(1);
+            }
+            let origin = brick_origin(extent, b).unwrap_or([0; 3]);
+            (voxel_at(origin, r.position()), r)
+        })
+    }
+
     /// Every record with its voxel coordinates, in storage order.
     pub fn iter(&self) -> impl Iterator<Item = ([u32; 3], &'a VoxelRecord)> + 'a {
         let extent = self.extent;

@@ -524,3 +524,57 @@ fn far_lights_and_huge_coordinates_do_not_fail() {
     let rep = w.run(&mut scene);
     assert_eq!(rep.records as usize, scene.records.len());
 }
+
+/// Runs of records in any order give what the serial pass gives: the
+/// contract hosts rely on to run the pass on threads.
+#[test]
+fn runs_in_any_order_equal_the_serial_pass() {
+    let e = Extent::cube(64).unwrap();
+    let big = |s: &mut dyn VoxelSink| {
+        testkit::sphere(e, vox([32, 32, 20]), 12 * VOXEL, Separation::Six, s)
+    };
+    let small = |s: &mut dyn VoxelSink| {
+        testkit::sphere(e, vox([32, 32, 45]), 4 * VOXEL, Separation::Six, s)
+    };
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &big), (attrs(1, 1), &small)], LIM);
+    let mut w = World::new(&[vox([32, 32, 1000]), vox([-40, 10, 30])]);
+    w.objects.push(sphere_obj([32, 32, 20], 12));
+    w.objects.push(Object {
+        material: 1,
+        ..sphere_obj([32, 32, 45], 4)
+    });
+    let unlit = scene.records.clone();
+    let serial_report = w.run(&mut scene);
+    let serial = scene.records.clone();
+
+    let mut storage = vec![Object::UNUSED; w.objects.len()];
+    let mut table = ObjectTable::new(&mut storage, &mut []);
+    for o in &w.objects {
+        table.push(*o).unwrap();
+    }
+    let raster = Raster::new(e, &scene.plane).unwrap();
+    let store = RecordStore::new(e, &scene.dir, &unlit).unwrap();
+    let mut out = unlit.clone();
+    let run = 97; // not a divisor of the record count, not a brick size
+    let mut report = LightReport::default();
+    // Last run first, to show the order does not matter.
+    let starts: Vec<usize> = (0..out.len()).step_by(run).collect();
+    for &first in starts.iter().rev() {
+        let end = (first + run).min(out.len());
+        let r = illuminate_run(
+            &raster,
+            &store,
+            first,
+            &mut out[first..end],
+            &table,
+            &w.materials,
+            &w.lights,
+            &LightParams::default(),
+        )
+        .unwrap();
+        report.add(&r);
+    }
+    assert_eq!(out, serial);
+    assert_eq!(report, serial_report);
+    assert!(report.translucent > 0 && report.visible > 0);
+}
