@@ -12,10 +12,11 @@
 //! 4. **fill pass**: every object again, named with its object id,
 //!    material and colour; [`Filler::finish`] sorts the bricks and sets the
 //!    proximity flags;
-//! 5. **light visibility** ([`rrt_core::light::illuminate`]): one discrete
-//!    shadow ray per record and light, the two visibility bits and the
-//!    precomputed ambient + diffuse illumination (SPD intensities
-//!    `I = sqrt(nl)/(2·nl)`, ambient the same).
+//! 5. **light visibility** ([`rrt_core::light::illuminate_run`], in runs of
+//!    records on rayon's threads): one discrete shadow ray per record and
+//!    light, the two visibility bits and the precomputed ambient + diffuse
+//!    illumination (SPD intensities `I = sqrt(nl)/(2·nl)`, ambient the
+//!    same). The result does not depend on the thread count.
 //!
 //! The result, a [`VoxelScene`], holds everything view-independent: the
 //! renderer ([`crate::trace`]) and the saved-raster file
@@ -32,8 +33,9 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
+use rayon::prelude::*;
 use rrt_core::connectivity::Connectivity;
-use rrt_core::light::{LightError, LightParams, LightReport, illuminate};
+use rrt_core::light::{LightError, LightParams, LightReport, illuminate_run};
 use rrt_core::object_table::{
     self, Light, Lights, MAX_LIGHTS, Materials, Object, ObjectTable, SCALAR_ONE,
 };
@@ -48,6 +50,9 @@ use crate::plane::Plane;
 use crate::scene::{Material, Scene, SourceLoc, View};
 use crate::shade;
 use crate::world::{WorldLight, WorldObject};
+
+/// Records per run of the parallel light pass.
+const LIGHT_RUN: usize = 1 << 14;
 
 /// Most distinct materials a scene may have (the record's index is 16
 /// bits; the table is kept small enough to copy per render).
@@ -132,6 +137,8 @@ pub struct BuildOptions {
     pub connectivity: Connectivity,
     /// Shadow rays of the light pass.
     pub light: LightParams,
+    /// Threads of the light pass; 0 for one per core.
+    pub threads: usize,
 }
 
 impl BuildOptions {
@@ -146,6 +153,7 @@ impl BuildOptions {
             },
             connectivity: Connectivity::Adaptive,
             light: LightParams::default(),
+            threads: 0,
         }
     }
 }
@@ -456,7 +464,7 @@ pub fn build(
         })?;
         progress.inc(1);
     }
-    let mut built = filler.finish()?;
+    let built = filler.finish()?;
     let voxelize = t0.elapsed();
 
     // Light visibility and precomputed illumination.
@@ -475,6 +483,7 @@ pub fn build(
     for m in &materials {
         let _ = core_materials.push(core_material(m));
     }
+    let mut light_report = LightReport::default();
     let intensity = scalar(shade::light_intensity(scene.lights.len()));
     let mut lights = Lights::new(intensity);
     for l in &fitted.lights {
@@ -485,17 +494,40 @@ pub fn build(
             intensity,
         });
     }
-    let light_report = {
-        let (raster, mut store) = built.split();
-        illuminate(
-            &raster,
-            &mut store,
-            &table,
-            &core_materials,
-            &lights,
-            &opts.light,
-        )?
+    // Runs of records on rayon's threads: each record's bits and
+    // illumination depend only on the (unchanged) store, so the result is
+    // the serial pass's whatever the thread count.
+    let lit: Vec<VoxelRecord> = {
+        let raster = built.raster();
+        let store = built.store();
+        let mut out = store.records().to_vec();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(opts.threads)
+            .build()
+            .map_err(|e| BuildError::Raster(format!("cannot start threads: {e}")))?;
+        let reports: Vec<Result<LightReport, LightError>> = pool.install(|| {
+            out.par_chunks_mut(LIGHT_RUN)
+                .enumerate()
+                .map(|(i, run)| {
+                    illuminate_run(
+                        &raster,
+                        &store,
+                        i * LIGHT_RUN,
+                        run,
+                        &table,
+                        &core_materials,
+                        &lights,
+                        &opts.light,
+                    )
+                })
+                .collect()
+        });
+        for r in reports {
+            light_report.add(&r?);
+        }
+        out
     };
+    records = lit;
     let lights_time = t1.elapsed();
 
     let objects = fitted

@@ -33,14 +33,18 @@
 //! With [`TraceOptions::verify`], a discrete hit is checked by intersecting
 //! the continuous world ray with the hit voxel's object ([`WorldObject`],
 //! indexed by the record's object id: the paper's object table). The
-//! intersection must lie near the voxel: within the voxel's box grown by
-//! one voxel on every side (a voxelized surface layer is at most √3 voxels
-//! thick, so a true intersection that belongs to this voxel lies there).
-//! Without one the hit is *false*: it is counted and the discrete walk
-//! resumes after the voxel. With one, the true point and the true normal
-//! are used, and the diffuse terms are recomputed with the true normal for
-//! the lights the bits say are visible (the precomputed `illum` was
-//! sampled at the voxel centre).
+//! first intersection from the voxel on is the hit when it lies near the
+//! voxel: within the voxel's box grown by one voxel on every side (a
+//! voxelized surface layer is at most √3 voxels thick). When the ray does
+//! not meet the object at all the hit is *false* (the paper's term): it is
+//! counted and the discrete walk resumes after the voxel. When it meets
+//! the object only farther on (a ray grazing a surface's voxel layer, whose
+//! intersection lies many voxels along it) the walk also resumes, to stop
+//! at the voxels near the intersection; accepting the far intersection at
+//! once could skip a nearer object. With a hit, the true point and the
+//! true normal are used, and the diffuse terms are recomputed with the true
+//! normal for the lights the bits say are visible (the precomputed `illum`
+//! was sampled at the voxel centre).
 //!
 //! # No acne
 //! A secondary ray starts on the surface it leaves: at the point where the
@@ -142,8 +146,14 @@ pub struct RayStats {
     pub steps: u64,
     /// Rays that ended on a surface.
     pub hits: u64,
-    /// Discrete hits that verification rejected.
+    /// Discrete hits that verification rejected: the continuous ray does
+    /// not meet the voxel's object (the paper's false hits).
     pub false_hits: u64,
+    /// Rays (of any kind but shadow) that met at least one false hit.
+    pub false_hit_rays: u64,
+    /// Discrete hits whose object the continuous ray meets only farther
+    /// on: the walk went on to the voxel of the intersection.
+    pub deferred: u64,
     /// Opaque cells without a record (a damaged raster), stepped over.
     pub missing: u64,
 }
@@ -158,6 +168,8 @@ impl RayStats {
         self.steps += o.steps;
         self.hits += o.hits;
         self.false_hits += o.false_hits;
+        self.deferred += o.deferred;
+        self.false_hit_rays += o.false_hit_rays;
         self.missing += o.missing;
     }
 
@@ -219,10 +231,24 @@ fn rgb(c: [u8; 3]) -> DVec3 {
     DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])) / 255.0
 }
 
+/// The outcome of verifying one discrete hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Verdict {
+    /// The continuous ray meets the object near the voxel: the true hit.
+    Hit(crate::intersect::Hit),
+    /// The continuous ray meets the object, but farther along than the
+    /// voxel's neighbourhood (a ray grazing a surface's voxel layer): the
+    /// walk goes on to the voxel that holds the intersection.
+    Ahead,
+    /// The continuous ray does not meet the object from the voxel on: the
+    /// paper's *false hit*.
+    False,
+}
+
 /// Intersection verification of a discrete hit at voxel `v` by the world
-/// ray `ray` (unit direction): the exact intersection with `object` whose
-/// point lies in the voxel's box grown by one voxel on every side, with
-/// `t > tmin`; `None` for a false hit (module docs).
+/// ray `ray` (unit direction): the exact intersection with `object` (with
+/// `t > tmin`) whose point lies in the voxel's box grown by one voxel on
+/// every side is the hit (module docs).
 #[must_use]
 pub fn verify(
     frame: &RasterFrame,
@@ -230,15 +256,23 @@ pub fn verify(
     ray: &Ray,
     v: [u32; 3],
     tmin: f64,
-) -> Option<crate::intersect::Hit> {
+) -> Verdict {
     let lo = DVec3::from(v.map(f64::from));
     let o_r = frame.world_to_raster(ray.origin);
     let vs = frame.voxel_size;
-    let (a, b) = slab(o_r, ray.dir, lo - 1.0, lo + 2.0)?;
-    object
+    let Some((a, b)) = slab(o_r, ray.dir, lo - 1.0, lo + 2.0) else {
+        return Verdict::False;
+    };
+    let from = (a * vs).max(tmin);
+    let first = object
         .shape
-        .intersect(ray, (a * vs).max(tmin), b * vs)
-        .filter(|hit| hit.normal.is_finite())
+        .intersect(ray, from, f64::INFINITY)
+        .filter(|hit| hit.normal.is_finite());
+    match first {
+        Some(hit) if hit.t < b * vs => Verdict::Hit(hit),
+        Some(_) => Verdict::Ahead,
+        None => Verdict::False,
+    }
 }
 
 /// The renderer over one voxelized scene.
@@ -380,6 +414,22 @@ impl<'s> Tracer<'s> {
     fn resolve(
         &self,
         ray: &Ray,
+        walk: FirstWalk,
+        tmin: f64,
+        leave: Option<&LeavingSurface>,
+        stats: &mut RayStats,
+    ) -> Option<SurfaceHit> {
+        let before = stats.false_hits;
+        let hit = self.resolve_walk(ray, walk, tmin, leave, stats);
+        if stats.false_hits > before {
+            stats.false_hit_rays += 1;
+        }
+        hit
+    }
+
+    fn resolve_walk(
+        &self,
+        ray: &Ray,
         mut walk: FirstWalk,
         tmin: f64,
         leave: Option<&LeavingSurface>,
@@ -438,14 +488,18 @@ impl<'s> Tracer<'s> {
             && let Some(obj) = self.objects.get(usize::try_from(rec.object).ok()?)
         {
             return match verify(&self.frame, obj, ray, v, tmin) {
-                Some(hit) => Some(SurfaceHit {
+                Verdict::Hit(hit) => Some(SurfaceHit {
                     voxel: v,
                     rec: *rec,
                     point: ray.at(hit.t),
                     normal: hit.normal,
                     verified: true,
                 }),
-                None => {
+                Verdict::Ahead => {
+                    stats.deferred += 1;
+                    None
+                }
+                Verdict::False => {
                     stats.false_hits += 1;
                     None
                 }

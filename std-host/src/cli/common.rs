@@ -219,6 +219,7 @@ pub enum Loaded {
 pub fn load_or_build(
     path: Option<&PathBuf>,
     raster: &RasterArgs,
+    threads: usize,
     show_progress: bool,
 ) -> Result<Loaded, CliError> {
     if let Some(p) = path
@@ -247,7 +248,9 @@ pub fn load_or_build(
     }
     let (scene, parse) = read_scene(path.map(PathBuf::as_path))?;
     let bar = progress(show_progress);
-    let built = build(&scene, &raster.build_options(), &bar);
+    let mut opts = raster.build_options();
+    opts.threads = threads;
+    let built = build(&scene, &opts, &bar);
     bar.finish_and_clear();
     let (vs, report) = built?;
     Ok(Loaded::Built {

@@ -126,9 +126,11 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
 }
 
 /// `rrt ray --raster FILE.rrt`: the voxels up to each hit, then
-/// `hit X Y Z object ID verify accepted|rejected`; after a rejected (false)
-/// hit the walk resumes, as the renderer's does; `miss` if the ray leaves
-/// the raster without an accepted hit.
+/// `hit X Y Z object ID verify accepted`, or `verify rejected: false hit`
+/// (the continuous ray misses the object), or `verify rejected:
+/// intersection farther on`; after a rejection the walk resumes, as the
+/// renderer's does; `miss` if the ray leaves the raster without an
+/// accepted hit.
 fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Result<(), CliError> {
     use rrt_core::raster::cell;
     let scene = crate::rasterfile::load(path)?;
@@ -179,18 +181,19 @@ fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Re
         let Some(rec) = store.get(v.index) else {
             continue;
         };
-        let accepted = scene
+        let verdict = scene
             .objects
             .get(rec.object as usize)
-            .and_then(|obj| crate::trace::verify(&scene.frame, obj, &world, [x, y, z], 0.0))
-            .is_some();
-        writeln!(
-            out,
-            "hit {x} {y} {z} object {} verify {}",
-            rec.object,
-            if accepted { "accepted" } else { "rejected" }
-        )?;
-        if accepted {
+            .map_or(crate::trace::Verdict::False, |obj| {
+                crate::trace::verify(&scene.frame, obj, &world, [x, y, z], 0.0)
+            });
+        let what = match verdict {
+            crate::trace::Verdict::Hit(_) => "accepted",
+            crate::trace::Verdict::Ahead => "rejected: intersection farther on",
+            crate::trace::Verdict::False => "rejected: false hit",
+        };
+        writeln!(out, "hit {x} {y} {z} object {} verify {what}", rec.object)?;
+        if matches!(verdict, crate::trace::Verdict::Hit(_)) {
             return Ok(());
         }
     }

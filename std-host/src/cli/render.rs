@@ -38,7 +38,7 @@ pub struct RenderArgs {
     /// K×K rays per pixel, box-filtered.
     #[arg(long, value_name = "K", default_value_t = 1)]
     pub supersample: u32,
-    /// Render threads [default: one per core].
+    /// Threads for the light pass and the render [default: one per core].
     #[arg(long, value_name = "T", default_value_t = 0)]
     pub threads: usize,
     /// View overrides.
@@ -62,7 +62,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         args.supersample,
     )?;
     let png = PngOutput::create(&args.output)?;
-    let loaded = load_or_build(args.scene.as_ref(), &args.raster, !args.quiet)?;
+    let loaded = load_or_build(args.scene.as_ref(), &args.raster, args.threads, !args.quiet)?;
     let scene = match &loaded {
         Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
     };
@@ -107,7 +107,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         let rays = stats.rays().max(1);
         writeln!(
             out,
-            "{}: {w}×{h}, raster {}×{}×{} ({}{}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow; {:.1} steps/ray; {} hits, {} false hits",
+            "{}: {w}×{h}, raster {}×{}×{} ({}{}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow; {:.1} steps/ray; {} hits, {} false hits ({:.2}% of rays)",
             args.output.display(),
             d[0],
             d[1],
@@ -123,6 +123,8 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             stats.steps as f64 / rays as f64,
             stats.hits,
             stats.false_hits,
+            100.0 * stats.false_hit_rays as f64
+                / (stats.primary + stats.reflected + stats.refracted).max(1) as f64,
         )?;
     }
     Ok(())

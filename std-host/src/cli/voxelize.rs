@@ -19,6 +19,9 @@ pub struct VoxelizeArgs {
     /// Voxelization.
     #[command(flatten)]
     pub raster: RasterArgs,
+    /// Threads for the light pass [default: one per core].
+    #[arg(long, value_name = "T", default_value_t = 0)]
+    pub threads: usize,
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
@@ -53,7 +56,7 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
             path: args.output.clone(),
             source,
         })?;
-    let loaded = load_or_build(args.scene.as_ref(), &args.raster, !args.quiet);
+    let loaded = load_or_build(args.scene.as_ref(), &args.raster, args.threads, !args.quiet);
     if loaded.is_err() && !existed {
         let _ = std::fs::remove_file(&args.output);
     }
