@@ -74,3 +74,5 @@ pub use connectivity::Connectivity;
 pub use discrete_ray::{DiscreteRay, Face, Hit, WalkEnd};
 pub use error::{RasterError, RayError};
 pub use raster::{Extent, Raster, RasterMut};
+#[cfg(any(test, feature = "check"))]
+pub mod check_voxelize;

@@ -79,3 +79,7 @@ pub trait VoxelSink {
     /// distance.
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel);
 }
+
+pub mod error;
+mod fixmath;
+pub mod sphere;

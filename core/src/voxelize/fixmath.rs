@@ -1,0 +1,220 @@
+//! Integer helpers shared by the voxelizers: exact floor/ceil divisions,
+//! square roots, cell ranges, clipping and unit vectors.
+//!
+//! Every function here is total: out-of-range input gives `None` or a
+//! saturated value, never a panic.
+
+use super::NORMAL_ONE;
+use super::error::{COORD_LIMIT, VoxelizeError};
+use crate::fixed::{FRAC_BITS, HALF_VOXEL, VOXEL};
+
+/// One voxel in fixed units, as `i128`.
+pub(crate) const V: i128 = VOXEL as i128;
+/// Half a voxel in fixed units, as `i128`.
+pub(crate) const H: i128 = HALF_VOXEL as i128;
+
+/// `Err(OutOfRange)` unless `|v| <= COORD_LIMIT`.
+pub(crate) fn check_coord(v: i64) -> Result<i128, VoxelizeError> {
+    if v.unsigned_abs() <= COORD_LIMIT.unsigned_abs() {
+        Ok(i128::from(v))
+    } else {
+        Err(VoxelizeError::OutOfRange)
+    }
+}
+
+/// A point checked against [`COORD_LIMIT`], widened to `i128`.
+pub(crate) fn check_point(p: [i64; 3]) -> Result<[i128; 3], VoxelizeError> {
+    Ok([check_coord(p[0])?, check_coord(p[1])?, check_coord(p[2])?])
+}
+
+/// `floor(n / V)` (an arithmetic shift: exact and total).
+#[inline]
+pub(crate) const fn cell_floor(n: i128) -> i128 {
+    n >> FRAC_BITS
+}
+
+/// `ceil(n / V)`.
+#[inline]
+pub(crate) const fn cell_ceil(n: i128) -> i128 {
+    // -floor(-n / V); for n = i128::MIN the negation would overflow, so
+    // saturate first (no accepted coordinate is anywhere near).
+    let m = n.saturating_neg();
+    (m >> FRAC_BITS).saturating_neg()
+}
+
+/// Fixed-point centre of cell `i`, as `i128`.
+#[inline]
+pub(crate) fn centre(i: u32) -> i128 {
+    // i < 2^32, so i·2^16 + 2^15 < 2^49.
+    (i128::from(i) << FRAC_BITS) | H
+}
+
+/// Fixed-point low face of cell `i`, as `i128`.
+#[inline]
+pub(crate) fn low(i: u32) -> i128 {
+    i128::from(i) << FRAC_BITS
+}
+
+/// Cells `[iV, (i+1)V]` (closed) that overlap the closed interval `[a, b]`:
+/// `ceil(a / V) - 1 ..= floor(b / V)`.
+#[inline]
+pub(crate) const fn cells_overlapping(a: i128, b: i128) -> (i128, i128) {
+    (cell_ceil(a).saturating_sub(1), cell_floor(b))
+}
+
+/// Cells whose centre `iV + V/2` lies in the closed interval `[a, b]`.
+#[inline]
+pub(crate) const fn centres_within(a: i128, b: i128) -> (i128, i128) {
+    (
+        cell_ceil(a.saturating_sub(H)),
+        cell_floor(b.saturating_sub(H)),
+    )
+}
+
+/// Intersects the cell range `lo ..= hi` with the raster axis `0 .. n`.
+#[inline]
+pub(crate) fn clip(lo: i128, hi: i128, n: u32) -> Option<(u32, u32)> {
+    let lo = lo.max(0);
+    let hi = hi.min(i128::from(n).saturating_sub(1));
+    if lo > hi {
+        return None;
+    }
+    Some((u32::try_from(lo).ok()?, u32::try_from(hi).ok()?))
+}
+
+/// `floor(sqrt(n))`, 0 for negative `n`.
+#[inline]
+pub(crate) fn isqrt(n: i128) -> i128 {
+    if n <= 0 {
+        return 0;
+    }
+    match u64::try_from(n) {
+        Ok(small) => i128::from(small.isqrt()),
+        // n < 2^127, so its root is < 2^64 and fits.
+        Err(_) => i128::try_from(n.unsigned_abs().isqrt()).unwrap_or(i128::MAX),
+    }
+}
+
+/// `ceil(sqrt(n))`, 0 for negative `n`.
+#[inline]
+pub(crate) fn ceil_sqrt(n: i128) -> i128 {
+    let s = isqrt(n);
+    // s ≤ 2^64, so s² and s + 1 cannot overflow i128.
+    if s.saturating_mul(s) < n {
+        s.saturating_add(1)
+    } else {
+        s
+    }
+}
+
+/// Saturating conversion of a non-negative fixed-point length to `u32`.
+#[inline]
+pub(crate) fn dist_u32(d: i128) -> u32 {
+    u32::try_from(d.unsigned_abs()).unwrap_or(u32::MAX)
+}
+
+/// Scales `v` to a unit vector of length [`NORMAL_ONE`]; `None` for the zero
+/// vector. Components are first shifted below `2^62`, so the squared length
+/// fits in `u128` and each quotient in `i32`.
+pub(crate) fn unit(v: [i128; 3]) -> Option<[i32; 3]> {
+    let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    if m == 0 {
+        return None;
+    }
+    let bits = 128u32.saturating_sub(m.leading_zeros());
+    let shift = bits.saturating_sub(62);
+    let w = v.map(|c| c >> shift);
+    // |w_k| < 2^62: each square < 2^124, the sum < 2^126.
+    let len2 = w.iter().fold(0u128, |acc, c| {
+        acc.saturating_add(c.unsigned_abs().saturating_mul(c.unsigned_abs()))
+    });
+    let len = i128::try_from(len2.isqrt()).ok()?;
+    if len == 0 {
+        return None;
+    }
+    let one = i128::from(NORMAL_ONE);
+    let mut out = [0i32; 3];
+    for (o, c) in out.iter_mut().zip(w) {
+        // |c| ≤ len, so |c·2^30 / len| ≤ 2^30; c·2^30 < 2^92.
+        *o = i32::try_from(c.checked_mul(one)?.checked_div(len)?).ok()?;
+    }
+    Some(out)
+}
+
+/// [`unit`] for vectors known to be small (`|v_k| < 2^31`): the same result
+/// with 64-bit arithmetic, falling back to [`unit`] otherwise.
+#[inline]
+pub(crate) fn unit_fast(v: [i128; 3]) -> Option<[i32; 3]> {
+    const LIM: i128 = 1 << 31;
+    if v.iter().all(|c| (-LIM..LIM).contains(c)) {
+        let w = v.map(|c| i64::try_from(c).unwrap_or(0));
+        // |w_k| < 2^31: squares < 2^62, sum < 2^64 fits u64.
+        let len2 = w.iter().fold(0u64, |acc, c| {
+            acc.wrapping_add(c.unsigned_abs().wrapping_mul(c.unsigned_abs()))
+        });
+        let len = i64::try_from(len2.isqrt()).ok()?;
+        if len == 0 {
+            return None;
+        }
+        let one = i64::from(NORMAL_ONE);
+        let mut out = [0i32; 3];
+        for (o, c) in out.iter_mut().zip(w) {
+            // |c| < 2^31: c·2^30 < 2^61 fits i64; the quotient ≤ 2^30.
+            *o = i32::try_from(c.wrapping_mul(one).checked_div(len)?).ok()?;
+        }
+        Some(out)
+    } else {
+        unit(v)
+    }
+}
+
+/// Counts offers; saturating, so it never overflows.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Counter(pub(crate) u64);
+
+impl Counter {
+    #[inline]
+    pub(crate) fn bump(&mut self) {
+        self.0 = self.0.saturating_add(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cell_ranges() {
+        assert_eq!(cell_floor(-1), -1);
+        assert_eq!(cell_ceil(1), 1);
+        assert_eq!(cell_ceil(V), 1);
+        assert_eq!(cells_overlapping(V, V), (0, 1));
+        assert_eq!(cells_overlapping(V + 1, 2 * V - 1), (1, 1));
+        assert_eq!(centres_within(0, V), (0, 0));
+        assert_eq!(centres_within(H + 1, V + H - 1), (1, 0));
+        assert_eq!(clip(-5, 3, 2), Some((0, 1)));
+        assert_eq!(clip(4, 9, 2), None);
+    }
+
+    #[test]
+    fn roots() {
+        for n in [0i128, 1, 2, 3, 4, 15, 16, 17, (1 << 70) + 5] {
+            let s = isqrt(n);
+            assert!(s * s <= n && (s + 1) * (s + 1) > n);
+            let c = ceil_sqrt(n);
+            assert!(c * c >= n && (c == 0 || (c - 1) * (c - 1) < n));
+        }
+        assert_eq!(isqrt(-4), 0);
+    }
+
+    #[test]
+    fn units() {
+        let one = i128::from(NORMAL_ONE);
+        assert_eq!(unit([0, 0, 5]), Some([0, 0, NORMAL_ONE]));
+        assert_eq!(unit([0, 0, 0]), None);
+        let u = unit([1 << 100, 1 << 100, 0]).unwrap();
+        let len2: i128 = u.iter().map(|c| i128::from(*c) * i128::from(*c)).sum();
+        assert!((len2 - one * one).abs() < one * 4);
+        assert_eq!(unit_fast([3, 4, 0]), unit([3, 4, 0]));
+    }
+}
