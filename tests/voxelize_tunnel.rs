@@ -17,7 +17,7 @@ use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::geometry::Sphere;
 use rrt_core::proximity::flag_neighbourhood;
 use rrt_core::raster::{Extent, Raster, RasterMut};
-use rrt_core::voxelize::{Separation, sphere};
+use rrt_core::voxelize::{Separation, sphere, triangle};
 use rrt_tests::Rng;
 
 /// Seeds to run: `RRT_SEED` alone if set, else `0..n`.
@@ -165,4 +165,276 @@ fn spheres_are_tunnel_free() {
     }
     println!("spheres: {rays} rays, all hit");
     assert!(rays > 100_000);
+}
+
+/// Parity inside test for a closed triangle mesh (float, test-side only).
+pub fn inside_mesh(verts: &[[i64; 3]], faces: &[[u32; 3]], p: [i64; 3]) -> bool {
+    let d = [0.537_7_f64, 0.314_1, 0.782_9];
+    let o = p.map(|c| c as f64);
+    let mut hits = 0;
+    for f in faces {
+        let [a, b, c] = f.map(|i| verts[i as usize].map(|x| x as f64));
+        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let pv = [
+            d[1] * e2[2] - d[2] * e2[1],
+            d[2] * e2[0] - d[0] * e2[2],
+            d[0] * e2[1] - d[1] * e2[0],
+        ];
+        let det = e1[0] * pv[0] + e1[1] * pv[1] + e1[2] * pv[2];
+        if det.abs() < 1e-12 {
+            continue;
+        }
+        let t = [o[0] - a[0], o[1] - a[1], o[2] - a[2]];
+        let u = (t[0] * pv[0] + t[1] * pv[1] + t[2] * pv[2]) / det;
+        let q = [
+            t[1] * e1[2] - t[2] * e1[1],
+            t[2] * e1[0] - t[0] * e1[2],
+            t[0] * e1[1] - t[1] * e1[0],
+        ];
+        let v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
+        let s = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
+        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s > 0.0 {
+            hits += 1;
+        }
+    }
+    hits % 2 == 1
+}
+
+/// Unit icosahedron (vertices, outward faces) and octahedron.
+fn platonic(ico: bool) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    if ico {
+        let p = (1.0 + 5f64.sqrt()) / 2.0;
+        let n = (1.0 + p * p).sqrt();
+        let v = vec![
+            [-1.0, p, 0.0],
+            [1.0, p, 0.0],
+            [-1.0, -p, 0.0],
+            [1.0, -p, 0.0],
+            [0.0, -1.0, p],
+            [0.0, 1.0, p],
+            [0.0, -1.0, -p],
+            [0.0, 1.0, -p],
+            [p, 0.0, -1.0],
+            [p, 0.0, 1.0],
+            [-p, 0.0, -1.0],
+            [-p, 0.0, 1.0],
+        ]
+        .into_iter()
+        .map(|c: [f64; 3]| c.map(|x| x / n))
+        .collect();
+        let f = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        (v, f)
+    } else {
+        let v = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let f = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        (v, f)
+    }
+}
+
+/// An axis-aligned box as 12 triangles.
+pub fn box_mesh(lo: [i64; 3], hi: [i64; 3]) -> (Vec<[i64; 3]>, Vec<[u32; 3]>) {
+    let v: Vec<[i64; 3]> = (0..8)
+        .map(|i| [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] }))
+        .collect();
+    let f = vec![
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6], // z faces
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7], // y faces
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5], // x faces
+    ];
+    (v, f)
+}
+
+/// Voxelizes a closed mesh with both separations and fires the probes.
+fn check_mesh(
+    verts: &[[i64; 3]],
+    faces: &[[u32; 3]],
+    extent: Extent,
+    rng: &mut Rng,
+    what: &str,
+) -> u64 {
+    let lo = [0, 1, 2].map(|k| verts.iter().map(|v| v[k]).min().unwrap());
+    let hi = [0, 1, 2].map(|k| verts.iter().map(|v| v[k]).max().unwrap());
+    let inside = |p: [i64; 3]| inside_mesh(verts, faces, p);
+    let os = origins(extent, lo, hi, 4, rng, inside);
+    let mut rays = 0;
+    for sep in [Separation::Six, Separation::TwentySix] {
+        let mut v = Voxelized::new(extent, |sink| {
+            let r = triangle::mesh(verts, None, faces, sep, extent, sink).unwrap();
+            assert_eq!(r.degenerate, 0);
+        });
+        rays += v.check(sep, &os, rng, &inside, what);
+    }
+    rays
+}
+
+#[test]
+fn closed_meshes_are_tunnel_free() {
+    let mut rays = 0u64;
+    for seed in seeds(160) {
+        let mut rng = Rng::new(1000 + seed);
+        let r = rng.range_i64(3 * VOXEL / 2, 14 * VOXEL) as f64;
+        let n = (2.0 * r / VOXEL as f64) as u32 + 6;
+        let extent = Extent::cube(n).unwrap();
+        let mid = f64::from(n) * VOXEL as f64 / 2.0;
+        let (unit, faces) = platonic(seed % 2 == 0);
+        let verts: Vec<[i64; 3]> = unit
+            .iter()
+            .map(|u| {
+                let j = [0; 3].map(|_| 1.0 + rng.range_i64(-150, 150) as f64 / 1000.0);
+                let p = [0, 1, 2].map(|k| mid + r * u[k] * j[k]);
+                match seed % 3 {
+                    0 => p.map(|c| c as i64),
+                    1 => p.map(|c| (c / VOXEL as f64).round() as i64 * VOXEL),
+                    _ => p.map(|c| (c / VOXEL as f64).floor() as i64 * VOXEL + VOXEL / 2),
+                }
+            })
+            .collect();
+        rays += check_mesh(
+            &verts,
+            &faces,
+            extent,
+            &mut rng,
+            &format!("seed {seed}: polyhedron {verts:?}"),
+        );
+    }
+    println!("polyhedra: {rays} rays, all hit");
+    assert!(rays > 100_000);
+}
+
+#[test]
+fn box_meshes_are_tunnel_free() {
+    let mut rays = 0u64;
+    for seed in seeds(80) {
+        let mut rng = Rng::new(2000 + seed);
+        let n = 20u32;
+        let extent = Extent::cube(n).unwrap();
+        // Corners on voxel faces, on voxel centres, or anywhere.
+        let snap = |x: i64| match seed % 3 {
+            0 => x / VOXEL * VOXEL,
+            1 => x / VOXEL * VOXEL + VOXEL / 2,
+            _ => x,
+        };
+        let lo = [0; 3].map(|_| snap(rng.range_i64(2 * VOXEL, 8 * VOXEL)));
+        let hi = [0; 3].map(|_| snap(rng.range_i64(10 * VOXEL, 17 * VOXEL)));
+        let (verts, faces) = box_mesh(lo, hi);
+        rays += check_mesh(
+            &verts,
+            &faces,
+            extent,
+            &mut rng,
+            &format!("seed {seed}: box mesh {lo:?}..{hi:?}"),
+        );
+    }
+    println!("box meshes: {rays} rays, all hit");
+    assert!(rays > 10_000);
+}
+
+/// Reads `v` and `f` lines of an OBJ file (triangles only).
+pub fn read_obj(text: &str) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut v = Vec::new();
+    let mut f = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.take(3).map(|x| x.parse().unwrap()).collect();
+                v.push([c[0], c[1], c[2]]);
+            }
+            Some("f") => {
+                let c: Vec<u32> = it
+                    .map(|x| x.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
+                    .collect();
+                for i in 1..c.len() - 1 {
+                    f.push([c[0], c[i], c[i + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    (v, f)
+}
+
+/// Scales float vertices to fit `n − 2·margin` voxels along the longest axis.
+pub fn fit(v: &[[f64; 3]], n: u32, margin: u32) -> Vec<[i64; 3]> {
+    let lo = [0, 1, 2].map(|k| v.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
+    let hi = [0, 1, 2].map(|k| v.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
+    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    let s = f64::from(n - 2 * margin) * VOXEL as f64 / size;
+    v.iter()
+        .map(|p| [0, 1, 2].map(|k| ((p[k] - lo[k]) * s + f64::from(margin) * VOXEL as f64) as i64))
+        .collect()
+}
+
+#[test]
+fn bunny_is_tunnel_free() {
+    let Some(data) = rrt_tests::shared_data() else {
+        println!("SKIPPED: ../shared/data not found, bunny test not run");
+        return;
+    };
+    let Ok(text) = std::fs::read_to_string(data.join("meshes/bunny.obj")) else {
+        println!("SKIPPED: meshes/bunny.obj not found");
+        return;
+    };
+    let (v, faces) = read_obj(&text);
+    let mut rays = 0;
+    for (i, n) in [48u32, 96].into_iter().enumerate() {
+        let verts = fit(&v, n, 3);
+        let mut rng = Rng::new(3000 + i as u64);
+        rays += check_mesh(
+            &verts,
+            &faces,
+            Extent::cube(n).unwrap(),
+            &mut rng,
+            &format!("bunny at {n}"),
+        );
+    }
+    println!("bunny: {rays} rays, all hit");
+    assert!(rays > 5_000);
 }

@@ -218,3 +218,64 @@ mod tests {
         assert_eq!(unit_fast([3, 4, 0]), unit([3, 4, 0]));
     }
 }
+
+/// `floor(n / d)` for `d > 0`.
+#[inline]
+pub(crate) fn floor_div(n: i128, d: i128) -> Option<i128> {
+    if d <= 0 {
+        return None;
+    }
+    n.checked_div_euclid(d)
+}
+
+/// `ceil(n / d)` for `d > 0`.
+#[inline]
+pub(crate) fn ceil_div(n: i128, d: i128) -> Option<i128> {
+    floor_div(n.checked_neg()?, d)?.checked_neg()
+}
+
+/// Incremental floor division: `floor((n0 + j·dn) / d)` for `j = 0, 1, …`,
+/// one addition and one comparison per step (the scan-line decision
+/// mechanism: no division inside the loop).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct IncDiv {
+    /// Current quotient.
+    pub(crate) q: i128,
+    /// Remainder, `0 <= r < d`.
+    r: i128,
+    dq: i128,
+    dr: i128,
+    d: i128,
+}
+
+impl IncDiv {
+    /// `None` for `d <= 0` or out-of-range operands.
+    pub(crate) fn new(n0: i128, dn: i128, d: i128) -> Option<Self> {
+        if d <= 0 {
+            return None;
+        }
+        Some(Self {
+            q: n0.checked_div_euclid(d)?,
+            r: n0.checked_rem_euclid(d)?,
+            dq: dn.checked_div_euclid(d)?,
+            dr: dn.checked_rem_euclid(d)?,
+            d,
+        })
+    }
+
+    /// Advances to the next `j`.
+    #[inline]
+    pub(crate) fn step(&mut self) {
+        // 0 <= r, dr < d, so r + dr < 2d cannot overflow; q moves by dq or
+        // dq + 1 per step and stays near the exact quotients, which the
+        // caller's ranges keep far from the i128 limits (saturating anyway).
+        self.r = self.r.wrapping_add(self.dr);
+        let carry = if self.r >= self.d {
+            self.r = self.r.wrapping_sub(self.d);
+            1
+        } else {
+            0
+        };
+        self.q = self.q.saturating_add(self.dq).saturating_add(carry);
+    }
+}

@@ -83,3 +83,4 @@ pub trait VoxelSink {
 pub mod error;
 mod fixmath;
 pub mod sphere;
+pub mod triangle;
