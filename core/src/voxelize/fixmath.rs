@@ -168,6 +168,15 @@ pub(crate) fn unit_fast(v: [i128; 3]) -> Option<[i32; 3]> {
     }
 }
 
+/// Euclidean length `floor(sqrt(v·v))` (saturating for huge `v`).
+#[inline]
+pub(crate) fn length(v: [i128; 3]) -> i128 {
+    isqrt(
+        v.iter()
+            .fold(0i128, |a, c| a.saturating_add(c.saturating_mul(*c))),
+    )
+}
+
 /// Counts offers; saturating, so it never overflows.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Counter(pub(crate) u64);

@@ -80,7 +80,10 @@ pub trait VoxelSink {
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel);
 }
 
+pub mod cuboid;
 pub mod error;
 mod fixmath;
+pub mod line;
 pub mod sphere;
 pub mod triangle;
+pub mod volume;
