@@ -80,10 +80,14 @@ pub trait VoxelSink {
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel);
 }
 
+pub mod cone;
 pub mod cuboid;
 pub mod error;
 mod fixmath;
 pub mod line;
+pub mod patch;
 pub mod sphere;
+mod tessellate;
+pub mod torus;
 pub mod triangle;
 pub mod volume;

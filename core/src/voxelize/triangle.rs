@@ -355,7 +355,7 @@ struct Axis {
 }
 
 /// A validated triangle.
-struct Tri {
+pub(crate) struct Tri {
     v: [[i128; 3]; 3],
     /// Edges `v1 − v0, v2 − v1, v0 − v2`.
     e: [[i128; 3]; 3],
@@ -375,6 +375,14 @@ impl Tri {
             check_point(t.vertices[1])?,
             check_point(t.vertices[2])?,
         ];
+        Self::from_points(v, t.normals)
+    }
+
+    /// A triangle from checked points (each within `COORD_LIMIT`).
+    pub(crate) fn from_points(
+        v: [[i128; 3]; 3],
+        normals: Option<[UnitVector; 3]>,
+    ) -> Result<Self, VoxelizeError> {
         let e = [sub(v[1], v[0]), sub(v[2], v[1]), sub(v[0], v[2])];
         let n = cross(e[0], sub(v[2], v[0])).ok_or(VoxelizeError::Arithmetic)?;
         if n == [0; 3] {
@@ -388,7 +396,7 @@ impl Tri {
             n,
             n_small: n.map(|c| c >> shift),
             unit: unit(n).ok_or(VoxelizeError::Degenerate)?,
-            normals: t.normals,
+            normals,
         })
     }
 
@@ -470,6 +478,33 @@ impl Tri {
         sink: &mut S,
         n: &mut Counter,
     ) -> Result<(), VoxelizeError> {
+        self.scan_with(sep, extent, sink, n, &|t: &Self, v| t.surfel(v))
+    }
+
+    /// [`Tri::scan`] with the surfel of each voxel computed by `surfel`
+    /// (surfaces tessellated into triangles use their own exact normals).
+    pub(crate) fn scan_with<S, F>(
+        &self,
+        sep: Separation,
+        extent: Extent,
+        sink: &mut S,
+        n: &mut Counter,
+        surfel: &F,
+    ) -> Result<(), VoxelizeError>
+    where
+        S: VoxelSink + ?Sized,
+        F: Fn(&Self, [u32; 3]) -> Surfel,
+    {
+        // Quick reject: the probe reaches at most half a voxel beyond the
+        // triangle's bounding box.
+        let size = extent.dims().map(super::fixmath::low);
+        for (k, s) in size.iter().enumerate() {
+            let lo = self.v.iter().map(|p| p[k]).min().unwrap_or(0);
+            let hi = self.v.iter().map(|p| p[k]).max().unwrap_or(0);
+            if hi.saturating_add(H) < 0 || lo.saturating_sub(H) > *s {
+                return Ok(());
+            }
+        }
         let k = dominant(self.n);
         let (na, nb, nk) = pick(k, extent.dims());
         // Axes in (a, b, k) coordinates, split by role.
@@ -566,7 +601,7 @@ impl Tri {
                 };
                 for ki in k0..=k1 {
                     let v = place(k, ai, bi, ki);
-                    sink.offer(v, self.surfel(v));
+                    sink.offer(v, surfel(self, v));
                     n.bump();
                 }
             }
@@ -575,7 +610,7 @@ impl Tri {
     }
 
     /// Nearest point data for voxel `v`: distance and normal.
-    fn surfel(&self, v: [u32; 3]) -> Surfel {
+    pub(crate) fn surfel(&self, v: [u32; 3]) -> Surfel {
         let c = v.map(centre);
         // Barycentric numerators of c's projection onto the plane.
         let a = [0, 1, 2].map(|i| {
@@ -740,8 +775,9 @@ mod tests {
 
     #[test]
     fn plane_thickness_is_the_rule() {
-        // A large triangle: away from its edges, the voxels of a column are
-        // exactly those with |d| ≤ ½‖n‖ (∞ for Six, 1 for TwentySix).
+        // A large triangle: away from its edges, a voxel belongs to it
+        // exactly when |d| ≤ ½‖n̂‖ (∞-norm for Six, 1-norm for TwentySix),
+        // i.e. |n·(c − v0)| ≤ ½·‖n‖·V in exact integers.
         let v = 65536i64;
         let t = Triangle {
             vertices: [
@@ -752,35 +788,23 @@ mod tests {
             normals: None,
         };
         let tr = Tri::new(&t).unwrap();
-        let n = tr.n.map(|c| c as f64);
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let n = tr.n;
+        let a = n.map(i128::abs);
         for (sep, norm) in [
-            (
-                Separation::Six,
-                n.iter().fold(0f64, |m, c| m.max(c.abs())) / len,
-            ),
-            (
-                Separation::TwentySix,
-                n.iter().map(|c| c.abs()).sum::<f64>() / len,
-            ),
+            (Separation::Six, a[0].max(a[1]).max(a[2])),
+            (Separation::TwentySix, a[0] + a[1] + a[2]),
         ] {
             for x in 5..15u32 {
                 for y in 5..15u32 {
                     for z in 0..24u32 {
-                        let c = [x, y, z].map(|i| (f64::from(i) + 0.5) * 65536.0);
-                        let d = (0..3)
-                            .map(|k| (c[k] - tr.v[0][k] as f64) * n[k])
-                            .sum::<f64>()
-                            / len;
-                        let rule = d.abs() <= 0.5 * norm * 65536.0;
-                        let margin = (d.abs() - 0.5 * norm * 65536.0).abs();
-                        if margin > 1.0 {
-                            assert_eq!(
-                                contains(&t, sep, [x, y, z]).unwrap(),
-                                rule,
-                                "{sep:?} {x} {y} {z}"
-                            );
-                        }
+                        let c = [x, y, z].map(centre);
+                        let d = dot(n, sub(c, tr.v[0]));
+                        let rule = 2 * d.abs() <= norm * V;
+                        assert_eq!(
+                            contains(&t, sep, [x, y, z]).unwrap(),
+                            rule,
+                            "{sep:?} {x} {y} {z}"
+                        );
                     }
                 }
             }

@@ -266,18 +266,21 @@ mod tests {
 
     #[test]
     fn ball_boundary_and_normals() {
-        // A smooth radial field: value = 4000 − 100·r², threshold 1500
-        // (r = 5): the layer is a sphere shell with outward normals.
+        // A smooth radial field: value = 4000 − 100·r², r measured from the
+        // block's centre (7.5, 7.5, 7.5); threshold 1500 (r = 5): the layer
+        // is a spherical shell with outward normals. Doubled coordinates
+        // keep everything integral.
         let n = 16u32;
+        let r2x4 = |p: [u32; 3]| {
+            p.iter()
+                .map(|c| (2 * i64::from(*c) - 15).pow(2))
+                .sum::<i64>()
+        };
         let mut s = Vec::new();
         for k in 0..n {
             for j in 0..n {
                 for i in 0..n {
-                    let r2 = [i, j, k]
-                        .iter()
-                        .map(|c| (f64::from(*c) - 7.5).powi(2))
-                        .sum::<f64>();
-                    s.push((4000.0 - 100.0 * r2).max(0.0) as u16);
+                    s.push(u16::try_from((4000 - 25 * r2x4([i, j, k])).max(0)).unwrap());
                 }
             }
         }
@@ -287,22 +290,23 @@ mod tests {
             offset: [-2, 3, 0],
         };
         let e = Extent::cube(24).unwrap();
+        let one = i128::from(NORMAL_ONE);
         for sep in [Separation::Six, Separation::TwentySix] {
             let mut c = Collect(HashMap::new());
             boundary(&b, 1500u16, sep, e, &mut c).unwrap();
             assert!(c.0.len() > 100);
             for (v, sf) in &c.0 {
-                let w = [
-                    f64::from(v[0]) + 2.0 - 7.5,
-                    f64::from(v[1]) - 3.0 - 7.5,
-                    f64::from(v[2]) - 7.5,
-                ];
-                let len = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
-                let dot: f64 = (0..3)
-                    .map(|k| w[k] / len * f64::from(sf.normal[k]) / f64::from(NORMAL_ONE))
-                    .sum();
-                assert!(dot > 0.95, "{v:?} {sf:?}");
-                assert!(len < 5.0 + 1e-9 && len > 3.2, "{v:?} at {len}");
+                let p = [v[0] + 2, v[1] - 3, v[2]];
+                let w = p.map(|c| i128::from(2 * i64::from(c) - 15));
+                let len2: i128 = w.iter().map(|x| x * x).sum();
+                // Inside r = 5 (doubled: 10), outside r = 3.2.
+                assert!(len2 <= 100 && len2 > 40, "{v:?}");
+                // cos(normal, radial) > 0.95.
+                let dot: i128 = (0..3).map(|k| w[k] * i128::from(sf.normal[k])).sum();
+                assert!(
+                    dot > 0 && dot * dot * 10_000 > 9_025 * len2 * one * one,
+                    "{v:?} {sf:?}"
+                );
                 assert!(sf.distance <= 65536);
             }
         }
