@@ -14,7 +14,7 @@ use rrt_core::geometry::{BezierPatch, Cone, Cuboid, Sphere, Torus, Triangle};
 use rrt_core::raster::Extent;
 use rrt_core::voxelize::volume::Block;
 use rrt_core::voxelize::{
-    NORMAL_ONE, Separation, Surfel, VoxelSink, cone, cuboid, patch, sphere, torus, triangle, volume,
+    Separation, Surfel, VoxelSink, cone, cuboid, patch, sphere, torus, triangle, volume,
 };
 
 /// Unique voxels and total offers.
@@ -229,9 +229,8 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
         apex_radius: 12 * VOXEL,
     };
     let e = Extent::cube(80).unwrap();
-    let a = [20.0, 10.0, 30.0];
-    let al = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) as f64;
-    let al = al.sqrt();
+    let a = [20.0f64, 10.0, 30.0];
+    let al = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
     let w = a.map(|c| c / al);
     let p = [w[1], -w[0], 0.0];
     let pl = (p[0] * p[0] + p[1] * p[1]).sqrt();
@@ -359,7 +358,6 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
     } else {
         println!("SKIPPED: bunny (../shared/data/meshes/bunny.obj not found)");
     }
-    let _ = NORMAL_ONE;
     assert!(rep.rows.len() >= 16);
 }
 
