@@ -114,16 +114,21 @@ pub(crate) fn dist_u32(d: i128) -> u32 {
 }
 
 /// Scales `v` to a unit vector of length [`NORMAL_ONE`]; `None` for the zero
-/// vector. Components are first shifted below `2^62`, so the squared length
-/// fits in `u128` and each quotient in `i32`.
+/// vector. Components are first shifted (up or down) so the largest lies in
+/// `[2^61, 2^62)`: the squared length fits in `u128`, each quotient in `i32`,
+/// and the result is accurate to about `2^-30` even for tiny vectors.
 pub(crate) fn unit(v: [i128; 3]) -> Option<[i32; 3]> {
     let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
     if m == 0 {
         return None;
     }
     let bits = 128u32.saturating_sub(m.leading_zeros());
-    let shift = bits.saturating_sub(62);
-    let w = v.map(|c| c >> shift);
+    let w = if bits > 62 {
+        v.map(|c| c >> bits.saturating_sub(62))
+    } else {
+        // |c| < 2^bits: shifting left by 62 − bits stays below 2^62.
+        v.map(|c| c << 62u32.saturating_sub(bits))
+    };
     // |w_k| < 2^62: each square < 2^124, the sum < 2^126.
     let len2 = w.iter().fold(0u128, |acc, c| {
         acc.saturating_add(c.unsigned_abs().saturating_mul(c.unsigned_abs()))
@@ -141,30 +146,65 @@ pub(crate) fn unit(v: [i128; 3]) -> Option<[i32; 3]> {
     Some(out)
 }
 
-/// [`unit`] for vectors known to be small (`|v_k| < 2^31`): the same result
-/// with 64-bit arithmetic, falling back to [`unit`] otherwise.
+/// [`unit`] with 64-bit arithmetic for vectors below `2^31` (scaled up to
+/// `[2^29, 2^30)` first, so tiny vectors stay accurate); [`unit`] otherwise.
 #[inline]
 pub(crate) fn unit_fast(v: [i128; 3]) -> Option<[i32; 3]> {
-    const LIM: i128 = 1 << 31;
-    if v.iter().all(|c| (-LIM..LIM).contains(c)) {
+    let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    if m == 0 {
+        return None;
+    }
+    if m >= 1 << 31 {
+        return unit(v);
+    }
+    let bits = 128u32.saturating_sub(m.leading_zeros());
+    let up = 30u32.saturating_sub(bits);
+    // |v_k| < 2^bits: after the shift below 2^30.
+    let w = v.map(|c| i64::try_from(c << up).unwrap_or(0));
+    normalize64(w)
+}
+
+/// Unit vector of `w` with every `|w_k| < 2^31`.
+#[inline]
+fn normalize64(w: [i64; 3]) -> Option<[i32; 3]> {
+    // |w_k| < 2^31: squares < 2^62, their sum < 2^64.
+    let len2 = w.iter().fold(0u64, |acc, c| {
+        acc.wrapping_add(c.unsigned_abs().wrapping_mul(c.unsigned_abs()))
+    });
+    let len = i64::try_from(len2.isqrt()).ok()?;
+    if len == 0 {
+        return None;
+    }
+    let one = i64::from(NORMAL_ONE);
+    let mut out = [0i32; 3];
+    for (o, c) in out.iter_mut().zip(w) {
+        // |c| < 2^31: c·2^30 < 2^61; |c| ≤ len keeps the quotient ≤ 2^30.
+        *o = i32::try_from(c.wrapping_mul(one).checked_div(len)?).ok()?;
+    }
+    Some(out)
+}
+
+/// Length `floor(sqrt(v·v))` and unit direction of `v`. Vectors with a
+/// component in `[2^20, 2^31)` (the common case: more than 1/64 voxel) take
+/// one 64-bit square root for both; others go through [`unit_fast`].
+#[inline]
+pub(crate) fn radial(v: [i128; 3]) -> (i128, Option<[i32; 3]>) {
+    let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    if (1 << 20..1 << 31).contains(&m) {
         let w = v.map(|c| i64::try_from(c).unwrap_or(0));
-        // |w_k| < 2^31: squares < 2^62, sum < 2^64 fits u64.
         let len2 = w.iter().fold(0u64, |acc, c| {
             acc.wrapping_add(c.unsigned_abs().wrapping_mul(c.unsigned_abs()))
         });
-        let len = i64::try_from(len2.isqrt()).ok()?;
-        if len == 0 {
-            return None;
-        }
+        let len = i64::try_from(len2.isqrt()).unwrap_or(i64::MAX);
         let one = i64::from(NORMAL_ONE);
         let mut out = [0i32; 3];
         for (o, c) in out.iter_mut().zip(w) {
-            // |c| < 2^31: c·2^30 < 2^61 fits i64; the quotient ≤ 2^30.
-            *o = i32::try_from(c.wrapping_mul(one).checked_div(len)?).ok()?;
+            // len ≥ 2^20: relative error of the floored root ≤ 2^-20.
+            *o = i32::try_from(c.wrapping_mul(one).checked_div(len).unwrap_or(0)).unwrap_or(0);
         }
-        Some(out)
+        (i128::from(len), Some(out))
     } else {
-        unit(v)
+        (length(v), unit_fast(v))
     }
 }
 
@@ -225,6 +265,20 @@ mod tests {
         let len2: i128 = u.iter().map(|c| i128::from(*c) * i128::from(*c)).sum();
         assert!((len2 - one * one).abs() < one * 4);
         assert_eq!(unit_fast([3, 4, 0]), unit([3, 4, 0]));
+        // Tiny vectors are scaled up first: (1, 1, 1) is not (1, 1, 1)·2^30.
+        for v in [[1i128, 1, 1], [1, 0, 0], [3, -7, 2], [1 << 25, 1 << 25, 5]] {
+            for u in [
+                unit(v).unwrap(),
+                unit_fast(v).unwrap(),
+                radial(v).1.unwrap(),
+            ] {
+                let l2: i128 = u.iter().map(|c| i128::from(*c).pow(2)).sum();
+                assert!(
+                    (l2 - one * one).abs() < one * one / (1 << 18),
+                    "{v:?} {u:?}"
+                );
+            }
+        }
     }
 }
 

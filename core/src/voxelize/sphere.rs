@@ -63,7 +63,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, V, ceil_sqrt, cell_floor, cells_overlapping, centre, centres_within, check_point,
-    clip, dist_u32, isqrt, unit_fast,
+    clip, dist_u32, isqrt, radial,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Sphere;
@@ -203,12 +203,9 @@ impl Ball {
     fn surfel(&self, v: [u32; 3]) -> Surfel {
         // |w_k| < 2^41 + 2^33: products below fit easily in i128.
         let w = [0, 1, 2].map(|k| centre(v[k]).wrapping_sub(self.c[k]));
-        let rho = isqrt(
-            w.iter()
-                .fold(0i128, |a, c| a.wrapping_add(c.wrapping_mul(*c))),
-        );
+        let (rho, normal) = radial(w);
         Surfel {
-            normal: unit_fast(w).unwrap_or([0, 0, NORMAL_ONE]),
+            normal: normal.unwrap_or([0, 0, NORMAL_ONE]),
             distance: dist_u32(rho.wrapping_sub(self.r)),
         }
     }
