@@ -23,6 +23,33 @@ use rrt_core::geometry::{Point, Sphere, Triangle};
 use rrt_core::raster::{Extent, cell};
 use rrt_core::voxelize::{NORMAL_ONE, Separation, Surfel, VoxelSink, sphere, triangle};
 
+/// Nanoseconds this thread has spent on a CPU (Linux `schedstat`), so the
+/// printed summary is not inflated by other processes sharing the machine;
+/// `None` elsewhere.
+fn cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+/// Runs `f` repeatedly for at least 0.3 s of wall-clock time (at least
+/// once), returning its last result and the wall-clock and on-CPU seconds
+/// per run.
+fn timed<T>(mut f: impl FnMut() -> T) -> (T, f64, f64) {
+    let (c0, t0) = (cpu_ns(), Instant::now());
+    let mut runs = 1u32;
+    let mut out = f();
+    while t0.elapsed().as_secs_f64() < 0.3 {
+        out = f();
+        runs += 1;
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let cpu = match (c0, cpu_ns()) {
+        (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
+        _ => wall,
+    };
+    (out, wall / f64::from(runs), cpu / f64::from(runs))
+}
+
 /// Counts offers and marks voxels opaque in a plane.
 struct CountingSink<'a> {
     extent: Extent,
@@ -98,7 +125,11 @@ struct Nff {
 fn parse_nff(text: &str) -> Nff {
     let mut out = Nff::default();
     let mut lines = text.lines();
-    let nums = |l: &str| -> Vec<f64> { l.split_whitespace().filter_map(|x| x.parse().ok()).collect() };
+    let nums = |l: &str| -> Vec<f64> {
+        l.split_whitespace()
+            .filter_map(|x| x.parse().ok())
+            .collect()
+    };
     while let Some(line) = lines.next() {
         let mut it = line.split_whitespace();
         match it.next() {
@@ -145,10 +176,14 @@ fn fit(nff: &Nff, n: u32) -> Scene {
     };
     nff.spheres.iter().for_each(|(c, r)| grow(*c, *r));
     nff.polygons.iter().flatten().for_each(|p| grow(*p, 0.0));
-    nff.patches.iter().flatten().for_each(|(p, _)| grow(*p, 0.0));
+    nff.patches
+        .iter()
+        .flatten()
+        .for_each(|(p, _)| grow(*p, 0.0));
     let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
     let scale = f64::from(n - 2) * VOXEL as f64 / size;
-    let dims = [0, 1, 2].map(|k| (((hi[k] - lo[k]) * scale / VOXEL as f64).ceil() as u32 + 2).max(1));
+    let dims =
+        [0, 1, 2].map(|k| (((hi[k] - lo[k]) * scale / VOXEL as f64).ceil() as u32 + 2).max(1));
     let to = |p: [f64; 3]| -> Point { [0, 1, 2].map(|k| ((p[k] - lo[k]) * scale) as i64 + VOXEL) };
     let unit = |n: [f64; 3]| {
         let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
@@ -166,8 +201,19 @@ fn fit(nff: &Nff, n: u32) -> Scene {
     }
     Scene {
         extent: Extent::new(dims[0], dims[1], dims[2]).unwrap(),
-        spheres: nff.spheres.iter().map(|(c, r)| Sphere { centre: to(*c), radius: (r * scale) as i64 }).collect(),
-        polygons: nff.polygons.iter().map(|p| p.iter().map(|v| to(*v)).collect()).collect(),
+        spheres: nff
+            .spheres
+            .iter()
+            .map(|(c, r)| Sphere {
+                centre: to(*c),
+                radius: (r * scale) as i64,
+            })
+            .collect(),
+        polygons: nff
+            .polygons
+            .iter()
+            .map(|p| p.iter().map(|v| to(*v)).collect())
+            .collect(),
         triangles,
     }
 }
@@ -182,24 +228,28 @@ fn table2(c: &mut Criterion) {
     let mut plane = vec![0u8; extent.len()];
     let mut group = c.benchmark_group("table2");
     group.sample_size(10);
-    println!("Table 2: random spheres of radius 10 in 256^3 (one timed run each)");
+    println!("Table 2: random spheres of radius 10 in 256^3 (mean of runs over >= 0.3 s)");
     for sep in [Separation::TwentySix, Separation::Six] {
         for count in [10usize, 100, 200, 400, 1000, 5000] {
             let spheres = random_spheres(count);
             let run = |plane: &mut [u8]| {
-                let mut sink = CountingSink { extent, plane, offers: 0 };
+                let mut sink = CountingSink {
+                    extent,
+                    plane,
+                    offers: 0,
+                };
                 for s in &spheres {
                     sphere::surface(black_box(s), sep, extent, &mut sink).unwrap();
                 }
                 sink.offers
             };
-            let t0 = Instant::now();
-            let offers = run(&mut plane);
-            let dt = t0.elapsed();
+            let _ = run(&mut plane); // warm up
+            let (offers, wall, cpu) = timed(|| run(&mut plane));
             println!(
-                "  {sep:?} {count:>5} spheres: {offers:>9} voxels, {:>9.3} ms, {:>6.1} ns/voxel",
-                dt.as_secs_f64() * 1e3,
-                dt.as_secs_f64() * 1e9 / offers as f64
+                "  {sep:?} {count:>5} spheres: {offers:>9} voxels, wall {:>9.3} ms, cpu {:>9.3} ms, {:>6.1} ns/voxel (cpu)",
+                wall * 1e3,
+                cpu * 1e3,
+                cpu * 1e9 / offers as f64
             );
             group.throughput(Throughput::Elements(offers));
             group.bench_function(format!("{sep:?}/{count}"), |b| b.iter(|| run(&mut plane)));
@@ -215,27 +265,30 @@ fn spd(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("spd");
     group.sample_size(10);
-    println!("SPD scenes (one timed run each, TwentySix)");
+    println!("SPD scenes (TwentySix; mean of runs over >= 0.3 s)");
     for name in ["balls2", "balls3", "balls4", "teapot"] {
         let nff = parse_nff(&std::fs::read_to_string(dir.join(format!("{name}.nff"))).unwrap());
         for n in [512u32, 1024] {
             let scene = fit(&nff, n);
             let mut plane = vec![0u8; scene.extent.len()];
             let run = |plane: &mut [u8]| {
-                let mut sink = CountingSink { extent: scene.extent, plane, offers: 0 };
+                let mut sink = CountingSink {
+                    extent: scene.extent,
+                    plane,
+                    offers: 0,
+                };
                 scene.voxelize(Separation::TwentySix, &mut sink);
                 sink.offers
             };
-            let t0 = Instant::now();
-            let offers = run(&mut plane);
-            let dt = t0.elapsed();
+            let (offers, wall, cpu) = timed(|| run(&mut plane));
             let opaque = plane.iter().filter(|c| **c & cell::OPAQUE != 0).count();
             println!(
-                "  {name} at {n}: raster {:?} (plane {:.1} MiB), {offers} offers, {opaque} voxels, {:.1} ms, {:.1} ns/offer",
+                "  {name} at {n}: raster {:?} (plane {:.1} MiB), {offers} offers, {opaque} voxels, wall {:.1} ms, cpu {:.1} ms, {:.1} ns/offer (cpu)",
                 scene.extent.dims(),
                 scene.extent.len() as f64 / (1 << 20) as f64,
-                dt.as_secs_f64() * 1e3,
-                dt.as_secs_f64() * 1e9 / offers as f64
+                wall * 1e3,
+                cpu * 1e3,
+                cpu * 1e9 / offers as f64
             );
             group.throughput(Throughput::Elements(offers));
             group.bench_function(format!("{name}/{n}"), |b| b.iter(|| run(&mut plane)));

@@ -216,73 +216,64 @@ impl Ball {
         n.bump();
     }
 
-    /// Rows of cells `lo ..= hi` along `axis` whose closed cell range meets
-    /// `[c − r, c + r]`, clipped.
-    fn cell_span(&self, axis: usize, reach: i128) -> Option<(u32, u32)> {
-        let c = self.c.get(axis).copied().unwrap_or(0);
-        let (lo, hi) = cells_overlapping(c.saturating_sub(reach), c.saturating_add(reach));
-        clip(lo, hi, self.dims.get(axis).copied().unwrap_or(0))
-    }
-
-    /// TwentySix shell (and, with `fill`, the cells wholly inside).
+    /// TwentySix shell (and, with `fill`, the cells wholly inside). Columns
+    /// run along x, the raster's fastest axis, so consecutive offers touch
+    /// neighbouring plane bytes.
     fn twenty_six<S: VoxelSink + ?Sized>(&self, sink: &mut S, n: &mut Counter, fill: bool) {
-        let [cx, cy, cz] = self.c;
-        let Some((y0, y1)) = self.cell_span(1, self.r) else {
+        const K: usize = 0;
+        let (ca, cb, ck) = pick(K, self.c);
+        let (na, nb, nk) = pick(K, self.dims);
+        let (bl, bh) = cells_overlapping(cb.saturating_sub(self.r), cb.saturating_add(self.r));
+        let Some((b0, b1)) = clip(bl, bh, nb) else {
             return;
         };
-        for y in y0..=y1 {
-            let (ay_min, ay_max) = near_far(cy, y);
-            let ey = self.r2.saturating_sub(ay_min.saturating_mul(ay_min));
-            if ey < 0 {
+        for bi in b0..=b1 {
+            let (ab_min, ab_max) = near_far(cb, bi);
+            let eb = self.r2.saturating_sub(ab_min.saturating_mul(ab_min));
+            if eb < 0 {
                 continue;
             }
-            let sx = isqrt(ey);
-            let (xl, xh) = cells_overlapping(cx.saturating_sub(sx), cx.saturating_add(sx));
-            let Some((x0, x1)) = clip(xl, xh, self.dims[0]) else {
+            let sa = isqrt(eb);
+            let (al, ah) = cells_overlapping(ca.saturating_sub(sa), ca.saturating_add(sa));
+            let Some((a0, a1)) = clip(al, ah, na) else {
                 continue;
             };
-            for x in x0..=x1 {
-                let (ax_min, ax_max) = near_far(cx, x);
-                let d_in = ey.saturating_sub(ax_min.saturating_mul(ax_min));
+            for ai in a0..=a1 {
+                let (aa_min, aa_max) = near_far(ca, ai);
+                let d_in = eb.saturating_sub(aa_min.saturating_mul(aa_min));
                 if d_in < 0 {
                     continue;
                 }
                 let h_in = isqrt(d_in);
-                let (zl, zh) = cells_overlapping(cz.saturating_sub(h_in), cz.saturating_add(h_in));
+                let (kl, kh) = cells_overlapping(ck.saturating_sub(h_in), ck.saturating_add(h_in));
                 let d_out = self
                     .r2
-                    .saturating_sub(ax_max.saturating_mul(ax_max))
-                    .saturating_sub(ay_max.saturating_mul(ay_max));
+                    .saturating_sub(aa_max.saturating_mul(aa_max))
+                    .saturating_sub(ab_max.saturating_mul(ab_max));
                 // Cells strictly inside the open ball: el ..= eh (empty when
                 // the column's far corner is outside the sphere).
                 let (el, eh) = if d_out > 0 {
                     let h_out = ceil_sqrt(d_out);
                     (
-                        cell_floor(cz.saturating_sub(h_out)).saturating_add(1),
-                        super::fixmath::cell_ceil(cz.saturating_add(h_out)).saturating_sub(2),
+                        cell_floor(ck.saturating_sub(h_out)).saturating_add(1),
+                        super::fixmath::cell_ceil(ck.saturating_add(h_out)).saturating_sub(2),
                     )
                 } else {
                     (1, 0)
                 };
-                let Some((z0, z1)) = clip(zl, zh, self.dims[2]) else {
+                let Some((k0, k1)) = clip(kl, kh, nk) else {
                     continue;
                 };
-                for z in z0..=z1 {
-                    let zi = i128::from(z);
-                    if (el..=eh).contains(&zi) {
+                for ki in k0..=k1 {
+                    let v = place(K, ai, bi, ki);
+                    if (el..=eh).contains(&i128::from(ki)) {
                         if fill {
-                            let s = self.surfel([x, y, z]);
-                            sink.offer(
-                                [x, y, z],
-                                Surfel {
-                                    normal: s.normal,
-                                    distance: 0,
-                                },
-                            );
+                            let s = self.surfel(v);
+                            sink.offer(v, Surfel { distance: 0, ..s });
                             n.bump();
                         }
                     } else {
-                        self.offer([x, y, z], sink, n);
+                        self.offer(v, sink, n);
                     }
                 }
             }
@@ -354,53 +345,51 @@ impl Ball {
 
     /// Six solid: voxels with centre inside and no centre segment reaching
     /// the sphere (`|w|² + 2h‖w‖∞ + h² < R²`), offered with distance 0.
+    /// Columns run along x.
     fn six_interior<S: VoxelSink + ?Sized>(&self, sink: &mut S, n: &mut Counter) {
-        let [cx, cy, cz] = self.c;
-        let (yl, yh) = centres_within(cy.saturating_sub(self.r), cy.saturating_add(self.r));
-        let Some((y0, y1)) = clip(yl, yh, self.dims[1]) else {
+        const K: usize = 0;
+        let (ca, cb, ck) = pick(K, self.c);
+        let (na, nb, nk) = pick(K, self.dims);
+        let (bl, bh) = centres_within(cb.saturating_sub(self.r), cb.saturating_add(self.r));
+        let Some((b0, b1)) = clip(bl, bh, nb) else {
             return;
         };
-        for y in y0..=y1 {
-            let dy = centre(y).wrapping_sub(cy);
-            let ey = self.r2.saturating_sub(dy.saturating_mul(dy));
-            if ey < 0 {
+        for bi in b0..=b1 {
+            let db = centre(bi).wrapping_sub(cb);
+            let eb = self.r2.saturating_sub(db.saturating_mul(db));
+            if eb < 0 {
                 continue;
             }
-            let sx = isqrt(ey);
-            let (xl, xh) = centres_within(cx.saturating_sub(sx), cx.saturating_add(sx));
-            let Some((x0, x1)) = clip(xl, xh, self.dims[0]) else {
+            let sa = isqrt(eb);
+            let (al, ah) = centres_within(ca.saturating_sub(sa), ca.saturating_add(sa));
+            let Some((a0, a1)) = clip(al, ah, na) else {
                 continue;
             };
-            for x in x0..=x1 {
-                let dx = centre(x).wrapping_sub(cx);
-                let ez = ey.saturating_sub(dx.saturating_mul(dx));
-                if ez < 0 {
+            for ai in a0..=a1 {
+                let da = centre(ai).wrapping_sub(ca);
+                let ek = eb.saturating_sub(da.saturating_mul(da));
+                if ek < 0 {
                     continue;
                 }
-                let sz = isqrt(ez);
-                let (zl, zh) = centres_within(cz.saturating_sub(sz), cz.saturating_add(sz));
-                let Some((z0, z1)) = clip(zl, zh, self.dims[2]) else {
+                let sk = isqrt(ek);
+                let (kl, kh) = centres_within(ck.saturating_sub(sk), ck.saturating_add(sk));
+                let Some((k0, k1)) = clip(kl, kh, nk) else {
                     continue;
                 };
-                for z in z0..=z1 {
-                    let dz = centre(z).wrapping_sub(cz);
-                    let m = dx.abs().max(dy.abs()).max(dz.abs());
-                    let w2 = dx
-                        .saturating_mul(dx)
-                        .saturating_add(dy.saturating_mul(dy))
-                        .saturating_add(dz.saturating_mul(dz));
+                for ki in k0..=k1 {
+                    let dk = centre(ki).wrapping_sub(ck);
+                    let m = da.abs().max(db.abs()).max(dk.abs());
+                    let w2 = da
+                        .saturating_mul(da)
+                        .saturating_add(db.saturating_mul(db))
+                        .saturating_add(dk.saturating_mul(dk));
                     let reach = w2
                         .saturating_add(m.saturating_mul(V))
                         .saturating_add(H.saturating_mul(H));
                     if reach < self.r2 {
-                        let s = self.surfel([x, y, z]);
-                        sink.offer(
-                            [x, y, z],
-                            Surfel {
-                                normal: s.normal,
-                                distance: 0,
-                            },
-                        );
+                        let v = place(K, ai, bi, ki);
+                        let s = self.surfel(v);
+                        sink.offer(v, Surfel { distance: 0, ..s });
                         n.bump();
                     }
                 }
