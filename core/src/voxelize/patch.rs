@@ -25,7 +25,7 @@
 //!
 //! # Which voxels
 //! The patch is evaluated on an `(n+1) × (n+1)` parameter grid by forward
-//! differencing in exact integers (after the paper's reference [8]): scaled
+//! differencing in exact integers (after the paper's reference \[8\]): scaled
 //! by `n³`, the Bernstein weights at `u = i/n` are the integers
 //! `C(3,k)·i^k·(n−i)^(3−k)`, so the four v-curves are stepped with three
 //! integer differences each, and along each grid row the u-curve through

@@ -24,7 +24,7 @@
 //!   *centre segments* (from face centre to opposite face centre) meets the
 //!   sphere; each such voxel is offered once.
 //!
-//! These are the *lattice-step rule* of [`crate::voxelize`] (a voxel belongs
+//! These are the *lattice-step rule* (see [`super::triangle`]: a voxel belongs
 //! to the surface when a lattice step of half length from its centre reaches
 //! the surface); for a plane they are exactly the thickness rule. Any
 //! discrete ray of the matching connectivity whose voxel centres pass from

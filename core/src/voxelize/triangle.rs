@@ -47,7 +47,7 @@
 //! of the normal; each axis with no component along the column bounds the
 //! rows and the columns of a row, each other axis bounds the cells of a
 //! column. Every bound is an exact floor/ceil division, stepped along a row
-//! by [`IncDiv`](super::fixmath) without dividing again.
+//! by an incremental quotient and remainder, without dividing again.
 //!
 //! # Accepted input and cost
 //! Coordinates within [`COORD_LIMIT`](super::error::COORD_LIMIT).

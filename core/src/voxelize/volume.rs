@@ -40,7 +40,7 @@
 //! # Accepted input and cost
 //! `samples.len()` must equal the product of `dims`
 //! ([`VoxelizeError::LengthMismatch`]); offsets within
-//! [`COORD_LIMIT`](super::error::COORD_LIMIT) voxels. Work is linear in the
+//! [`COORD_LIMIT`] voxels. Work is linear in the
 //! samples of the block that fall inside the raster (the input), with a
 //! constant per sample.
 
