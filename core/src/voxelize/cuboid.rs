@@ -33,7 +33,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, V, cells_overlapping, centre, centres_within, check_point, clip, dist_u32, length,
-    low, unit_fast,
+    low, split, unit_fast,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Cuboid;
@@ -136,17 +136,22 @@ fn scan<S: VoxelSink + ?Sized>(
             };
             let xi = i128::from(x);
             let inner_col = (sx0..=sx1).contains(&xi) && (sy0..=sy1).contains(&yi);
-            for z in z0..=z1 {
-                let v = [x, y, z];
-                let interior = inner_col && (sz0..=sz1).contains(&i128::from(z));
-                if interior {
-                    if fill {
-                        let s = surfel(lo, hi, v);
-                        sink.offer(v, Surfel { distance: 0, ..s });
-                        n.bump();
-                    }
-                } else {
+            // Cells strictly inside are skipped (surface) or filled (solid)
+            // without visiting them one by one.
+            let (el, eh) = if inner_col { (sz0, sz1) } else { (1, 0) };
+            let [below, inside, above] = split(z0, z1, el, eh);
+            for (a, b) in below.into_iter().chain(above) {
+                for z in a..=b {
+                    let v = [x, y, z];
                     sink.offer(v, surfel(lo, hi, v));
+                    n.bump();
+                }
+            }
+            if let (true, Some((a, b))) = (fill, inside) {
+                for z in a..=b {
+                    let v = [x, y, z];
+                    let s = surfel(lo, hi, v);
+                    sink.offer(v, Surfel { distance: 0, ..s });
                     n.bump();
                 }
             }

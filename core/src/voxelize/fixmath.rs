@@ -82,6 +82,26 @@ pub(crate) fn clip(lo: i128, hi: i128, n: u32) -> Option<(u32, u32)> {
     Some((u32::try_from(lo).ok()?, u32::try_from(hi).ok()?))
 }
 
+/// Splits the cell range `lo ..= hi` around the (possibly empty) range
+/// `ex_lo ..= ex_hi`: the part below it, the part inside it, the part above
+/// it. Lets a scan skip the inside of a solid without visiting it.
+#[inline]
+pub(crate) fn split(lo: u32, hi: u32, ex_lo: i128, ex_hi: i128) -> [Option<(u32, u32)>; 3] {
+    let (l, h) = (i128::from(lo), i128::from(hi));
+    let part = |a: i128, b: i128| -> Option<(u32, u32)> {
+        let (a, b) = (a.max(l), b.min(h));
+        (a <= b).then_some((u32::try_from(a).ok()?, u32::try_from(b).ok()?))
+    };
+    if ex_lo > ex_hi {
+        return [part(l, h), None, None];
+    }
+    [
+        part(l, ex_lo.saturating_sub(1)),
+        part(ex_lo, ex_hi),
+        part(ex_hi.saturating_add(1), h),
+    ]
+}
+
 /// `floor(sqrt(n))`, 0 for negative `n`.
 #[inline]
 pub(crate) fn isqrt(n: i128) -> i128 {
@@ -243,6 +263,17 @@ mod tests {
         assert_eq!(centres_within(H + 1, V + H - 1), (1, 0));
         assert_eq!(clip(-5, 3, 2), Some((0, 1)));
         assert_eq!(clip(4, 9, 2), None);
+    }
+
+    #[test]
+    fn splits() {
+        assert_eq!(
+            split(0, 9, 3, 5),
+            [Some((0, 2)), Some((3, 5)), Some((6, 9))]
+        );
+        assert_eq!(split(4, 9, 3, 5), [None, Some((4, 5)), Some((6, 9))]);
+        assert_eq!(split(0, 9, 1, 0), [Some((0, 9)), None, None]);
+        assert_eq!(split(0, 2, -9, 99), [None, Some((0, 2)), None]);
     }
 
     #[test]

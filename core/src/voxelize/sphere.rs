@@ -63,7 +63,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, V, ceil_sqrt, cell_floor, cells_overlapping, centre, centres_within, check_point,
-    clip, dist_u32, isqrt, radial,
+    clip, dist_u32, isqrt, radial, split,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Sphere;
@@ -264,16 +264,20 @@ impl Ball {
                 let Some((k0, k1)) = clip(kl, kh, nk) else {
                     continue;
                 };
-                for ki in k0..=k1 {
-                    let v = place(K, ai, bi, ki);
-                    if (el..=eh).contains(&i128::from(ki)) {
-                        if fill {
-                            let s = self.surfel(v);
-                            sink.offer(v, Surfel { distance: 0, ..s });
-                            n.bump();
-                        }
-                    } else {
-                        self.offer(v, sink, n);
+                // The cells wholly inside are skipped (surface) or filled
+                // (solid) without testing each.
+                let [below, inside, above] = split(k0, k1, el, eh);
+                for (k0, k1) in below.into_iter().chain(above) {
+                    for ki in k0..=k1 {
+                        self.offer(place(K, ai, bi, ki), sink, n);
+                    }
+                }
+                if let (true, Some((k0, k1))) = (fill, inside) {
+                    for ki in k0..=k1 {
+                        let v = place(K, ai, bi, ki);
+                        let s = self.surfel(v);
+                        sink.offer(v, Surfel { distance: 0, ..s });
+                        n.bump();
                     }
                 }
             }
