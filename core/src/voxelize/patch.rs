@@ -141,8 +141,11 @@ fn at(p: &[[[i128; 3]; 4]; 4], a: usize, b: usize) -> [i128; 3] {
     p.get(a).and_then(|r| r.get(b)).copied().unwrap_or([0; 3])
 }
 
-/// Grid steps per parameter: `n² ≥ S / tolerance` with `S` bounding the
-/// second derivatives (6·Δuu + 18·Δuv + 6·Δvv of the control net, L1).
+/// Grid steps per parameter. Linear interpolation over a grid triangle
+/// (legs `h = 1/n`, circumradius `h/√2`) errs by at most `R²/2 · M = h²/4 ·
+/// M`, `M` bounding the second directional derivative: `M ≤ max(|p_uu|,
+/// |p_vv|) + |p_uv| ≤ 6·max(Δuu, Δvv) + 9·Δuv` over the control net (L1
+/// norms, which bound the Euclidean ones). So `n² ≥ M / (4·tolerance)`.
 fn steps(p: &[[[i128; 3]; 4]; 4]) -> u32 {
     let l1 = |v: [i128; 3]| {
         v.iter()
@@ -188,11 +191,11 @@ fn steps(p: &[[[i128; 3]; 4]; 4]) -> u32 {
             }
         }
     }
-    let s = duu
+    let m = duu
+        .max(dvv)
         .saturating_mul(6)
-        .saturating_add(duv.saturating_mul(18))
-        .saturating_add(dvv.saturating_mul(6));
-    let need = isqrt(s.checked_div(TOLERANCE).unwrap_or(0)).saturating_add(1);
+        .saturating_add(duv.saturating_mul(9));
+    let need = isqrt(m.checked_div(TOLERANCE.saturating_mul(4)).unwrap_or(0)).saturating_add(1);
     u32::try_from(need.clamp(1, i128::from(MAX_STEPS))).unwrap_or(MAX_STEPS)
 }
 
