@@ -135,53 +135,29 @@ pub(crate) fn dist_u32(d: i128) -> u32 {
 
 /// Scales `v` to a unit vector of length [`NORMAL_ONE`]; `None` for the zero
 /// vector. Components are first shifted (up or down) so the largest lies in
-/// `[2^61, 2^62)`: the squared length fits in `u128`, each quotient in `i32`,
-/// and the result is accurate to about `2^-30` even for tiny vectors.
+/// `[2^29, 2^30)`; then 64-bit arithmetic suffices and the result is accurate
+/// to about `2^-29` relative, even for tiny vectors.
+#[inline]
 pub(crate) fn unit(v: [i128; 3]) -> Option<[i32; 3]> {
     let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
     if m == 0 {
         return None;
     }
     let bits = 128u32.saturating_sub(m.leading_zeros());
-    let w = if bits > 62 {
-        v.map(|c| c >> bits.saturating_sub(62))
+    let w = if bits > 30 {
+        v.map(|c| c >> bits.saturating_sub(30))
     } else {
-        // |c| < 2^bits: shifting left by 62 − bits stays below 2^62.
-        v.map(|c| c << 62u32.saturating_sub(bits))
+        // |c| < 2^bits: shifting left by 30 − bits stays below 2^30.
+        v.map(|c| c << 30u32.saturating_sub(bits))
     };
-    // |w_k| < 2^62: each square < 2^124, the sum < 2^126.
-    let len2 = w.iter().fold(0u128, |acc, c| {
-        acc.saturating_add(c.unsigned_abs().saturating_mul(c.unsigned_abs()))
-    });
-    let len = i128::try_from(len2.isqrt()).ok()?;
-    if len == 0 {
-        return None;
-    }
-    let one = i128::from(NORMAL_ONE);
-    let mut out = [0i32; 3];
-    for (o, c) in out.iter_mut().zip(w) {
-        // |c| ≤ len, so |c·2^30 / len| ≤ 2^30; c·2^30 < 2^92.
-        *o = i32::try_from(c.checked_mul(one)?.checked_div(len)?).ok()?;
-    }
-    Some(out)
+    normalize64(w.map(|c| i64::try_from(c).unwrap_or(0)))
 }
 
-/// [`unit`] with 64-bit arithmetic for vectors below `2^31` (scaled up to
-/// `[2^29, 2^30)` first, so tiny vectors stay accurate); [`unit`] otherwise.
+/// [`unit`] (kept as a name for the call sites that know their vectors are
+/// small; both take the same 64-bit path).
 #[inline]
 pub(crate) fn unit_fast(v: [i128; 3]) -> Option<[i32; 3]> {
-    let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
-    if m == 0 {
-        return None;
-    }
-    if m >= 1 << 31 {
-        return unit(v);
-    }
-    let bits = 128u32.saturating_sub(m.leading_zeros());
-    let up = 30u32.saturating_sub(bits);
-    // |v_k| < 2^bits: after the shift below 2^30.
-    let w = v.map(|c| i64::try_from(c << up).unwrap_or(0));
-    normalize64(w)
+    unit(v)
 }
 
 /// Unit vector of `w` with every `|w_k| < 2^31`.
