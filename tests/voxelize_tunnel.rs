@@ -9,7 +9,8 @@
 //! voxel before it leaves the raster. The shared checker is
 //! `rrt_core::check_voxelize`.
 //!
-//! Every case derives from a printed seed: `RRT_SEED=<seed>` replays one.
+//! Every case derives from a printed seed: `RRT_SEED=<seed>` replays one;
+//! `RRT_SCALE=<k>` runs k times as many cases.
 
 use rrt_core::check_voxelize::{PlaneSink, check_closed, probe_targets};
 use rrt_core::discrete_ray::Connectivity;
@@ -20,11 +21,16 @@ use rrt_core::raster::{Extent, Raster, RasterMut};
 use rrt_core::voxelize::{NORMAL_ONE, Separation, cone, cuboid, patch, sphere, torus, triangle};
 use rrt_tests::Rng;
 
-/// Seeds to run: `RRT_SEED` alone if set, else `0..n`.
+/// Seeds to run: `RRT_SEED` alone if set, else `0..n` (times `RRT_SCALE`
+/// when set, for longer soak runs, e.g. `RRT_SCALE=20` in release mode).
 fn seeds(n: u64) -> Vec<u64> {
+    let scale: u64 = std::env::var("RRT_SCALE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
     match std::env::var("RRT_SEED") {
         Ok(s) => vec![s.parse().expect("RRT_SEED is a number")],
-        Err(_) => (0..n).collect(),
+        Err(_) => (0..n * scale).collect(),
     }
 }
 

@@ -21,8 +21,9 @@
 //! As for triangles ([`super::triangle`]): a voxel belongs to the surface
 //! when its probe (TwentySix: its closed cube; Six: its inscribed
 //! octahedron) meets the box's boundary, i.e. meets the closed box without
-//! lying inside the open box. [`solid`] adds the voxels inside, with
-//! distance 0.
+//! lying inside the open box, with ties (faces on voxel faces or centres)
+//! decided by the infinitesimal shift of [`super::triangle`]: one layer per
+//! face. [`solid`] adds the voxels inside, with distance 0.
 //!
 //! # Accepted input and cost
 //! Coordinates within [`COORD_LIMIT`](super::error::COORD_LIMIT) and
@@ -32,8 +33,8 @@
 
 use super::error::VoxelizeError;
 use super::fixmath::{
-    Counter, H, V, cells_overlapping, centre, centres_within, check_point, clip, dist_u32, length,
-    low, split, unit_fast,
+    Counter, H, cell_floor, centre, centres_within, check_point, clip, dist_u32, length, split,
+    unit_fast,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Cuboid;
@@ -76,56 +77,37 @@ fn scan<S: VoxelSink + ?Sized>(
     sink: &mut S,
     fill: bool,
 ) -> Result<u64, VoxelizeError> {
-    let lo = check_point(b.min)?;
-    let hi = check_point(b.max)?;
-    if lo.iter().zip(hi.iter()).any(|(l, h)| l >= h) {
-        return Err(VoxelizeError::Degenerate);
-    }
+    let bx = BoxTies::new(b)?;
+    let (lo, hi) = (bx.lo, bx.hi);
     let dims = extent.dims();
     let mut n = Counter::default();
-    // Cells strictly inside the open box along one axis.
-    let strict = |k: usize| -> (i128, i128) {
-        // low(i) > lo and low(i) + V < hi.
-        (
-            super::fixmath::cell_floor(lo[k]).saturating_add(1),
-            super::fixmath::cell_ceil(hi[k]).saturating_sub(2),
-        )
-    };
-    // Probe reach beyond the box along one axis, given what the other axes
-    // used up (Six: L1 budget; TwentySix: a full half voxel each).
+    // Candidate cells along one axis: TwentySix exactly (half-open per the
+    // tie rule); Six closed within the L1 budget left by the other axes,
+    // ties then settled per cell by `meets_six`.
     let range = |k: usize, budget: i128| -> (i128, i128) {
         match sep {
-            Separation::TwentySix => cells_overlapping(lo[k], hi[k]),
+            Separation::TwentySix => (cell_floor(lo[k]), cell_floor(hi[k])),
             Separation::Six => {
                 centres_within(lo[k].saturating_sub(budget), hi[k].saturating_add(budget))
             }
-        }
-    };
-    let out_dist = |k: usize, c: i128| -> i128 {
-        if c < lo[k] {
-            lo[k].saturating_sub(c)
-        } else if c > hi[k] {
-            c.saturating_sub(hi[k])
-        } else {
-            0
         }
     };
     let (yl, yh) = range(1, H);
     let Some((y0, y1)) = clip(yl, yh, dims[1]) else {
         return Ok(0);
     };
-    let (sy0, sy1) = strict(1);
-    let (sx0, sx1) = strict(0);
-    let (sz0, sz1) = strict(2);
+    let (sy0, sy1) = bx.strict(1);
+    let (sx0, sx1) = bx.strict(0);
+    let (sz0, sz1) = bx.strict(2);
     for y in y0..=y1 {
-        let dy = out_dist(1, centre(y));
+        let dy = out_dist(lo[1], hi[1], centre(y));
         let (xl, xh) = range(0, H.saturating_sub(dy));
         let Some((x0, x1)) = clip(xl, xh, dims[0]) else {
             continue;
         };
         let yi = i128::from(y);
         for x in x0..=x1 {
-            let dx = out_dist(0, centre(x));
+            let dx = out_dist(lo[0], hi[0], centre(x));
             let budget = H.saturating_sub(dy).saturating_sub(dx);
             if budget < 0 && sep == Separation::Six {
                 continue;
@@ -143,6 +125,9 @@ fn scan<S: VoxelSink + ?Sized>(
             for (a, b) in below.into_iter().chain(above) {
                 for z in a..=b {
                     let v = [x, y, z];
+                    if sep == Separation::Six && !bx.meets_six(v) {
+                        continue;
+                    }
                     sink.offer(v, surfel(lo, hi, v));
                     n.bump();
                 }
@@ -160,6 +145,99 @@ fn scan<S: VoxelSink + ?Sized>(
     Ok(n.0)
 }
 
+/// Distance from `c` to `[lo, hi]` on one axis.
+#[inline]
+fn out_dist(lo: i128, hi: i128, c: i128) -> i128 {
+    if c < lo {
+        lo.saturating_sub(c)
+    } else if c > hi {
+        c.saturating_sub(hi)
+    } else {
+        0
+    }
+}
+
+/// A validated box with the tie rule of [`super::triangle`]: the box is
+/// shifted by an infinitesimal `ε = (ε1, ε2, ε3)`, `ε1 ≫ ε2 ≫ ε3 > 0`.
+struct BoxTies {
+    lo: [i128; 3],
+    hi: [i128; 3],
+}
+
+impl BoxTies {
+    fn new(b: &Cuboid) -> Result<Self, VoxelizeError> {
+        let lo = check_point(b.min)?;
+        let hi = check_point(b.max)?;
+        if lo.iter().zip(hi.iter()).any(|(l, h)| l >= h) {
+            return Err(VoxelizeError::Degenerate);
+        }
+        Ok(Self { lo, hi })
+    }
+
+    /// Cells strictly inside the (shifted) open box on axis `k`: `iV > lo`
+    /// and `(i+1)V ≤ hi`.
+    fn strict(&self, k: usize) -> (i128, i128) {
+        let (lo, hi) = (
+            self.lo.get(k).copied().unwrap_or(0),
+            self.hi.get(k).copied().unwrap_or(0),
+        );
+        (
+            cell_floor(lo).saturating_add(1),
+            cell_floor(hi).saturating_sub(1),
+        )
+    }
+
+    /// Whether voxel `v` lies strictly inside the shifted open box.
+    fn inside(&self, v: [u32; 3]) -> bool {
+        (0..3).all(|k| {
+            let (a, b) = self.strict(k);
+            (a..=b).contains(&i128::from(v.get(k).copied().unwrap_or(0)))
+        })
+    }
+
+    /// Whether the closed cube of `v` meets the shifted closed box: per axis
+    /// `iV ≤ hi` and `(i+1)V > lo`.
+    fn meets_cube(&self, v: [u32; 3]) -> bool {
+        (0..3).all(|k| {
+            let i = i128::from(v.get(k).copied().unwrap_or(0));
+            let (lo, hi) = (
+                self.lo.get(k).copied().unwrap_or(0),
+                self.hi.get(k).copied().unwrap_or(0),
+            );
+            (cell_floor(lo)..=cell_floor(hi)).contains(&i)
+        })
+    }
+
+    /// Whether the inscribed octahedron of `v` meets the shifted closed box:
+    /// L1 distance from the centre below half a voxel, or equal to it with
+    /// the shift moving the box closer (the first axis whose distance
+    /// depends on ε decides).
+    fn meets_six(&self, v: [u32; 3]) -> bool {
+        let mut d1 = 0i128;
+        let mut first: Option<bool> = None;
+        for k in 0..3 {
+            let c = centre(v.get(k).copied().unwrap_or(0));
+            let (lo, hi) = (
+                self.lo.get(k).copied().unwrap_or(0),
+                self.hi.get(k).copied().unwrap_or(0),
+            );
+            d1 = d1.saturating_add(out_dist(lo, hi, c));
+            // d/dε_k of the distance: +1 at or below lo, −1 above hi.
+            let closer = if c <= lo {
+                Some(false)
+            } else if c > hi {
+                Some(true)
+            } else {
+                None
+            };
+            if first.is_none() {
+                first = closer;
+            }
+        }
+        d1 < H || (d1 == H && first.unwrap_or(true))
+    }
+}
+
 /// Whether voxel `v`'s probe meets the surface of `cuboid`: the membership
 /// rule of [`surface`], evaluated directly.
 ///
@@ -170,33 +248,12 @@ pub fn contains(
     separation: Separation,
     v: [u32; 3],
 ) -> Result<bool, VoxelizeError> {
-    let lo = check_point(cuboid.min)?;
-    let hi = check_point(cuboid.max)?;
-    if lo.iter().zip(hi.iter()).any(|(l, h)| l >= h) {
-        return Err(VoxelizeError::Degenerate);
-    }
-    let mut meets = true;
-    let mut l1 = 0i128;
-    let mut inside = true;
-    for k in 0..3 {
-        let c = centre(v[k]);
-        let d = if c < lo[k] {
-            lo[k].saturating_sub(c)
-        } else if c > hi[k] {
-            c.saturating_sub(hi[k])
-        } else {
-            0
-        };
-        l1 = l1.saturating_add(d);
-        meets &= d <= H;
-        let l = low(v[k]);
-        inside &= l > lo[k] && l.saturating_add(V) < hi[k];
-    }
+    let b = BoxTies::new(cuboid)?;
     let meets = match separation {
-        Separation::TwentySix => meets,
-        Separation::Six => l1 <= H,
+        Separation::TwentySix => b.meets_cube(v),
+        Separation::Six => b.meets_six(v),
     };
-    Ok(meets && !inside)
+    Ok(meets && !b.inside(v))
 }
 
 /// Nearest point on the box surface: outside, the clamped point and the

@@ -39,6 +39,18 @@
 //! union of voxelized surfaces) is tunnel-free across shared edges and
 //! vertices whenever the union of its triangles is closed.
 //!
+//! # Ties
+//! A plane through voxel faces (an axis-aligned face at an integer voxel
+//! coordinate, say) touches the probes of the voxels on both sides; the
+//! closed rule would take both layers. Instead every voxelizer that goes
+//! through here decides ties as if the object were shifted by an
+//! infinitesimal `ε = (ε1, ε2, ε3)`, `ε1 ≫ ε2 ≫ ε3 > 0` (simulation of
+//! simplicity): a probe meets the shifted object exactly when, on every
+//! separating axis `α`, the projections overlap with the bound on the side
+//! `α·ε` points to made open. The shifted surface is still closed when the
+//! original is, and the lattice-step argument applies to it unchanged, so
+//! the result stays tunnel-free while aligned planes get one layer.
+//!
 //! # Algorithm
 //! Separating-axis tests, evaluated scan-line style: the triangle and the
 //! probe are disjoint exactly when their projections onto one of a finite
@@ -423,11 +435,18 @@ impl Tri {
                 .ok()
                 .and_then(|x| x.checked_mul(H))
                 .ok_or(VoxelizeError::Arithmetic)?;
-            f(Axis {
-                alpha,
-                lo: tmin.checked_sub(s).ok_or(VoxelizeError::Arithmetic)?,
-                hi: tmax.checked_add(s).ok_or(VoxelizeError::Arithmetic)?,
-            });
+            let lo = tmin.checked_sub(s).ok_or(VoxelizeError::Arithmetic)?;
+            let hi = tmax.checked_add(s).ok_or(VoxelizeError::Arithmetic)?;
+            // Tie-break (see "Ties" in the module docs): the triangle is
+            // shifted by an infinitesimal ε = (ε1, ε2, ε3), ε1 ≫ ε2 ≫ ε3 > 0,
+            // so the bound on the side α·ε points to is open.
+            let rising = alpha.iter().find(|c| **c != 0).is_some_and(|c| *c > 0);
+            let (lo, hi) = if rising {
+                (lo.checked_add(1).ok_or(VoxelizeError::Arithmetic)?, hi)
+            } else {
+                (lo, hi.checked_sub(1).ok_or(VoxelizeError::Arithmetic)?)
+            };
+            f(Axis { alpha, lo, hi });
             Ok(())
         };
         add(self.n)?;
@@ -799,6 +818,9 @@ mod tests {
                     for z in 0..24u32 {
                         let c = [x, y, z].map(centre);
                         let d = dot(n, sub(c, tr.v[0]));
+                        if 2 * d.abs() == norm * V {
+                            continue; // a tie: decided by the perturbation
+                        }
                         let rule = 2 * d.abs() <= norm * V;
                         assert_eq!(
                             contains(&t, sep, [x, y, z]).unwrap(),
