@@ -273,7 +273,16 @@ mod tests {
         assert!((len2 - one * one).abs() < one * 4);
         assert_eq!(unit_fast([3, 4, 0]), unit([3, 4, 0]));
         // Tiny vectors are scaled up first: (1, 1, 1) is not (1, 1, 1)·2^30.
-        for v in [[1i128, 1, 1], [1, 0, 0], [3, -7, 2], [1 << 25, 1 << 25, 5]] {
+        // Fuzz regression: a zero-length segment at the origin gave the
+        // centre offset (h, h, h), whose floored root (56755) left the
+        // normal 1.4e-5 too long before the scaling.
+        for v in [
+            [1i128, 1, 1],
+            [1, 0, 0],
+            [3, -7, 2],
+            [1 << 25, 1 << 25, 5],
+            [32768, 32768, 32768],
+        ] {
             for u in [
                 unit(v).unwrap(),
                 unit_fast(v).unwrap(),
