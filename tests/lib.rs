@@ -550,3 +550,4 @@ pub mod fuzz {
 }
 
 pub mod packet_case;
+pub mod voxelize_case;

@@ -175,7 +175,9 @@ const CHUNK: usize = 256;
 /// voxel before it in its row. Backward: the mirror image.
 fn chamfer_pass(plane: &mut [u8], nx: usize, ny: usize, nz: usize, slice: usize, backward: bool) {
     let rows = ny.saturating_mul(nz);
-    let Some(ny_nz) = core::num::NonZeroUsize::new(ny) else { return };
+    let Some(ny_nz) = core::num::NonZeroUsize::new(ny) else {
+        return;
+    };
     for i in 0..rows {
         let r = if backward {
             rows.wrapping_sub(1).wrapping_sub(i)
