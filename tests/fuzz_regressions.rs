@@ -48,3 +48,13 @@ fn nff_inputs_replay() {
         }
     }
 }
+
+#[test]
+fn voxelize_inputs_replay() {
+    for (name, bytes) in inputs("voxelize") {
+        let input = rrt_tests::voxelize_case::Input::arbitrary_take_rest(Unstructured::new(&bytes))
+            .unwrap_or_else(|e| panic!("{name}: does not decode: {e}"));
+        eprintln!("{name}: {input:?}");
+        rrt_tests::voxelize_case::run(input);
+    }
+}
