@@ -100,8 +100,8 @@ fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
 
 /// The PNG is byte-identical for 1, 2 and 3 threads (and so are the ray
 /// counts), with and without verification and supersampling, on an image
-/// whose size is not a multiple of the tile or block; and with the scalar
-/// primary walk instead of ray packets.
+/// whose size is not a multiple of the tile or block; and with ray packets
+/// for the primary walk instead of the skipping scalar walk.
 #[test]
 fn png_is_identical_for_every_thread_count() {
     let scene = Scene::load(data("balls1.nff")).unwrap();

@@ -73,6 +73,13 @@
 //! code, which resumes the very `DiscreteRay` the packet left in its lane.
 //! The packet is bit-identical to the scalar walk, so the image does not
 //! depend on the choice.
+//!
+//! # Empty-space skipping
+//! The scalar walks use the plane's proximity distances
+//! ([`rrt_core::proximity::distance_field`], computed by the builder):
+//! where the nearest non-transparent voxel is `d ≥ 3` voxels away, a
+//! 26-run takes `d − 2` steps at once, landing exactly where single steps
+//! would. [`RayStats::steps`] counts voxels visited, a jump as one.
 
 #![deny(missing_docs)]
 // `!(x < y)` is deliberate: it is true for NaN, which must be refused too.
@@ -114,8 +121,11 @@ pub struct TraceOptions {
     /// The acne rule's slab and angle, and the connectivity of render-time
     /// shadow rays (those of the light pass by default).
     pub light: LightParams,
-    /// Walk primary rays eight at a time in a [`RayPacket8`] (bit-identical
-    /// to the scalar walk, so the image is the same either way).
+    /// Walk primary rays eight at a time in a [`RayPacket8`] instead of one
+    /// by one with empty-space skipping. Both give the same image; the
+    /// packet does not skip, and on balls4 (raster 2048, 512², one thread)
+    /// the skipping scalar walk rendered in 0.37 s against the packets'
+    /// 0.48 s (one run, medians of three), so it is the default.
     pub packets: bool,
 }
 
@@ -126,7 +136,7 @@ impl Default for TraceOptions {
             depth: 3,
             verify: false,
             light: LightParams::default(),
-            packets: true,
+            packets: false,
         }
     }
 }
@@ -142,7 +152,7 @@ pub struct RayStats {
     pub refracted: u64,
     /// Render-time shadow rays (lights seen through translucent material).
     pub shadow: u64,
-    /// Voxels visited by all rays.
+    /// Voxels visited by all rays (an empty-space jump counts as one).
     pub steps: u64,
     /// Rays that ended on a surface.
     pub hits: u64,
@@ -398,7 +408,7 @@ impl<'s> Tracer<'s> {
             };
         };
         let end = dray
-            .walk(&self.raster, self.opts.connectivity, u32::MAX, |_, c| {
+            .walk_skipping(&self.raster, self.opts.connectivity, u32::MAX, |_, c| {
                 c & cell::OPAQUE != 0
             })
             .unwrap_or(WalkEnd::Exit);
@@ -462,7 +472,7 @@ impl<'s> Tracer<'s> {
             let extent = self.extent;
             let mut missing = 0u64;
             end = dray
-                .walk(&raster, self.opts.connectivity, u32::MAX, |index, c| {
+                .walk_skipping(&raster, self.opts.connectivity, u32::MAX, |index, c| {
                     hit_test(&store, extent, leave, index, c, &mut missing)
                 })
                 .unwrap_or(WalkEnd::Exit);
@@ -561,7 +571,7 @@ impl<'s> Tracer<'s> {
         let extent = self.extent;
         let mut missing = 0u64;
         let end = dray
-            .walk(&raster, self.opts.connectivity, u32::MAX, |index, c| {
+            .walk_skipping(&raster, self.opts.connectivity, u32::MAX, |index, c| {
                 hit_test(&store, extent, Some(rule), index, c, &mut missing)
             })
             .unwrap_or(WalkEnd::Exit);
@@ -686,7 +696,7 @@ impl<'s> Tracer<'s> {
         let mut att = 1.0;
         let mut seen: Vec<u32> = Vec::new();
         let end = dray
-            .walk(&self.raster, self.opts.light.mode, u32::MAX, |index, c| {
+            .walk_skipping(&self.raster, self.opts.light.mode, u32::MAX, |index, c| {
                 if c & cell::OPAQUE == 0 {
                     return false;
                 }
