@@ -130,7 +130,8 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
 /// (the continuous ray misses the object), or `verify rejected:
 /// intersection farther on`; after a rejection the walk resumes, as the
 /// renderer's does; `miss` if the ray leaves the raster without an
-/// accepted hit.
+/// accepted hit. Only the voxel's own object is verified here (the
+/// renderer also tries the objects of its neighbours before resuming).
 fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Result<(), CliError> {
     use rrt_core::raster::cell;
     let scene = crate::rasterfile::load(path)?;
