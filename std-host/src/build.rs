@@ -17,7 +17,9 @@
 //!    records on rayon's threads): one discrete shadow ray per record and
 //!    light, the two visibility bits and the precomputed ambient + diffuse
 //!    illumination (SPD intensities `I = sqrt(nl)/(2·nl)`, ambient the
-//!    same). The result does not depend on the thread count.
+//!    same). The result does not depend on the thread count. The runs
+//!    write into a copy of the records (20 bytes per record while the pass
+//!    runs), since the store they read must stay whole.
 //!
 //! The result, a [`VoxelScene`], holds everything view-independent: the
 //! renderer ([`crate::trace`]) and the saved-raster file
