@@ -326,6 +326,8 @@ fn twenty_six_run<
     // jump visits one voxel for k steps).
     let mut cur = if SKIP { cells(idx).unwrap_or(0) } else { 0 };
     let mut visits = 0u32;
+    // Division by inc_a for the jumps (inc_a > 0 whenever a jump is taken).
+    let by_a = Reciprocal::new(if SKIP { inc_a } else { 2 });
 
     // How the loop ended: exits write it, the loop body never does.
     // The budget is checked before the exit, as in `six_run`: a call that
@@ -346,8 +348,8 @@ fn twenty_six_run<
         // Far from every non-transparent voxel, take k 26-steps at once.
         let k = if SKIP { skip_count(cur, todo) } else { 1 };
         if SKIP && k > 1 {
-            let (nb, lb) = jump_count(f1, k, inc_a, inc_b);
-            let (nc, lc) = jump_count(f2, k, inc_a, inc_c);
+            let (nb, lb) = jump_count(f1, k, by_a, inc_b);
+            let (nc, lc) = jump_count(f2, k, by_a, inc_c);
             let kk = i64::from(k);
             f1 = f1
                 .wrapping_add(kk.wrapping_mul(inc_b))
@@ -450,9 +452,15 @@ fn twenty_six_run<
     end
 }
 
+/// The shortest jump worth taking. A jump's length is read from the cell
+/// just loaded, so the next load waits for this one, while single steps
+/// compute their addresses without looking at the cells and overlap their
+/// loads; a jump pays only when it replaces several steps.
+pub(crate) const MIN_JUMP: u8 = 8;
+
 /// How many 26-steps a run may take at once from a voxel whose cell is
 /// `cur`, with `todo` driving crossings left: `d − 2` for a proximity
-/// distance `d ≥ 3`, else 1.
+/// distance `d ≥ MIN_JUMP + 2`, else 1.
 ///
 /// Why `d − 2`: every voxel those steps pass (on the 26-ray or on the 6-ray
 /// between its voxels) lies within chessboard distance `d − 2` of the
@@ -463,7 +471,7 @@ fn twenty_six_run<
 #[inline(always)]
 fn skip_count(cur: u8, todo: u32) -> u32 {
     let d = crate::proximity::distance(cur);
-    if d >= 3 {
+    if d >= MIN_JUMP.wrapping_add(2) {
         u32::from(d.wrapping_sub(2)).min(todo)
     } else {
         1
@@ -478,16 +486,77 @@ fn skip_count(cur: u8, todo: u32) -> u32 {
 /// `(inc_m − inc_a, inc_m]` after the first step from any reachable
 /// `f ∈ (−inc_a, inc_a]`; so after `i ≥ 1` steps the count is the unique
 /// `n_i` putting `f + i·inc_m − n_i·inc_a` in that interval:
-/// `n_i = ⌈(f + (i − 1)·inc_m) / inc_a⌉`. The values are below 2^55 (k ≤ 61).
+/// `n_i = ⌈(f + (i − 1)·inc_m) / inc_a⌉`, which is 0 when the numerator is
+/// not positive. The values are below 2^55 (k ≤ 61).
 #[inline(always)]
-fn jump_count(f: i64, k: u32, inc_a: i64, inc_m: i64) -> (i64, bool) {
+fn jump_count(f: i64, k: u32, by_a: Reciprocal, inc_m: i64) -> (i64, bool) {
     let ceil = |i: u32| -> i64 {
         let x = f.wrapping_add(i64::from(i.wrapping_sub(1)).wrapping_mul(inc_m));
-        x.wrapping_add(inc_a)
-            .wrapping_sub(1)
-            .checked_div_euclid(inc_a)
-            .unwrap_or(0)
+        match u64::try_from(x.wrapping_sub(1)) {
+            // ⌈x / inc_a⌉ = ⌊(x − 1) / inc_a⌋ + 1 for x > 0.
+            Ok(x1) if x > 0 => i64::try_from(by_a.div(x1)).unwrap_or(0).wrapping_add(1),
+            _ => 0,
+        }
     };
     let n = ceil(k);
     (n, n != ceil(k.wrapping_sub(1)))
+}
+
+/// Exact division by a constant through a multiplication: `⌊x / d⌋` for
+/// `x < 2^64`, `d ≥ 2`, from `m = ⌊2^64 / d⌋` (one 128-bit division, once
+/// per run). `⌊x·m / 2^64⌋` is `⌊x / d⌋` or one less, since
+/// `x/d − 1 < x·m/2^64 ≤ x/d`; one comparison corrects it.
+#[derive(Clone, Copy)]
+struct Reciprocal {
+    d: u64,
+    m: u64,
+}
+
+impl Reciprocal {
+    fn new(d: i64) -> Self {
+        let d = u64::try_from(d).unwrap_or(0).max(2);
+        let m = u64::try_from((1u128 << 64).checked_div(u128::from(d)).unwrap_or(0)).unwrap_or(0);
+        Self { d, m }
+    }
+
+    #[inline(always)]
+    fn div(self, x: u64) -> u64 {
+        let q = u64::try_from(u128::from(x).wrapping_mul(u128::from(self.m)) >> 64).unwrap_or(0);
+        let r = x.wrapping_sub(q.wrapping_mul(self.d));
+        if r >= self.d { q.wrapping_add(1) } else { q }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Reciprocal;
+
+    #[test]
+    fn reciprocal_division_is_exact() {
+        let mut x = 0x0123_4567_89ab_cdefu64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for _ in 0..200_000 {
+            let d = (next() >> (1 + next() % 62)).max(2);
+            let r = Reciprocal::new(i64::try_from(d >> 1).unwrap().max(2));
+            let n = next() >> (next() % 64);
+            assert_eq!(r.div(n), n / r.d, "{n} / {}", r.d);
+            for edge in [
+                0,
+                1,
+                r.d - 1,
+                r.d,
+                r.d + 1,
+                u64::MAX,
+                u64::MAX - 1,
+                r.d.wrapping_mul(r.m),
+            ] {
+                assert_eq!(r.div(edge), edge / r.d, "{edge} / {}", r.d);
+            }
+        }
+    }
 }
