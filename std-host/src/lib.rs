@@ -15,6 +15,10 @@
 //! * `check` (feature `check`): invariant checkers shared by tests and
 //!   fuzz targets.
 //! * [`cli`]: the `rrt` command line (the binary only parses arguments).
+//! * [`volume`]: sampled (NRRD, raw) and computed volumes, resampling,
+//!   placement in the world and classification.
+//! * [`texture`]: image maps and solid textures, precomputed per voxel.
+//! * [`vox`]: MagicaVoxel `.vox` models.
 
 #![forbid(unsafe_code)]
 
@@ -26,3 +30,6 @@ pub mod fit;
 pub mod intersect;
 pub mod scene;
 pub mod shade;
+pub mod texture;
+pub mod volume;
+pub mod vox;
