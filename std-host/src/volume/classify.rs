@@ -387,6 +387,9 @@ mod tests {
             }
         }
         let got = gray_gradient(f, 2, 3, 4);
-        assert!((got - want / (2.0 * ZH_FACE)).length() < 1e-12, "{got} {want}");
+        assert!(
+            (got - want / (2.0 * ZH_FACE)).length() < 1e-12,
+            "{got} {want}"
+        );
     }
 }

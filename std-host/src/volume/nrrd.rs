@@ -375,6 +375,14 @@ fn build_header(
         hint,
     };
 
+    if !ended && fields.get("data file").is_none() {
+        return Err(VolumeError::Data {
+            path: path.to_path_buf(),
+            offset: header_bytes,
+            msg: "the header has no empty line ending it and no `data file`: truncated, or no data"
+                .into(),
+        });
+    }
     let ty = fields.get("type").ok_or_else(|| missing("type", ""))?;
     let sample_type = parse_type(&ty.value).map_err(|m| herr(ty.line, m))?;
 
@@ -504,10 +512,11 @@ fn build_header(
         }
     };
     if data_file.is_none() && !ended {
+        // `data file: LOCAL` without the empty line.
         return Err(VolumeError::Data {
             path: path.to_path_buf(),
             offset: header_bytes,
-            msg: "the header has no empty line ending it and no `data file`: no data".into(),
+            msg: "the header has no empty line ending it: truncated, or no data".into(),
         });
     }
     Ok(Header {

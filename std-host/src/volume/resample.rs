@@ -442,7 +442,9 @@ impl<'a> PlacedVolume<'a> {
             let a = (lo[axis] - 0.5).ceil().max(0.0);
             let z = (hi[axis] - 0.5).floor().min(f64::from(dims[axis]) - 1.0);
             // NaN bounds fail too.
-            if a.partial_cmp(&z).is_none_or(|o| o == std::cmp::Ordering::Greater) {
+            if a.partial_cmp(&z)
+                .is_none_or(|o| o == std::cmp::Ordering::Greater)
+            {
                 return None;
             }
             // 0 <= a <= z < 2^16.
