@@ -585,11 +585,14 @@ impl VoxScene {
             let (x, y, z) = (x as usize, y as usize, z as usize);
             x < sx && y < sy && z < sz && occ.get(x + sx * (y + sy * z)).copied().unwrap_or(false)
         };
-        let w = [1.0, std::f64::consts::FRAC_1_SQRT_2, 1.0 / 3f64.sqrt()];
+        // Zucker–Hummel weights as integers (×256, as the core's volume
+        // voxelizer): sums cancel exactly where the neighbourhood is
+        // symmetric.
+        let w: [i64; 3] = [256, 181, 148];
         let mut out = Vec::with_capacity(m.voxels.len());
         for v in &m.voxels {
             let p = [v[0], v[1], v[2]].map(i64::from);
-            let mut g = DVec3::ZERO;
+            let mut g = [0i64; 3];
             let mut all = true;
             for dz in -1..=1i64 {
                 for dy in -1..=1i64 {
@@ -604,24 +607,28 @@ impl VoxScene {
                         let d = [dx, dy, dz];
                         let nz = d.iter().filter(|c| **c != 0).count();
                         // An empty neighbour pulls the normal toward it.
-                        g += DVec3::new(dx as f64, dy as f64, dz as f64) * w[nz - 1];
+                        for (ga, da) in g.iter_mut().zip(d) {
+                            *ga += da * w[nz - 1];
+                        }
                     }
                 }
             }
-            let n = g.try_normalize().or_else(|| {
-                const FACES: [[i64; 3]; 6] = [
-                    [-1, 0, 0],
-                    [1, 0, 0],
-                    [0, -1, 0],
-                    [0, 1, 0],
-                    [0, 0, -1],
-                    [0, 0, 1],
-                ];
-                FACES
-                    .iter()
-                    .find(|d| !filled(p[0] + d[0], p[1] + d[1], p[2] + d[2]))
-                    .map(|d| DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64))
-            });
+            let n = DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64)
+                .try_normalize()
+                .or_else(|| {
+                    const FACES: [[i64; 3]; 6] = [
+                        [-1, 0, 0],
+                        [1, 0, 0],
+                        [0, -1, 0],
+                        [0, 1, 0],
+                        [0, 0, -1],
+                        [0, 0, 1],
+                    ];
+                    FACES
+                        .iter()
+                        .find(|d| !filled(p[0] + d[0], p[1] + d[1], p[2] + d[2]))
+                        .map(|d| DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64))
+                });
             let normal = n.map_or([0, 0, NORMAL_ONE], |n| {
                 // |component| ≤ 1: fits after scaling.
                 [n.x, n.y, n.z].map(|c| (c * f64::from(NORMAL_ONE)).round() as i32)
