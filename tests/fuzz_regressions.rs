@@ -48,3 +48,12 @@ fn nff_inputs_replay() {
         }
     }
 }
+
+#[test]
+fn nrrd_inputs_replay() {
+    for (name, bytes) in inputs("nrrd") {
+        if let Err(broken) = rrt_host::volume::check::nrrd_input(&bytes) {
+            panic!("{name}: {broken}");
+        }
+    }
+}

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use rrt_core::raster::Extent;
+use rrt_core::store::Texture;
 use rrt_host::fit::RasterFrame;
 use rrt_host::volume::classify::gray_normal;
 use rrt_host::volume::computed::{self, Metaball, Metaballs, ScreenedSources};
@@ -15,7 +16,7 @@ use rrt_host::volume::raw::{self, RawSpec};
 use rrt_host::volume::resample::{Quantizer, resample_cubic};
 use rrt_host::volume::{
     Classifier, ColorRamp, Endian, Grid, Limits, Placement, Ramp, SampleType, Samples, Volume,
-    VolumeError, nrrd,
+    VolumeColors, VolumeError, nrrd,
 };
 
 fn fixture(name: &str) -> PathBuf {
@@ -437,6 +438,25 @@ fn classification_with_ramps() {
         assert_eq!(*s >= block.threshold, opaque, "voxel {vox:?} value {val:?}");
     }
     assert!(Classifier::iso(f64::NAN).validate().is_err());
+    // The colour ramp as the builder's texture: each voxel centre's value.
+    let colors = VolumeColors::new(placed, frame, &c);
+    for vox in [[0u32, 0, 0], [3, 2, 9], [9, 7, 17], [5, 5, 5]] {
+        let centre = vox.map(rrt_core::fixed::voxel_centre);
+        let w = frame.raster_to_world(DVec3::from(vox.map(f64::from)) + 0.5);
+        let want = placed
+            .sample_world(w)
+            .map_or([7; 3], |x| c.color(x, [7; 3]));
+        assert_eq!(
+            colors.color(centre, [0, 0, 1 << 30], [7; 3]),
+            want,
+            "{vox:?}"
+        );
+    }
+    // Voxel (4, 3, 7): centre (3, 3.5, 6) is sample (4, 3, 2), value 59:
+    // the ramp's end. Voxel (5, 5, 5) lies outside the volume: the base.
+    let at = |v: [u32; 3]| colors.color(v.map(rrt_core::fixed::voxel_centre), [0; 3], [7; 3]);
+    assert_eq!(at([4, 3, 7]), [0, 0, 255]);
+    assert_eq!(at([5, 5, 5]), [7; 3]);
 }
 
 #[test]

@@ -43,6 +43,8 @@ use glam::{DMat3, DVec3};
 
 use crate::scene::Bounds;
 
+#[cfg(any(test, feature = "check"))]
+pub mod check;
 pub mod classify;
 pub mod computed;
 pub mod nrrd;

@@ -335,7 +335,15 @@ fn parse_header<R: BufRead>(
     if lineno == 0 {
         return Err(herr(1, "empty file: not a NRRD file".into()));
     }
-    build_header(path, &fields, version, consumed, ended, may_open_files)
+    build_header(
+        path,
+        &fields,
+        version,
+        consumed,
+        ended,
+        may_open_files,
+        limits,
+    )
 }
 
 fn magic(text: &[u8]) -> Option<u8> {
@@ -363,6 +371,7 @@ fn build_header(
     header_bytes: u64,
     ended: bool,
     may_open_files: bool,
+    limits: &Limits,
 ) -> Result<Header, VolumeError> {
     let herr = |line: usize, msg: String| VolumeError::Header {
         path: path.to_path_buf(),
@@ -467,6 +476,17 @@ fn build_header(
                 return Err(herr(
                     f.line,
                     format!("byte skip: expected -1 or a count ≥ 0, found {v}"),
+                ));
+            }
+            // Skipped decompressed bytes cost as much as samples: bounded
+            // like them (a gzip bomb cannot make the reader spin).
+            if encoding == Encoding::Gzip && v.unsigned_abs() > limits.max_bytes {
+                return Err(herr(
+                    f.line,
+                    format!(
+                        "byte skip: {v} decompressed bytes to skip, more than the limit of {} bytes",
+                        limits.max_bytes
+                    ),
                 ));
             }
             if v == -1 && encoding != Encoding::Raw {
