@@ -88,14 +88,14 @@ pub fn nrrd_input(data: &[u8]) -> Result<(), String> {
             voxel_size: size / 8.0,
         };
         let c = Classifier::iso(0.5 * (lo + hi));
-        if let Ok(Some(block)) = placed.raster_block(&frame, &c, 1 << 20) {
-            if block.samples.len() > 512 || block.threshold == 0 {
-                return Err(format!(
-                    "block of {} samples, threshold {}",
-                    block.samples.len(),
-                    block.threshold
-                ));
-            }
+        if let Ok(Some(block)) = placed.raster_block(&frame, &c, 1 << 20)
+            && (block.samples.len() > 512 || block.threshold == 0)
+        {
+            return Err(format!(
+                "block of {} samples, threshold {}",
+                block.samples.len(),
+                block.threshold
+            ));
         }
     }
     Ok(())
