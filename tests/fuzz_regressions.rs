@@ -50,6 +50,16 @@ fn nff_inputs_replay() {
 }
 
 #[test]
+fn voxelize_inputs_replay() {
+    for (name, bytes) in inputs("voxelize") {
+        let input = rrt_tests::voxelize_case::Input::arbitrary_take_rest(Unstructured::new(&bytes))
+            .unwrap_or_else(|e| panic!("{name}: does not decode: {e}"));
+        eprintln!("{name}: {input:?}");
+        rrt_tests::voxelize_case::run(input);
+    }
+}
+
+#[test]
 fn nrrd_inputs_replay() {
     for (name, bytes) in inputs("nrrd") {
         if let Err(broken) = rrt_host::volume::check::nrrd_input(&bytes) {

@@ -423,11 +423,11 @@ pub mod fuzz {
     //! the fuzzer replays exactly under `cargo test`.
 
     use arbitrary::Arbitrary;
-    use rrt_core::check::check_adaptive_matches_six;
-    use rrt_core::discrete_ray::DiscreteRay;
+    use rrt_core::check::{check_adaptive_matches_six, check_skipping};
+    use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
     use rrt_core::error::RayError;
     use rrt_core::fixed::VOXEL;
-    use rrt_core::proximity::flag_neighbourhood;
+    use rrt_core::proximity::{distance_field, flag_neighbourhood};
     use rrt_core::raster::{Extent, RasterMut, cell};
 
     use crate::oracle::{Case, check_exact};
@@ -536,7 +536,18 @@ pub mod fuzz {
         {
             panic!("adaptive missed a six hit: {v:?} {c:?}");
         }
+        // With proximity distances, skipping finds the same hits and states.
+        distance_field(&mut raster);
+        let r = raster.as_raster();
+        if let Ok(Some(ray)) = set_up {
+            for mode in Connectivity::ALL {
+                if let Err(v) = check_skipping(&r, &ray, mode) {
+                    panic!("skipping diverged in {mode:?}: {v:?} {c:?}");
+                }
+            }
+        }
     }
 }
 
 pub mod packet_case;
+pub mod voxelize_case;

@@ -24,22 +24,26 @@ use rrt_benches::{
     BenchRaster, BenchRay, SplitMix, Trace, baseline, camera_rays, random_rays, rss_mib,
 };
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
-use rrt_core::proximity::flag_neighbourhood;
+use rrt_core::proximity::distance_field;
 use rrt_core::raster::{Raster, RasterMut};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Algo {
     Rrt(Connectivity),
+    /// rrt with proximity-distance skipping (issue 8), on the same raster.
+    RrtSkip(Connectivity),
     AmanatidesWoo,
     WalkVoxels,
     Bresenham3d,
     IntBresenham,
 }
 
-const ALGOS: [Algo; 7] = [
+const ALGOS: [Algo; 9] = [
     Algo::Rrt(Connectivity::Six),
     Algo::Rrt(Connectivity::TwentySix),
     Algo::Rrt(Connectivity::Adaptive),
+    Algo::RrtSkip(Connectivity::TwentySix),
+    Algo::RrtSkip(Connectivity::Adaptive),
     Algo::AmanatidesWoo,
     Algo::WalkVoxels,
     Algo::Bresenham3d,
@@ -52,6 +56,8 @@ impl Algo {
             Self::Rrt(Connectivity::Six) => "rrt six",
             Self::Rrt(Connectivity::TwentySix) => "rrt twenty-six",
             Self::Rrt(Connectivity::Adaptive) => "rrt adaptive",
+            Self::RrtSkip(Connectivity::TwentySix) => "rrt 26 + skip",
+            Self::RrtSkip(_) => "rrt ada + skip",
             Self::AmanatidesWoo => "float A&W",
             Self::WalkVoxels => "ld WalkVoxels",
             Self::Bresenham3d => "ld Bresenham3d",
@@ -82,20 +88,25 @@ fn run(
         }
     };
     match algo {
-        Algo::Rrt(mode) => {
+        Algo::Rrt(mode) | Algo::RrtSkip(mode) => {
+            let skip = matches!(algo, Algo::RrtSkip(_));
             for r in rays {
                 let Some(mut ray) = r.discrete(extent) else {
                     each(Trace::default());
                     continue;
                 };
-                let hit = ray.first_hit(raster, mode).ok().flatten();
+                let hit = if skip {
+                    ray.first_hit_skipping(raster, mode)
+                } else {
+                    ray.first_hit(raster, mode)
+                };
                 each(Trace {
                     steps: u64::from(ray.steps()),
-                    hit: hit.map(|h| h.index),
+                    hit: hit.ok().flatten().map(|h| h.index),
                 });
             }
         }
-        _ => {
+        Algo::AmanatidesWoo | Algo::WalkVoxels | Algo::Bresenham3d | Algo::IntBresenham => {
             let f = match algo {
                 Algo::AmanatidesWoo => baseline::amanatides_woo,
                 Algo::WalkVoxels => baseline::line_drawing_walk,
@@ -187,13 +198,16 @@ fn table(n: u32, set: &str, raster: &Raster<'_>, rays: &[BenchRay], rounds: usiz
     );
     println!(
         "ratios (rays/s): twenty-six / int Bresenham {:.2}, / ld Bresenham3d {:.2}, / float A&W {:.2}; \
-         six / float A&W {:.2}, / ld WalkVoxels {:.2}; adaptive / float A&W {:.2}",
+         six / float A&W {:.2}, / ld WalkVoxels {:.2}; adaptive / float A&W {:.2}; \
+         with skipping: twenty-six / float A&W {:.2}, adaptive / float A&W {:.2}",
         ratio(tws, Algo::IntBresenham),
         ratio(tws, Algo::Bresenham3d),
         ratio(tws, Algo::AmanatidesWoo),
         ratio(six, Algo::AmanatidesWoo),
         ratio(six, Algo::WalkVoxels),
         ratio(ada, Algo::AmanatidesWoo),
+        ratio(Algo::RrtSkip(Connectivity::TwentySix), Algo::AmanatidesWoo),
+        ratio(Algo::RrtSkip(Connectivity::Adaptive), Algo::AmanatidesWoo),
     );
     rows
 }
@@ -210,7 +224,9 @@ fn scene(n: u32) -> Scene {
     let before = rss_mib().unwrap_or(0.0);
     let mut raster = BenchRaster::random_spheres(n, 1000, &mut rng);
     let extent = raster.extent();
-    flag_neighbourhood(&mut RasterMut::new(extent, &mut raster.plane).expect("plane"));
+    // Proximity distances (and the proximity flags, the same as
+    // flag_neighbourhood's): Adaptive reads the flags, skipping the distances.
+    distance_field(&mut RasterMut::new(extent, &mut raster.plane).expect("plane"));
     let after = rss_mib().unwrap_or(0.0);
     println!(
         "\nraster {n}^3: 1000 random solid spheres r = {:.1}, {:.2}% occupied; every page written (RSS +{:.0} MiB for a {:.0} MiB plane)",

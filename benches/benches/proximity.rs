@@ -3,47 +3,32 @@
 //! over the records (`store::flag_proximity`, 27 cell writes per record).
 //! The builder keeps the faster one; the figures are in the store docs.
 //!
-//! The spheres are voxelized by a plain brute-force voxelizer in this file
-//! (the voxelizers of `core/src/voxelize/` are another work item); only the
-//! flag passes are timed.
+//! Only the flag passes are timed.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use rrt_core::fixed::VOXEL;
+use rrt_core::geometry::Sphere;
 use rrt_core::proximity::flag_neighbourhood;
 use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, RecordStore, directory_len, flag_proximity};
 use rrt_core::voxel::VoxelRecord;
-use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
+use rrt_core::voxelize::{Separation, VoxelSink};
 use std::hint::black_box;
 
-/// 26-separating sphere surface by brute force over its bounding box.
+/// A 26-separating sphere surface through the real voxelizer.
 fn sphere(centre: [f64; 3], radius: f64, sink: &mut impl VoxelSink) {
-    let lo = centre.map(|c| (c - radius - 2.0).floor().max(0.0) as u32);
-    let hi = centre.map(|c| ((c + radius + 2.0).ceil() as u32).min(511));
-    for z in lo[2]..=hi[2] {
-        for y in lo[1]..=hi[1] {
-            for x in lo[0]..=hi[0] {
-                let p = [x, y, z].map(|c| c as f64 + 0.5);
-                let d = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
-                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                if len == 0.0 {
-                    continue;
-                }
-                let n = d.map(|c| c / len);
-                let half = 0.5 * (n[0].abs() + n[1].abs() + n[2].abs());
-                let dist = len - radius;
-                if dist.abs() <= half {
-                    sink.offer(
-                        [x, y, z],
-                        Surfel {
-                            normal: n.map(|c| (c * f64::from(NORMAL_ONE)).round() as i32),
-                            distance: (dist.abs() * VOXEL as f64) as u32,
-                        },
-                    );
-                }
-            }
-        }
-    }
+    let fx = |v: f64| (v * VOXEL as f64).round() as i64;
+    let s = Sphere {
+        centre: centre.map(fx),
+        radius: fx(radius),
+    };
+    rrt_core::voxelize::sphere::surface(
+        &s,
+        Separation::TwentySix,
+        Extent::cube(512).unwrap(),
+        sink,
+    )
+    .unwrap();
 }
 
 const SPHERES: [([f64; 3], f64); 4] = [

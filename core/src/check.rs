@@ -498,3 +498,86 @@ pub fn check_adaptive_matches_six(raster: &Raster<'_>, ray: &DiscreteRay) -> Res
         }
     }
 }
+
+/// Empty-space skipping must not change what a ray finds: with the proximity
+/// distances of [`crate::proximity::distance_field`] in the plane,
+/// [`DiscreteRay::first_hit_skipping`] and [`DiscreteRay::first_hit`] find the
+/// same hits, hit by hit through resumption, with the same faces and the same
+/// resume state (all but the step count, which counts visits). Budgeted
+/// skipping walks (1 and 3 voxels per call, the reference that tracks every
+/// variable) must agree with the unbounded ones the same way.
+///
+/// # Errors
+/// [`Violation::Diverged`] with the number of the first differing hit.
+pub fn check_skipping(
+    raster: &Raster<'_>,
+    ray: &DiscreteRay,
+    mode: Connectivity,
+) -> Result<(), Violation> {
+    let without_steps = |r: &DiscreteRay| {
+        let mut s = *r.state();
+        s.steps = 0;
+        s
+    };
+    let limit = ray
+        .crossings()
+        .iter()
+        .fold(2u32, |a, &c| a.saturating_add(c));
+    let mut plain = *ray;
+    let mut skipping = *ray;
+    let mut nth = 0u32;
+    loop {
+        nth = nth.saturating_add(1);
+        let a = plain
+            .first_hit(raster, mode)
+            .map_err(|_| Violation::Setup)?;
+        let b = skipping
+            .first_hit_skipping(raster, mode)
+            .map_err(|_| Violation::Setup)?;
+        match (a, b) {
+            (None, None) => break,
+            (Some(x), Some(y)) if x.index == y.index && x.face == y.face => {}
+            _ => return Err(Violation::Diverged { step: nth }),
+        }
+        if without_steps(&plain) != without_steps(&skipping) {
+            return Err(Violation::Diverged { step: nth });
+        }
+        if nth > limit {
+            return Err(Violation::TooLong {
+                visits: nth,
+                bound: limit,
+            });
+        }
+    }
+    // Budgeted skipping walks against unbounded ones.
+    for budget in [1u32, 3] {
+        let mut unbounded = *ray;
+        let mut budgeted = *ray;
+        let mut nth = 0u32;
+        loop {
+            nth = nth.saturating_add(1);
+            let a = unbounded
+                .first_hit_skipping(raster, mode)
+                .map_err(|_| Violation::Setup)?;
+            let end = loop {
+                match budgeted.walk_skipping(raster, mode, budget, |_, c| c & cell::OPAQUE != 0) {
+                    Ok(WalkEnd::Budget) => {}
+                    Ok(e) => break e,
+                    Err(_) => return Err(Violation::Setup),
+                }
+            };
+            match (a, end) {
+                (None, WalkEnd::Exit) => break,
+                (Some(h), WalkEnd::Hit) if h == budgeted.hit() && unbounded == budgeted => {}
+                _ => return Err(Violation::Diverged { step: nth }),
+            }
+            if nth > limit {
+                return Err(Violation::TooLong {
+                    visits: nth,
+                    bound: limit,
+                });
+            }
+        }
+    }
+    Ok(())
+}

@@ -61,27 +61,28 @@ extern crate std;
 
 #[cfg(any(test, feature = "check"))]
 pub mod check;
+#[cfg(any(test, feature = "check"))]
+pub mod check_packet;
+#[cfg(any(test, feature = "check"))]
+pub mod check_voxelize;
 pub mod connectivity;
+pub mod csg;
 pub mod discrete_ray;
 pub mod error;
 pub mod fixed;
 pub mod geometry;
+pub mod light;
+pub mod object_table;
 pub mod packet;
 pub mod proximity;
 pub mod raster;
+pub mod store;
+#[cfg(test)]
+mod testkit;
+pub mod voxel;
 pub mod voxelize;
-
-#[cfg(any(test, feature = "check"))]
-pub mod check_packet;
 
 pub use connectivity::Connectivity;
 pub use discrete_ray::{DiscreteRay, Face, Hit, WalkEnd};
 pub use error::{RasterError, RayError};
 pub use raster::{Extent, Raster, RasterMut};
-pub mod csg;
-pub mod light;
-pub mod object_table;
-pub mod store;
-#[cfg(test)]
-mod testkit;
-pub mod voxel;

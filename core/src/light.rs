@@ -21,7 +21,7 @@
 //!
 //! # Facing away
 //! A light the stored normal faces away from (`N·L ≤ 0`) gets no light, as
-//! in the SPD: on a closed shape ([`Shape::is_closed`]) it is marked
+//! in the SPD: on a closed shape ([`crate::object_table::Shape::is_closed`]) it is marked
 //! occluded without firing a ray. An open shape (triangle, patch, open
 //! cone) can be seen from both sides; for a light behind it the shadow ray is
 //! fired from the back side (with `−N`) and the bits say whether the back

@@ -307,10 +307,10 @@ impl DiscreteRay {
             return Err(RayError::ExtentMismatch);
         }
         let plane = raster.plane();
-        Ok(self.run(mode, |i| plane.get(i).copied(), budget, test))
+        Ok(self.run::<false, _, _>(mode, |i| plane.get(i).copied(), budget, test))
     }
 
-    fn run<C: Fn(usize) -> Option<u8> + Copy, T: FnMut(usize, u8) -> bool>(
+    fn run<const SKIP: bool, C: Fn(usize) -> Option<u8> + Copy, T: FnMut(usize, u8) -> bool>(
         &mut self,
         mode: Connectivity,
         cells: C,
@@ -319,12 +319,12 @@ impl DiscreteRay {
     ) -> WalkEnd {
         let (p, s) = (&self.p, &mut self.s);
         match mode {
-            Connectivity::Six => step::run::<{ step::SIX }, C, T>(p, s, cells, budget, test),
+            Connectivity::Six => step::run::<{ step::SIX }, SKIP, C, T>(p, s, cells, budget, test),
             Connectivity::TwentySix => {
-                step::run::<{ step::TWENTY_SIX }, C, T>(p, s, cells, budget, test)
+                step::run::<{ step::TWENTY_SIX }, SKIP, C, T>(p, s, cells, budget, test)
             }
             Connectivity::Adaptive => {
-                step::run::<{ step::ADAPTIVE }, C, T>(p, s, cells, budget, test)
+                step::run::<{ step::ADAPTIVE }, SKIP, C, T>(p, s, cells, budget, test)
             }
         }
     }
@@ -345,6 +345,73 @@ impl DiscreteRay {
     #[must_use]
     pub fn path(self, mode: Connectivity) -> Path {
         Path { ray: self, mode }
+    }
+
+    /// As [`DiscreteRay::walk`], with **empty-space skipping**: where the
+    /// raster's proximity distance (see
+    /// [`crate::proximity::distance_field`]) at the current voxel is `d ≥ 3`,
+    /// a run of 26-steps (TwentySix, and Adaptive away from surfaces) advances
+    /// `d − 2` steps at once, exactly: it lands on the voxel, with the state,
+    /// that `d − 2` single steps reach. Six walks do not skip.
+    ///
+    /// **Contract:** `test` must reject every cell without [`cell::OPAQUE`]
+    /// (skipped voxels are not tested). Then the hits, their faces and the
+    /// resume state after each are those of [`DiscreteRay::walk`]; only
+    /// `steps` differs: it counts the voxels actually visited, one per jump.
+    /// A plane without distances (all distance bits 0) never skips.
+    ///
+    /// # Errors
+    /// As [`DiscreteRay::walk`].
+    pub fn walk_skipping<T: FnMut(usize, u8) -> bool>(
+        &mut self,
+        raster: &Raster<'_>,
+        mode: Connectivity,
+        budget: u32,
+        test: T,
+    ) -> Result<WalkEnd, RayError> {
+        if raster.extent() != self.p.extent {
+            return Err(RayError::ExtentMismatch);
+        }
+        let plane = raster.plane();
+        Ok(self.run::<true, _, _>(mode, |i| plane.get(i).copied(), budget, test))
+    }
+
+    /// [`DiscreteRay::first_hit`] with empty-space skipping (see
+    /// [`DiscreteRay::walk_skipping`]).
+    ///
+    /// ```
+    /// use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
+    /// use rrt_core::fixed::{voxel_centre, VOXEL};
+    /// use rrt_core::proximity::distance_field;
+    /// use rrt_core::raster::{cell, Extent, RasterMut};
+    ///
+    /// let e = Extent::cube(64).unwrap();
+    /// let mut plane = vec![cell::EMPTY; e.len()];
+    /// plane[e.index([60, 9, 9]).unwrap()] = cell::OPAQUE;
+    /// let mut r = RasterMut::new(e, &mut plane).unwrap();
+    /// distance_field(&mut r);
+    /// let r = r.as_raster();
+    /// let origin = [0, voxel_centre(9), voxel_centre(9)];
+    /// let ray = DiscreteRay::new(e, origin, [VOXEL as i32, 1, 0]).unwrap().unwrap();
+    /// let (mut plain, mut skipping) = (ray, ray);
+    /// let a = plain.first_hit(&r, Connectivity::Adaptive).unwrap().unwrap();
+    /// let b = skipping.first_hit_skipping(&r, Connectivity::Adaptive).unwrap().unwrap();
+    /// assert_eq!((a.voxel, a.face), (b.voxel, b.face));
+    /// assert_eq!(a.steps, 61);
+    /// assert!(b.steps < 10);
+    /// ```
+    ///
+    /// # Errors
+    /// As [`DiscreteRay::walk`].
+    pub fn first_hit_skipping(
+        &mut self,
+        raster: &Raster<'_>,
+        mode: Connectivity,
+    ) -> Result<Option<Hit>, RayError> {
+        match self.walk_skipping(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)? {
+            WalkEnd::Hit => Ok(Some(self.hit())),
+            WalkEnd::Exit | WalkEnd::Budget => Ok(None),
+        }
     }
 
     /// Walks to the first non-transparent ([`cell::OPAQUE`]) voxel, with no
@@ -546,7 +613,7 @@ impl Iterator for Path {
     fn next(&mut self) -> Option<Visit> {
         let end = self
             .ray
-            .run(self.mode, |_| Some(cell::EMPTY), 1, |_, _| false);
+            .run::<false, _, _>(self.mode, |_| Some(cell::EMPTY), 1, |_, _| false);
         self.ray.visit(end, cell::EMPTY)
     }
 }

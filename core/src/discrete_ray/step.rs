@@ -78,6 +78,7 @@ enum Run {
 #[inline(always)]
 pub(crate) fn run<
     const MODE: u8,
+    const SKIP: bool,
     C: Fn(usize) -> Option<u8> + Copy,
     T: FnMut(usize, u8) -> bool,
 >(
@@ -114,9 +115,9 @@ pub(crate) fn run<
         .wrapping_add(u64::from(rb))
         .wrapping_add(u64::from(rc));
     let end = if u64::from(left) > most {
-        drive::<MODE, false, C, T>(p, s, cells, &mut left, &mut test)
+        drive::<MODE, SKIP, false, C, T>(p, s, cells, &mut left, &mut test)
     } else {
-        drive::<MODE, true, C, T>(p, s, cells, &mut left, &mut test)
+        drive::<MODE, SKIP, true, C, T>(p, s, cells, &mut left, &mut test)
     };
     if matches!(end, WalkEnd::Exit) {
         s.done = true;
@@ -128,6 +129,7 @@ pub(crate) fn run<
 #[inline(always)]
 fn drive<
     const MODE: u8,
+    const SKIP: bool,
     const BUDGETED: bool,
     C: Fn(usize) -> Option<u8> + Copy,
     T: FnMut(usize, u8) -> bool,
@@ -143,10 +145,12 @@ fn drive<
             Run::End(e) => e,
             Run::Switch => WalkEnd::Exit, // a pure Six run never switches
         },
-        TWENTY_SIX => match twenty_six_run::<BUDGETED, false, C, T>(p, s, cells, left, test) {
-            Run::End(e) => e,
-            Run::Switch => WalkEnd::Exit,
-        },
+        TWENTY_SIX => {
+            match twenty_six_run::<BUDGETED, false, SKIP, C, T>(p, s, cells, left, test) {
+                Run::End(e) => e,
+                Run::Switch => WalkEnd::Exit,
+            }
+        }
         _ => loop {
             let Some(cur) = cells(s.index) else {
                 return WalkEnd::Exit;
@@ -154,7 +158,7 @@ fn drive<
             let r = if s.tie || cur & cell::PROXIMITY != 0 {
                 six_run::<BUDGETED, true, C, T>(p, s, cells, left, test)
             } else {
-                twenty_six_run::<BUDGETED, true, C, T>(p, s, cells, left, test)
+                twenty_six_run::<BUDGETED, true, SKIP, C, T>(p, s, cells, left, test)
             };
             if let Run::End(e) = r {
                 return e;
@@ -291,6 +295,7 @@ fn six_run<
 fn twenty_six_run<
     const BUDGETED: bool,
     const ADAPTIVE: bool,
+    const SKIP: bool,
     C: Fn(usize) -> Option<u8> + Copy,
     T: FnMut(usize, u8) -> bool,
 >(
@@ -317,6 +322,12 @@ fn twenty_six_run<
     let mut minors = 0usize;
     // Driving-axis crossings left before the exit.
     let mut todo = ra;
+    // With skipping: the current voxel's cell, and the voxels visited (a
+    // jump visits one voxel for k steps).
+    let mut cur = if SKIP { cells(idx).unwrap_or(0) } else { 0 };
+    let mut visits = 0u32;
+    // Division by inc_a for the jumps (inc_a > 0 whenever a jump is taken).
+    let by_a = Reciprocal::new(if SKIP { inc_a } else { 2 });
 
     // How the loop ended: exits write it, the loop body never does.
     // The budget is checked before the exit, as in `six_run`: a call that
@@ -334,23 +345,58 @@ fn twenty_six_run<
         if todo == 0 {
             break;
         }
-        todo = todo.wrapping_sub(1);
-        let sb = usize::from(f1 > 0);
-        let sc = usize::from(f2 > 0);
-        // inc_a masked to zero unless the minor axis steps too.
-        let mask = |m: usize| i64::from(m != 0).wrapping_neg();
-        f1 = f1.wrapping_add(inc_b).wrapping_sub(inc_a & mask(sb));
-        f2 = f2.wrapping_add(inc_c).wrapping_sub(inc_a & mask(sc));
-        minors = sb | (sc << 1);
-        // `& 3` keeps the table lookup free of a bounds check.
-        idx = idx.wrapping_add(diag[minors & 3]);
-        if BUDGETED {
-            let (mb, mc) = (mask(sb), mask(sc));
-            e3 = e3.wrapping_add(inc_c & mb).wrapping_sub(inc_b & mc);
-            rb = rb.wrapping_sub(u32::from(sb != 0));
-            rc = rc.wrapping_sub(u32::from(sc != 0));
-            steps = steps.wrapping_add(1);
-            last = 1 | (u8::from(sb != 0) << 1) | (u8::from(sc != 0) << 2);
+        // Far from every non-transparent voxel, take k 26-steps at once.
+        let k = if SKIP { skip_count(cur, todo) } else { 1 };
+        if SKIP && k > 1 {
+            let (nb, lb) = jump_count(f1, k, by_a, inc_b);
+            let (nc, lc) = jump_count(f2, k, by_a, inc_c);
+            let kk = i64::from(k);
+            f1 = f1
+                .wrapping_add(kk.wrapping_mul(inc_b))
+                .wrapping_sub(nb.wrapping_mul(inc_a));
+            f2 = f2
+                .wrapping_add(kk.wrapping_mul(inc_c))
+                .wrapping_sub(nc.wrapping_mul(inc_a));
+            let [off_a, off_b, off_c] = p.off;
+            let times = |off: usize, n: i64| off.wrapping_mul(usize::try_from(n).unwrap_or(0));
+            idx = idx
+                .wrapping_add(times(off_a, kk))
+                .wrapping_add(times(off_b, nb))
+                .wrapping_add(times(off_c, nc));
+            todo = todo.wrapping_sub(k);
+            minors = usize::from(lb) | (usize::from(lc) << 1);
+            if BUDGETED {
+                e3 = e3
+                    .wrapping_add(nb.wrapping_mul(inc_c))
+                    .wrapping_sub(nc.wrapping_mul(inc_b));
+                rb = rb.wrapping_sub(u32::try_from(nb).unwrap_or(0));
+                rc = rc.wrapping_sub(u32::try_from(nc).unwrap_or(0));
+                steps = steps.wrapping_add(1);
+                last = 1 | (u8::from(lb) << 1) | (u8::from(lc) << 2);
+            }
+        } else {
+            todo = todo.wrapping_sub(1);
+            let sb = usize::from(f1 > 0);
+            let sc = usize::from(f2 > 0);
+            // inc_a masked to zero unless the minor axis steps too.
+            let mask = |m: usize| i64::from(m != 0).wrapping_neg();
+            f1 = f1.wrapping_add(inc_b).wrapping_sub(inc_a & mask(sb));
+            f2 = f2.wrapping_add(inc_c).wrapping_sub(inc_a & mask(sc));
+            minors = sb | (sc << 1);
+            // `& 3` keeps the table lookup free of a bounds check.
+            idx = idx.wrapping_add(diag[minors & 3]);
+            if BUDGETED {
+                let (mb, mc) = (mask(sb), mask(sc));
+                e3 = e3.wrapping_add(inc_c & mb).wrapping_sub(inc_b & mc);
+                rb = rb.wrapping_sub(u32::from(sb != 0));
+                rc = rc.wrapping_sub(u32::from(sc != 0));
+                steps = steps.wrapping_add(1);
+                last = 1 | (u8::from(sb != 0) << 1) | (u8::from(sc != 0) << 2);
+            }
+        }
+        if SKIP {
+            // Every advance, one step or a jump, visits one voxel.
+            visits = visits.wrapping_add(1);
         }
         // ---- visit ----
         let Some(c) = cells(idx) else {
@@ -363,6 +409,9 @@ fn twenty_six_run<
         if ADAPTIVE && c & cell::PROXIMITY != 0 {
             end = Run::Switch;
             break;
+        }
+        if SKIP {
+            cur = c;
         }
     }
     e1 = f1.wrapping_add(thr_b);
@@ -388,7 +437,7 @@ fn twenty_six_run<
         e3 = start.err[2]
             .wrapping_add(inc_c.wrapping_mul(i64::from(nb)))
             .wrapping_sub(inc_b.wrapping_mul(i64::from(nc)));
-        steps = start.steps.wrapping_add(k);
+        steps = start.steps.wrapping_add(if SKIP { visits } else { k });
         last = 1 | (u8::try_from(minors).unwrap_or(0) << 1);
     }
     s.index = idx;
@@ -401,4 +450,100 @@ fn twenty_six_run<
         s.tie = false;
     }
     end
+}
+
+/// The shortest jump worth taking. A jump's length is read from the cell
+/// just loaded, so the next load waits for this one, while single steps
+/// compute their addresses without looking at the cells and overlap their
+/// loads; a jump pays only when it replaces several steps.
+pub(crate) const MIN_JUMP: u8 = 8;
+
+/// How many 26-steps a run may take at once from a voxel whose cell is
+/// `cur`, with `todo` driving crossings left: `d − 2` for a proximity
+/// distance `d ≥ MIN_JUMP + 2`, else 1.
+///
+/// Why `d − 2`: every voxel those steps pass (on the 26-ray or on the 6-ray
+/// between its voxels) lies within chessboard distance `d − 2` of the
+/// current voxel, so at distance at least 2 from every non-transparent
+/// voxel: transparent and unflagged. Single steps would have visited only
+/// such voxels, decided nothing on them (no hit, no switch to 6-steps), and
+/// arrived at the same state.
+#[inline(always)]
+fn skip_count(cur: u8, todo: u32) -> u32 {
+    let d = crate::proximity::distance(cur);
+    if d >= MIN_JUMP.wrapping_add(2) { u32::from(d.wrapping_sub(2)).min(todo) } else { 1 }
+}
+
+/// The number of crossings `n` of a minor axis among the next `k ≥ 2`
+/// 26-steps from the threshold-shifted term `f`, and whether the last of
+/// those steps took one.
+///
+/// A 26-step maps `f` to `f + inc_m − inc_a·[f > 0]`, which keeps it in
+/// `(inc_m − inc_a, inc_m]` after the first step from any reachable
+/// `f ∈ (−inc_a, inc_a]`; so after `i ≥ 1` steps the count is the unique
+/// `n_i` putting `f + i·inc_m − n_i·inc_a` in that interval:
+/// `n_i = ⌈(f + (i − 1)·inc_m) / inc_a⌉`, which is 0 when the numerator is
+/// not positive. The values are below 2^55 (k ≤ 61).
+#[inline(always)]
+fn jump_count(f: i64, k: u32, by_a: Reciprocal, inc_m: i64) -> (i64, bool) {
+    let ceil = |i: u32| -> i64 {
+        let x = f.wrapping_add(i64::from(i.wrapping_sub(1)).wrapping_mul(inc_m));
+        match u64::try_from(x.wrapping_sub(1)) {
+            // ⌈x / inc_a⌉ = ⌊(x − 1) / inc_a⌋ + 1 for x > 0.
+            Ok(x1) if x > 0 => i64::try_from(by_a.div(x1)).unwrap_or(0).wrapping_add(1),
+            _ => 0,
+        }
+    };
+    let n = ceil(k);
+    (n, n != ceil(k.wrapping_sub(1)))
+}
+
+/// Exact division by a constant through a multiplication: `⌊x / d⌋` for
+/// `x < 2^64`, `d ≥ 2`, from `m = ⌊2^64 / d⌋` (one 128-bit division, once
+/// per run). `⌊x·m / 2^64⌋` is `⌊x / d⌋` or one less, since
+/// `x/d − 1 < x·m/2^64 ≤ x/d`; one comparison corrects it.
+#[derive(Clone, Copy)]
+struct Reciprocal {
+    d: u64,
+    m: u64,
+}
+
+impl Reciprocal {
+    fn new(d: i64) -> Self {
+        let d = u64::try_from(d).unwrap_or(0).max(2);
+        let m = u64::try_from((1u128 << 64).checked_div(u128::from(d)).unwrap_or(0)).unwrap_or(0);
+        Self { d, m }
+    }
+
+    #[inline(always)]
+    fn div(self, x: u64) -> u64 {
+        let q = u64::try_from(u128::from(x).wrapping_mul(u128::from(self.m)) >> 64).unwrap_or(0);
+        let r = x.wrapping_sub(q.wrapping_mul(self.d));
+        if r >= self.d { q.wrapping_add(1) } else { q }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Reciprocal;
+
+    #[test]
+    fn reciprocal_division_is_exact() {
+        let mut x = 0x0123_4567_89ab_cdefu64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for _ in 0..200_000 {
+            let d = (next() >> (1 + next() % 62)).max(2);
+            let r = Reciprocal::new(i64::try_from(d >> 1).unwrap().max(2));
+            let n = next() >> (next() % 64);
+            assert_eq!(r.div(n), n / r.d, "{n} / {}", r.d);
+            for edge in [0, 1, r.d - 1, r.d, r.d + 1, u64::MAX, u64::MAX - 1, r.d.wrapping_mul(r.m)] {
+                assert_eq!(r.div(edge), edge / r.d, "{edge} / {}", r.d);
+            }
+        }
+    }
 }

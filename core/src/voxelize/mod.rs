@@ -14,12 +14,27 @@
 //! * [`Separation::TwentySix`]: it is **26-tunnel-free**: not even a
 //!   26-connected discrete ray passes through.
 //!
-//! For a surface with unit normal `n` at the point nearest a voxel centre,
-//! the voxel belongs to the surface when the centre lies within half the
-//! minimal separating thickness: `|d| ≤ ½·max(|nx|,|ny|,|nz|)` for Six (a
-//! *naive* digital surface) and `|d| ≤ ½·(|nx|+|ny|+|nz|)` for TwentySix (a
-//! *standard* digital surface), measured in voxels. Attributes (normal,
-//! colour) are sampled at the voxel centre, as the paper does.
+//! **The rule: a voxel belongs to a surface when its *probe* meets the
+//! surface.** For TwentySix the probe is the voxel's closed cube; for Six it
+//! is the octahedron inscribed in the voxel (the sphere's Six voxelizer uses
+//! the three segments through the centre, a subset). Why it is tunnel-free:
+//! wherever the chain of a discrete ray's voxel centres crosses the surface,
+//! it crosses within half a step of some centre, and that voxel's probe
+//! meets the surface there. The argument holds for any union of objects,
+//! so meshes are tunnel-free across shared edges and vertices.
+//!
+//! For a plane with unit normal `n` the rule is exactly the classic one: the
+//! centre lies within `½·max(|nx|,|ny|,|nz|)` voxels of the plane for Six (a
+//! *naive* digital plane) and within `½·(|nx|+|ny|+|nz|)` for TwentySix (a
+//! *standard* one). Applied with the normal at the nearest point to a
+//! *curved* surface, that distance rule can leave tunnels on small spheres
+//! (up to about 0.17 voxel for Six and 0.35 for TwentySix at radius ½ voxel,
+//! shrinking as 1/R²), which the probe rule does not. Ties (a face exactly
+//! on voxel faces or centres) are decided as if the object were shifted by
+//! an infinitesimal amount, so such faces get one layer, not two. Measured
+//! thickness stays within 0.94–1.04× of the minimum the separation needs
+//! (`tests/voxelize_thickness.rs`). Attributes (normal, colour) are sampled
+//! at the voxel centre, as the paper does.
 //!
 //! # Cost
 //! Every voxelizer does work linear in the number of voxels it generates
@@ -79,3 +94,15 @@ pub trait VoxelSink {
     /// distance.
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel);
 }
+
+pub mod cone;
+pub mod cuboid;
+pub mod error;
+mod fixmath;
+pub mod line;
+pub mod patch;
+pub mod sphere;
+mod tessellate;
+pub mod torus;
+pub mod triangle;
+pub mod volume;
