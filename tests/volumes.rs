@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use rrt_core::raster::Extent;
 use rrt_core::store::Texture;
+use rrt_core::voxelize::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use rrt_host::fit::RasterFrame;
 use rrt_host::volume::classify::gray_normal;
 use rrt_host::volume::computed::{self, Metaball, Metaballs, ScreenedSources};
@@ -221,6 +222,40 @@ fn real_mri_head() {
     assert_eq!(block.threshold, 20 * 256);
     assert_eq!(block.count_inside(), 3_844_205);
     assert_eq!(block.at_voxel([100, 150, 60]), Some(110 * 256));
+    // The head's surface layer through the core's volume voxelizer, in
+    // slabs of 4 MiB: every voxel inside, with an outside 6-neighbour.
+    drop(block);
+    let mut layer = Collect::default();
+    let n = placed
+        .voxelize(&frame, &c, Separation::Six, 4 << 20, &mut layer)
+        .unwrap();
+    assert_eq!(n, layer.0.len() as u64);
+    eprintln!("MRI head at iso 20: {n} boundary voxels (6-separating)");
+    assert!(n > 100_000 && n < 3_844_205, "{n}");
+    for vox in layer.0.keys().step_by(997) {
+        let [i, j, k] = *vox;
+        assert!(c.is_opaque(v.value(i, j, k).unwrap()));
+        let outside = [
+            [1i64, 0, 0],
+            [-1, 0, 0],
+            [0, 1, 0],
+            [0, -1, 0],
+            [0, 0, 1],
+            [0, 0, -1],
+        ]
+        .iter()
+        .any(|d| {
+            let p = [
+                i64::from(i) + d[0],
+                i64::from(j) + d[1],
+                i64::from(k) + d[2],
+            ];
+            p.iter().any(|x| *x < 0)
+                || v.value(p[0] as u32, p[1] as u32, p[2] as u32)
+                    .is_none_or(|x| !c.is_opaque(x))
+        });
+        assert!(outside, "{vox:?}");
+    }
 }
 
 #[test]
@@ -389,6 +424,34 @@ fn anisotropic_volume_in_cubic_raster_voxels() {
         }
     }
     assert!(boundary > 200, "{boundary}");
+    // Through the core's volume voxelizer: whole block or slabs, the same
+    // voxels and surfels; the core's integer normals agree with the float
+    // gray-level gradient of the same block to within a degree.
+    for sep in [Separation::Six, Separation::TwentySix] {
+        let mut whole = Collect::default();
+        let n = placed
+            .voxelize(&frame, &c, sep, 1 << 24, &mut whole)
+            .unwrap();
+        let mut slabs = Collect::default();
+        let m = placed
+            .voxelize(&frame, &c, sep, 18 * 18 * 2 * 4, &mut slabs)
+            .unwrap();
+        assert_eq!(n, whole.0.len() as u64);
+        assert_eq!(m, n);
+        assert_eq!(whole.0, slabs.0, "{sep:?}");
+        assert!(n > 300, "{n}");
+        for (v, s) in &whole.0 {
+            let (x, y, z) = (i64::from(v[0]), i64::from(v[1]), i64::from(v[2]));
+            let want = gray_normal(at, x, y, z).unwrap();
+            let got = DVec3::from(s.normal.map(f64::from)) / f64::from(NORMAL_ONE);
+            assert!(
+                got.dot(want) > 1f64.to_radians().cos(),
+                "{v:?} {got} {want}"
+            );
+            // Every boundary voxel is inside, with an outside neighbour.
+            assert!(block.at_voxel(*v).unwrap() >= block.threshold);
+        }
+    }
     // The world box and the raster box agree.
     let wb = placed.world_bounds();
     assert_eq!(wb.min, centre_world + DVec3::new(-8.5, -8.5, -9.25));
@@ -399,6 +462,19 @@ fn anisotropic_volume_in_cubic_raster_voxels() {
     assert_eq!(wb.max, centre_world + DVec3::new(8.5, 8.5, 8.25));
     assert_eq!(first, [11, 12, 13]);
     assert_eq!(n, [18, 18, 17]);
+}
+
+/// Every offer of a voxelizer, each voxel at most once.
+#[derive(Default)]
+struct Collect(std::collections::BTreeMap<[u32; 3], Surfel>);
+
+impl VoxelSink for Collect {
+    fn offer(&mut self, voxel: [u32; 3], surfel: Surfel) {
+        assert!(
+            self.0.insert(voxel, surfel).is_none(),
+            "{voxel:?} offered twice"
+        );
+    }
 }
 
 #[test]

@@ -471,7 +471,11 @@ pub(crate) const MIN_JUMP: u8 = 8;
 #[inline(always)]
 fn skip_count(cur: u8, todo: u32) -> u32 {
     let d = crate::proximity::distance(cur);
-    if d >= MIN_JUMP.wrapping_add(2) { u32::from(d.wrapping_sub(2)).min(todo) } else { 1 }
+    if d >= MIN_JUMP.wrapping_add(2) {
+        u32::from(d.wrapping_sub(2)).min(todo)
+    } else {
+        1
+    }
 }
 
 /// The number of crossings `n` of a minor axis among the next `k ≥ 2`
@@ -541,7 +545,16 @@ mod tests {
             let r = Reciprocal::new(i64::try_from(d >> 1).unwrap().max(2));
             let n = next() >> (next() % 64);
             assert_eq!(r.div(n), n / r.d, "{n} / {}", r.d);
-            for edge in [0, 1, r.d - 1, r.d, r.d + 1, u64::MAX, u64::MAX - 1, r.d.wrapping_mul(r.m)] {
+            for edge in [
+                0,
+                1,
+                r.d - 1,
+                r.d,
+                r.d + 1,
+                u64::MAX,
+                u64::MAX - 1,
+                r.d.wrapping_mul(r.m),
+            ] {
                 assert_eq!(r.div(edge), edge / r.d, "{edge} / {}", r.d);
             }
         }

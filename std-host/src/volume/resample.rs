@@ -40,7 +40,8 @@ use std::ops::Range;
 
 use glam::{DAffine3, DMat3, DVec3};
 use rayon::prelude::*;
-use rrt_core::voxelize::{Surfel, VoxelSink};
+use rrt_core::voxelize::volume::{self, Block};
+use rrt_core::voxelize::{Separation, Surfel, VoxelSink};
 
 use super::{Classifier, DimsFmt, Grid, Limits, SampleType, Samples, Volume, VolumeError};
 use crate::fit::RasterFrame;
@@ -532,6 +533,59 @@ impl<'a> PlacedVolume<'a> {
             )?;
             Ok((block, s..e))
         }))
+    }
+
+    /// Voxelizes the placed volume into `sink` with the core's volume
+    /// voxelizer (`rrt_core::voxelize::volume::boundary`: the boundary
+    /// layer of the classified voxels, gray-level gradient normals), in z
+    /// slabs of at most `max_block_bytes` each ([`PlacedVolume::raster_slabs`]),
+    /// so memory stays bounded whatever the volume's size. The voxels and
+    /// surfels are the same as for one whole block. Returns the voxels
+    /// offered (each once).
+    ///
+    /// # Errors
+    /// As [`PlacedVolume::raster_slabs`]; [`VolumeError::Invalid`] if the
+    /// core refuses a block (offsets beyond its coordinate limit).
+    pub fn voxelize<S: VoxelSink + ?Sized>(
+        &self,
+        frame: &RasterFrame,
+        classifier: &Classifier,
+        separation: Separation,
+        max_block_bytes: u64,
+        sink: &mut S,
+    ) -> Result<u64, VolumeError> {
+        struct Count<'s, S: ?Sized>(&'s mut S, u64);
+        impl<S: VoxelSink + ?Sized> VoxelSink for Count<'_, S> {
+            fn offer(&mut self, voxel: [u32; 3], surfel: Surfel) {
+                self.1 += 1;
+                self.0.offer(voxel, surfel);
+            }
+        }
+        let mut counted = Count(sink, 0);
+        for slab in self.raster_slabs(frame, classifier, max_block_bytes)? {
+            let (block, z) = slab?;
+            let core_block = Block {
+                samples: &block.samples,
+                dims: block.dims,
+                offset: block.offset,
+            };
+            let mut clip = ClipZ {
+                z,
+                sink: &mut counted,
+            };
+            volume::boundary(
+                &core_block,
+                block.threshold,
+                separation,
+                frame.extent,
+                &mut clip,
+            )
+            .map_err(|e| VolumeError::Invalid {
+                what: "volume voxelization".into(),
+                msg: e.to_string(),
+            })?;
+        }
+        Ok(counted.1)
     }
 
     fn block_for(
