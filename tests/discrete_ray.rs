@@ -357,10 +357,10 @@ fn skipping_changes_nothing_but_the_step_count() {
         // Larger rasters than the oracle test's, so that distances reach 63.
         case.dims = case.dims.map(|d| d * 4);
         let e = Extent::new(case.dims[0], case.dims[1], case.dims[2]).unwrap();
-        let per_mille = rng.below(4);
+        let per_100k = rng.below(40);
         let mut plane: Vec<u8> = (0..e.len())
             .map(|_| {
-                if rng.below(1000) < per_mille {
+                if rng.below(100_000) < per_100k {
                     cell::OPAQUE
                 } else {
                     0
