@@ -464,6 +464,48 @@ fn anisotropic_volume_in_cubic_raster_voxels() {
     assert_eq!(n, [18, 18, 17]);
 }
 
+/// The paper's Figure 1 cut: a box subtracted from a solid volume before
+/// its boundary is found exposes a closed cut face whose normals point
+/// into the cut.
+#[test]
+fn csg_cut_exposes_the_cut_face() {
+    let grid = Grid::axis_aligned([1.0; 3], DVec3::ZERO);
+    let ball = |p: DVec3| 1000.0 - 100.0 * (p - DVec3::splat(10.0)).length();
+    let v = computed::sample(&ball, [21; 3], grid, &Limits::default()).unwrap();
+    let placed = Placement::IDENTITY.place(&v);
+    let frame = RasterFrame {
+        extent: Extent::cube(24).unwrap(),
+        origin: DVec3::splat(-1.5),
+        voxel_size: 1.0,
+    };
+    let c = Classifier::iso(200.0); // r = 8
+    // Voxel i has centre i − 1: keep x < 10 (voxels 0..=10): the half ball.
+    let keep = |v: [u32; 3]| v[0] <= 10;
+    let mut cut = Collect::default();
+    placed
+        .voxelize_where(&frame, &c, Separation::Six, 1 << 20, Some(&keep), &mut cut)
+        .unwrap();
+    let mut whole = Collect::default();
+    placed
+        .voxelize(&frame, &c, Separation::Six, 1 << 20, &mut whole)
+        .unwrap();
+    assert!(cut.0.keys().all(|v| v[0] <= 10));
+    // The cut face: voxels at x = 10 well inside the disc, normals +x.
+    let face: Vec<_> = cut
+        .0
+        .iter()
+        .filter(|(v, _)| v[0] == 10 && (f64::from(v[1]) - 11.0).hypot(f64::from(v[2]) - 11.0) < 6.0)
+        .collect();
+    assert!(face.len() > 90, "{}", face.len());
+    for (v, s) in &face {
+        assert!(
+            !whole.0.contains_key(*v),
+            "{v:?} was interior before the cut"
+        );
+        assert!(s.normal[0] > NORMAL_ONE / 2, "{v:?} {:?}", s.normal);
+    }
+}
+
 /// Every offer of a voxelizer, each voxel at most once.
 #[derive(Default)]
 struct Collect(std::collections::BTreeMap<[u32; 3], Surfel>);

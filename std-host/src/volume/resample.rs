@@ -47,6 +47,10 @@ use super::{Classifier, DimsFmt, Grid, Limits, SampleType, Samples, Volume, Volu
 use crate::fit::RasterFrame;
 use crate::scene::Bounds;
 
+/// A predicate on raster voxels: which to keep (see
+/// [`PlacedVolume::voxelize_where`]).
+pub type Keep<'k> = &'k (dyn Fn([u32; 3]) -> bool + Sync);
+
 /// Largest value of the raster grid's samples.
 pub const SAMPLE_MAX: u16 = u16::MAX;
 
@@ -473,8 +477,7 @@ impl<'a> PlacedVolume<'a> {
         let Some((first, n)) = self.raster_box(frame) else {
             return Ok(None);
         };
-        let z = first[2]..first[2] + n[2];
-        self.block_for(frame, classifier, first, n, z, max_bytes)
+        self.block_for(frame, classifier, first, n, None, max_bytes)
             .map(Some)
     }
 
@@ -493,6 +496,19 @@ impl<'a> PlacedVolume<'a> {
         frame: &'s RasterFrame,
         classifier: &'s Classifier,
         max_bytes: u64,
+    ) -> Result<
+        impl Iterator<Item = Result<(RasterBlock, Range<u32>), VolumeError>> + 's,
+        VolumeError,
+    > {
+        self.slabs(frame, classifier, max_bytes, None)
+    }
+
+    fn slabs<'s>(
+        &'s self,
+        frame: &'s RasterFrame,
+        classifier: &'s Classifier,
+        max_bytes: u64,
+        keep: Option<Keep<'s>>,
     ) -> Result<
         impl Iterator<Item = Result<(RasterBlock, Range<u32>), VolumeError>> + 's,
         VolumeError,
@@ -528,7 +544,7 @@ impl<'a> PlacedVolume<'a> {
                 classifier,
                 [first[0], first[1], lo],
                 [n[0], n[1], hi - lo],
-                s..e,
+                keep,
                 max_bytes,
             )?;
             Ok((block, s..e))
@@ -554,6 +570,26 @@ impl<'a> PlacedVolume<'a> {
         max_block_bytes: u64,
         sink: &mut S,
     ) -> Result<u64, VolumeError> {
+        self.voxelize_where(frame, classifier, separation, max_block_bytes, None, sink)
+    }
+
+    /// [`PlacedVolume::voxelize`] keeping only the raster voxels for which
+    /// `keep` is true: the others count as transparent *before* the
+    /// boundary layer is found, so a CSG cut (the paper's box subtracted
+    /// from the MRI head) exposes a closed cut surface, whose gray-level
+    /// normals point out of the remaining volume into the cut.
+    ///
+    /// # Errors
+    /// As [`PlacedVolume::voxelize`].
+    pub fn voxelize_where<S: VoxelSink + ?Sized>(
+        &self,
+        frame: &RasterFrame,
+        classifier: &Classifier,
+        separation: Separation,
+        max_block_bytes: u64,
+        keep: Option<Keep<'_>>,
+        sink: &mut S,
+    ) -> Result<u64, VolumeError> {
         struct Count<'s, S: ?Sized>(&'s mut S, u64);
         impl<S: VoxelSink + ?Sized> VoxelSink for Count<'_, S> {
             fn offer(&mut self, voxel: [u32; 3], surfel: Surfel) {
@@ -562,7 +598,7 @@ impl<'a> PlacedVolume<'a> {
             }
         }
         let mut counted = Count(sink, 0);
-        for slab in self.raster_slabs(frame, classifier, max_block_bytes)? {
+        for slab in self.slabs(frame, classifier, max_block_bytes, keep)? {
             let (block, z) = slab?;
             let core_block = Block {
                 samples: &block.samples,
@@ -594,7 +630,7 @@ impl<'a> PlacedVolume<'a> {
         classifier: &Classifier,
         first: [u32; 3],
         n: [u32; 3],
-        _owned: Range<u32>,
+        keep: Option<Keep<'_>>,
         max_bytes: u64,
     ) -> Result<RasterBlock, VolumeError> {
         classifier.validate()?;
@@ -632,6 +668,17 @@ impl<'a> PlacedVolume<'a> {
                         let Some(v) = self.volume.sample_index(to_index.transform_point3(w)) else {
                             continue;
                         };
+                        if let Some(keep) = keep {
+                            // Voxel coordinates below 2^16 + 2^16: fit u32.
+                            let vox = [
+                                first[0] + i as u32,
+                                first[1] + jn as u32,
+                                first[2] + k as u32,
+                            ];
+                            if !keep(vox) {
+                                continue;
+                            }
+                        }
                         let q = quant.quantize(v);
                         *out = if classifier.is_opaque(v) {
                             q.max(threshold)
