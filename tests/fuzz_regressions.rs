@@ -58,3 +58,12 @@ fn voxelize_inputs_replay() {
         rrt_tests::voxelize_case::run(input);
     }
 }
+
+#[test]
+fn nrrd_inputs_replay() {
+    for (name, bytes) in inputs("nrrd") {
+        if let Err(broken) = rrt_host::volume::check::nrrd_input(&bytes) {
+            panic!("{name}: {broken}");
+        }
+    }
+}

@@ -25,6 +25,10 @@
 //! * `check` (feature `check`): invariant checkers shared by tests and
 //!   fuzz targets.
 //! * [`cli`]: the `rrt` command line (the binary only parses arguments).
+//! * [`volume`]: sampled (NRRD, raw) and computed volumes, resampling,
+//!   placement in the world and classification.
+//! * [`texture`]: image maps and solid textures, precomputed per voxel.
+//! * [`vox`]: MagicaVoxel `.vox` models.
 
 #![forbid(unsafe_code)]
 
@@ -41,5 +45,8 @@ pub mod rasterfile;
 pub mod render;
 pub mod scene;
 pub mod shade;
+pub mod texture;
 pub mod trace;
+pub mod volume;
+pub mod vox;
 pub mod world;
