@@ -27,8 +27,10 @@ fn pixel(x: u32, y: u32) -> [u8; 3] {
     [(60 * x) as u8, (100 * y) as u8, 7]
 }
 
-fn write_png() -> PathBuf {
-    let p = tmp("4x2.png");
+/// Writes the 4×2 image to a file of its own per caller (tests run in
+/// parallel in one process, so a shared path would race).
+fn write_png(tag: &str) -> PathBuf {
+    let p = tmp(&format!("4x2-{tag}.png"));
     let img = image::RgbImage::from_fn(4, 2, |x, y| image::Rgb(pixel(x, y)));
     img.save(&p).unwrap();
     p
@@ -38,7 +40,7 @@ const UP: DVec3 = DVec3::Z;
 
 #[test]
 fn planar_mapping_through_the_raster_frame() {
-    let png = write_png();
+    let png = write_png("1");
     // The image spans 4 × 2 world units on the xy plane: one unit a pixel.
     let planar = Mapping::Planar {
         origin: DVec3::ZERO,
@@ -111,7 +113,7 @@ fn planar_mapping_through_the_raster_frame() {
 
 #[test]
 fn cylindrical_and_spherical_mapping() {
-    let png = write_png();
+    let png = write_png("2");
     let cyl = ImageTexture::open(
         &png,
         Mapping::Cylindrical {
@@ -246,7 +248,7 @@ fn jpeg_and_bad_image_files() {
     std::fs::write(&gif, b"GIF89a\x01\x00\x01\x00\x00\x00\x00;").unwrap();
     let e = ImageTexture::open(&gif, planar).unwrap_err().to_string();
     assert!(e.contains("not an image: a Gif image"), "{e}");
-    let png = std::fs::read(write_png()).unwrap();
+    let png = std::fs::read(write_png("3")).unwrap();
     let cut = tmp("cut.png");
     std::fs::write(&cut, &png[..png.len() / 2]).unwrap();
     let e = ImageTexture::open(&cut, planar).unwrap_err();
