@@ -256,8 +256,16 @@ fn project(n: [i64; 3]) -> ([i128; 2], i128) {
 }
 
 /// The unnormalized direction of an octahedral pair, components in
-/// `[-32767, 32767]` (`|x| + |y| + |z| = 32767`).
-fn unfold(e: [i16; 2]) -> [i64; 3] {
+/// `[-32767, 32767]` (`|x| + |y| + |z| = 32767`): what [`decode_normal`]
+/// normalizes. Hosts that normalize in floating point start from this.
+///
+/// ```
+/// use rrt_core::voxel::{encode_normal, unfold};
+/// use rrt_core::voxelize::NORMAL_ONE;
+/// assert_eq!(unfold(encode_normal([0, 0, -NORMAL_ONE])), [0, 0, -32767]);
+/// ```
+#[must_use]
+pub fn unfold(e: [i16; 2]) -> [i64; 3] {
     let one = i64::from(SNORM16_ONE);
     let c = |v: i16| i64::from(v).clamp(one.wrapping_neg(), one);
     let (u, v) = (c(e[0]), c(e[1]));

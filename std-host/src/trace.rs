@@ -241,10 +241,20 @@ fn slab(o: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
     (t0 <= t1).then_some((t0, t1))
 }
 
-/// The unit vector of a stored octahedral normal.
+/// `x` rounded to the nearest integer, halves away from zero, saturating:
+/// `f64::round` is a library call on the baseline x86-64 target, and this
+/// runs twice per axis for every ray. (The fixed-point ray is whatever this
+/// gives: any deterministic rounding would do.)
+#[inline]
+fn round_to_int(x: f64) -> i64 {
+    (x + 0.5f64.copysign(x)) as i64
+}
+
+/// The unit vector of a stored octahedral normal (unfolded in integers,
+/// normalized in floating point).
 fn decode(rec: &VoxelRecord) -> DVec3 {
-    let n = rec.normal_vector();
-    DVec3::new(f64::from(n[0]), f64::from(n[1]), f64::from(n[2])).normalize_or(DVec3::Z)
+    let n = rrt_core::voxel::unfold(rec.normal);
+    DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize_or(DVec3::Z)
 }
 
 fn rgb(c: [u8; 3]) -> DVec3 {
@@ -384,7 +394,7 @@ impl<'s> Tracer<'s> {
             return None;
         }
         let one = f64::from(1u32 << 30);
-        let dir = [d.x, d.y, d.z].map(|c| (c / m * one).round() as i32);
+        let dir = [d.x, d.y, d.z].map(|c| round_to_int(c / m * one) as i32);
         let mut o = self.frame.world_to_raster(ray.origin);
         // Origins beyond the core's range (a far camera) start just before
         // the raster box instead; the line is the same.
@@ -400,7 +410,7 @@ impl<'s> Tracer<'s> {
                 return None;
             }
         }
-        let fx = |v: f64| (v * VOXEL as f64).round() as i64;
+        let fx = |v: f64| round_to_int(v * VOXEL as f64);
         DiscreteRay::new(self.extent, [fx(o.x), fx(o.y), fx(o.z)], dir)
             .ok()
             .flatten()

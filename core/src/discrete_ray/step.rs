@@ -327,7 +327,8 @@ fn twenty_six_run<
     let mut cur = if SKIP { cells(idx).unwrap_or(0) } else { 0 };
     let mut visits = 0u32;
     // Division by inc_a for the jumps (inc_a > 0 whenever a jump is taken).
-    let by_a = Reciprocal::new(if SKIP { inc_a } else { 2 });
+    // Made at the first jump: most runs never jump.
+    let mut by_a: Option<Reciprocal> = None;
 
     // How the loop ended: exits write it, the loop body never does.
     // The budget is checked before the exit, as in `six_run`: a call that
@@ -348,6 +349,7 @@ fn twenty_six_run<
         // Far from every non-transparent voxel, take k 26-steps at once.
         let k = if SKIP { skip_count(cur, todo) } else { 1 };
         if SKIP && k > 1 {
+            let by_a = *by_a.get_or_insert_with(|| Reciprocal::new(inc_a));
             let (nb, lb) = jump_count(f1, k, by_a, inc_b);
             let (nc, lc) = jump_count(f2, k, by_a, inc_c);
             let kk = i64::from(k);
@@ -424,11 +426,15 @@ fn twenty_six_run<
         // numbers of minor crossings (exact: inc_a > 0 since the ray moved).
         // |k·inc| < 2^65, so this is done in i128, once per run.
         let kb = i128::from(k);
+        // The numerator is n·inc_a with n ≤ 2^16 and inc_a < 2^48: it fits
+        // u64, and the exact division by inc_a is one hardware division.
+        let ua = u64::try_from(inc_a).unwrap_or(1).max(1);
         let count = |e0: i64, e: i64, inc: i64| -> u32 {
             let num = i128::from(e0)
                 .wrapping_add(kb.wrapping_mul(i128::from(inc)))
                 .wrapping_sub(i128::from(e));
-            u32::try_from(num.checked_div(i128::from(inc_a)).unwrap_or(0)).unwrap_or(0)
+            let n = u64::try_from(num).unwrap_or(0).checked_div(ua).unwrap_or(0);
+            u32::try_from(n).unwrap_or(0)
         };
         let nb = count(start.err[0], e1, inc_b);
         let nc = count(start.err[1], e2, inc_c);
@@ -503,8 +509,8 @@ fn jump_count(f: i64, k: u32, by_a: Reciprocal, inc_m: i64) -> (i64, bool) {
 }
 
 /// Exact division by a constant through a multiplication: `⌊x / d⌋` for
-/// `x < 2^64`, `d ≥ 2`, from `m = ⌊2^64 / d⌋` (one 128-bit division, once
-/// per run). `⌊x·m / 2^64⌋` is `⌊x / d⌋` or one less, since
+/// `x < 2^64`, `d ≥ 2`, from `m = ⌊(2^64 − 1) / d⌋` (one 64-bit division,
+/// at a run's first jump). `⌊x·m / 2^64⌋` is `⌊x / d⌋` or one less, since
 /// `x/d − 1 < x·m/2^64 ≤ x/d`; one comparison corrects it.
 #[derive(Clone, Copy)]
 struct Reciprocal {
@@ -515,7 +521,9 @@ struct Reciprocal {
 impl Reciprocal {
     fn new(d: i64) -> Self {
         let d = u64::try_from(d).unwrap_or(0).max(2);
-        let m = u64::try_from((1u128 << 64).checked_div(u128::from(d)).unwrap_or(0)).unwrap_or(0);
+        // ⌊(2^64 − 1) / d⌋ = ⌊2^64 / d⌋ unless d divides 2^64, when it is one
+        // less: either way x·m/2^64 > x/d − 1, and a 64-bit division suffices.
+        let m = u64::MAX.checked_div(d).unwrap_or(0);
         Self { d, m }
     }
 
