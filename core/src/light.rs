@@ -69,7 +69,7 @@ use crate::fixed::{VOXEL, voxel_centre};
 use crate::object_table::{Lights, Materials, ObjectTable, SCALAR_BITS};
 use crate::raster::{Extent, Raster, cell};
 use crate::store::{RecordStore, RecordStoreMut};
-use crate::voxel::{LightVisibility, VoxelRecord, dot_unit, normalize};
+use crate::voxel::{LightVisibility, VoxelRecord, decode_normal, dot_unit, normalize};
 use crate::voxelize::NORMAL_ONE;
 
 /// Tuning of the shadow rays.
@@ -299,7 +299,7 @@ fn shade_record<const N: usize>(
             c0,
             light.position,
             side,
-            normal,
+            rec.normal,
             rec.object,
         )?;
         rec.set_light(i, vis);
@@ -371,7 +371,7 @@ fn shadow_ray<const N: usize>(
     c0: [i64; 3],
     light: [i64; 3],
     side: [i32; 3],
-    stored: [i32; 3],
+    stored: [i16; 2],
     object: u32,
 ) -> Result<LightVisibility, LightError> {
     let extent = raster.extent();
@@ -474,8 +474,10 @@ pub struct LeavingSurface {
     /// Unit normal ([`NORMAL_ONE`]-scaled) of the side the ray leaves
     /// towards: heights are measured along it.
     pub side: [i32; 3],
-    /// The stored normal of the voxel left (for the same-surface test).
-    pub stored: [i32; 3],
+    /// The stored normal of the voxel left, encoded as in
+    /// [`VoxelRecord::normal`] (for the same-surface test; decoded only
+    /// when a voxel of another object is met).
+    pub stored: [i16; 2],
     /// Object id of the voxel left.
     pub object: u32,
     /// Height above the tangent plane, fixed units, below which voxels of
@@ -514,7 +516,7 @@ impl LeavingSurface {
             start: extent.index(v),
             c0: v.map(voxel_centre),
             side,
-            stored: rec.normal_vector(),
+            stored: rec.normal,
             object: rec.object,
             slab: params.slab,
             same_surface_cos: params.same_surface_cos,
@@ -530,9 +532,17 @@ impl LeavingSurface {
         if Some(index) == self.start {
             return true;
         }
-        let Some(vb) = extent.coord(index) else {
-            return false;
-        };
+        extent
+            .coord(index)
+            .is_some_and(|vb| self.ignores_voxel(vb, b))
+    }
+
+    /// [`ignores`](Self::ignores) for a voxel given by its coordinates `vb`
+    /// (a caller that has them saves the division of
+    /// [`Extent::coord`]); the start voxel is recognized by its index only,
+    /// so a caller checks `Some(index) == self.start` first.
+    #[must_use]
+    pub fn ignores_voxel(&self, vb: [u32; 3], b: &VoxelRecord) -> bool {
         let d = sub(vb.map(voxel_centre), self.c0);
         // (c_b − c₀)·N₀ in fixed units: |d| < 2^33, |N| <= 2^30.
         let height = d
@@ -544,7 +554,8 @@ impl LeavingSurface {
         if height > i128::from(self.slab) {
             return false;
         }
-        b.object == self.object || dot_unit(b.normal_vector(), self.stored) >= self.same_surface_cos
+        b.object == self.object
+            || dot_unit(b.normal_vector(), decode_normal(self.stored)) >= self.same_surface_cos
     }
 }
 

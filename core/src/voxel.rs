@@ -381,8 +381,29 @@ fn cos2_score(n: [i64; 3], d: [i64; 3]) -> Option<(u128, u128)> {
 /// ```
 #[must_use]
 pub fn decode_normal(e: [i16; 2]) -> [i32; 3] {
-    // unfold never returns the zero vector (|x|+|y|+|z| = 32767).
-    normalize(unfold(e)).unwrap_or([0, 0, NORMAL_ONE])
+    // unfold gives |x| + |y| + |z| = 32767, so |v|² = L lies in
+    // [32767²/3, 32767²] ⊂ [2^28, 2^30): L·2^34 < 2^64, and
+    // len = ⌊2^17·|v|⌋ ≥ 2^31 is within 2^-31 of 2^17·|v| relatively.
+    // Each component c·2^47/len (c·2^47 < 2^62) is then within 0.25 of
+    // c·2^30/|v| before rounding: 64-bit integer work only, where
+    // `normalize` needs 128 bits for arbitrary inputs.
+    let v = unfold(e);
+    let l2 = v
+        .iter()
+        .map(|c| c.unsigned_abs().saturating_mul(c.unsigned_abs()))
+        .fold(0u64, u64::saturating_add);
+    let len = l2.checked_shl(34).unwrap_or(0).isqrt();
+    if len == 0 {
+        return [0, 0, NORMAL_ONE];
+    }
+    v.map(|c| {
+        let q = (c.unsigned_abs() << 47)
+            .saturating_add(len >> 1)
+            .checked_div(len)
+            .unwrap_or(0);
+        let q = i32::try_from(q).unwrap_or(NORMAL_ONE);
+        if c < 0 { q.wrapping_neg() } else { q }
+    })
 }
 
 /// Normalizes `v` to a unit vector scaled by [`NORMAL_ONE`], in integer
@@ -670,6 +691,33 @@ mod tests {
             assert!((l2 - one * one).abs() <= 4 * one, "{v:?}: {n:?}");
         }
         assert_eq!(normalize([i64::MIN, 0, 0]), Some([-NORMAL_ONE, 0, 0]));
+    }
+
+    #[test]
+    fn decode_is_normalize_of_unfold_within_one_unit() {
+        // Every 97th code on each axis, and the extremes.
+        let codes = (i16::MIN..=i16::MAX)
+            .step_by(97)
+            .chain([i16::MAX, -1, 0, 1]);
+        let codes: [i16; 680] = {
+            let mut a = [0i16; 680];
+            for (slot, c) in a.iter_mut().zip(codes) {
+                *slot = c;
+            }
+            a
+        };
+        for &u in &codes {
+            for &v in &codes {
+                let fast = decode_normal([u, v]);
+                let slow = normalize(unfold([u, v])).unwrap();
+                for (f, s) in fast.iter().zip(slow.iter()) {
+                    assert!(
+                        (i64::from(*f) - i64::from(*s)).abs() <= 1,
+                        "{u} {v}: {fast:?} {slow:?}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

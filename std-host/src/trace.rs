@@ -247,7 +247,7 @@ fn slab(o: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
 /// gives: any deterministic rounding would do.)
 #[inline]
 fn round_to_int(x: f64) -> i64 {
-    (x + 0.5f64.copysign(x)) as i64
+    crate::fit::round(x) as i64
 }
 
 /// The unit vector of a stored octahedral normal (unfolded in integers,
@@ -901,11 +901,18 @@ fn hit_test(
     if c & cell::OPAQUE == 0 {
         return false;
     }
-    match store.get(index) {
+    // The voxel being left is never a hit (and has a record: it was hit).
+    if leave.is_some_and(|l| l.start == Some(index)) {
+        return false;
+    }
+    let Some(v) = extent.coord(index) else {
+        return false;
+    };
+    match store.get_voxel(v) {
         None => {
             *missing += 1;
             false
         }
-        Some(rec) => leave.is_none_or(|l| !l.ignores(extent, index, rec)),
+        Some(rec) => leave.is_none_or(|l| !l.ignores_voxel(v, rec)),
     }
 }
