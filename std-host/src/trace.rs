@@ -444,7 +444,7 @@ impl<'s> Tracer<'s> {
     fn resolve(
         &self,
         ray: &Ray,
-        walk: FirstWalk,
+        walk: &mut FirstWalk,
         tmin: f64,
         leave: Option<&LeavingSurface>,
         stats: &mut RayStats,
@@ -460,13 +460,14 @@ impl<'s> Tracer<'s> {
     fn resolve_walk(
         &self,
         ray: &Ray,
-        mut walk: FirstWalk,
+        walk: &mut FirstWalk,
         tmin: f64,
         leave: Option<&LeavingSurface>,
         stats: &mut RayStats,
     ) -> Option<SurfaceHit> {
         stats.steps += walk.steps;
-        let mut dray = walk.ray.take()?;
+        // Resumed in place: a discrete ray is a few hundred bytes.
+        let dray = walk.ray.as_mut()?;
         let mut end = walk.end;
         let o_r = self.frame.world_to_raster(ray.origin);
         let vs = self.frame.voxel_size;
@@ -638,7 +639,7 @@ impl<'s> Tracer<'s> {
         leave: Option<&LeavingSurface>,
         stats: &mut RayStats,
     ) -> DVec3 {
-        let walk = match leave {
+        let mut walk = match leave {
             None => self.first_walk(ray),
             Some(rule) => self.secondary_walk(ray, rule, stats),
         };
@@ -648,7 +649,7 @@ impl<'s> Tracer<'s> {
         } else {
             0.0
         };
-        match self.resolve(ray, walk, tmin, leave, stats) {
+        match self.resolve(ray, &mut walk, tmin, leave, stats) {
             None => self.background,
             Some(h) => {
                 stats.hits += 1;
@@ -827,14 +828,14 @@ impl<'s> Tracer<'s> {
     /// Stage one walks every ray to its first non-transparent voxel; stage
     /// two resolves and shades each (module docs, *For packets*).
     pub fn trace_block(&self, rays: &[Option<Ray>; BLOCK], stats: &mut RayStats) -> [DVec3; BLOCK] {
-        let walks = if self.opts.packets {
+        let mut walks = if self.opts.packets {
             self.first_walks_packet(rays)
         } else {
             rays.map(|r| r.map(|r| self.first_walk(&r)))
         };
         let mut out = [DVec3::ZERO; BLOCK];
-        for ((o, r), w) in out.iter_mut().zip(rays).zip(walks) {
-            let (Some(r), Some(w)) = (r, w) else {
+        for ((o, r), w) in out.iter_mut().zip(rays).zip(walks.iter_mut()) {
+            let (Some(r), Some(w)) = (r, w.as_mut()) else {
                 continue;
             };
             stats.primary += 1;
