@@ -101,6 +101,30 @@ fn render_writes_a_png_and_one_summary_line() {
     ])
     .unwrap();
     assert!(q.is_empty());
+    // Exact shadows: with verification only.
+    let x = |extra: &[&str]| {
+        let mut a = vec![
+            "render",
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--raster",
+            "64",
+            "--exact-shadows",
+        ];
+        a.extend_from_slice(extra);
+        cli(&a)
+    };
+    let e = x(&[]).unwrap_err();
+    assert!(e.contains("--verify"), "{e}");
+    let s = x(&["--verify"]).unwrap();
+    assert!(
+        s.contains("exact shadows") && !s.contains(" 0 shadow"),
+        "{s}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -404,24 +404,40 @@ fn verification_rejects_known_false_hits() {
 /// measured when they were set (printed by the test).
 #[test]
 fn psnr_floor_against_embree_nff() {
-    let cases: [(&str, PathBuf, f64, f64); 3] = [
-        // (ground truth, scene, basic floor, verified floor)
-        ("tetra-256.png", data("tetra.nff"), 27.5, 50.0),
-        ("balls1-256.png", data("balls1.nff"), 22.0, 27.0),
-        ("balls2-256.png", balls2(), 19.0, 23.5),
+    let cases: [(&str, PathBuf, [f64; 3]); 3] = [
+        // (ground truth, scene, floors: basic, verified, verified + exact shadows)
+        ("tetra-256.png", data("tetra.nff"), [27.5, 50.0, 50.0]),
+        ("balls1-256.png", data("balls1.nff"), [22.0, 27.0, 43.0]),
+        ("balls2-256.png", balls2(), [19.0, 23.5, 36.0]),
     ];
-    for (gt, scene, basic_floor, verified_floor) in cases {
+    for (gt, scene, floors) in cases {
         let (w, h, expect) = read_png(&data("embree").join(gt));
         let vs = voxelize(&Scene::load(&scene).unwrap(), 512, Connectivity::Adaptive);
-        for (verify, floor) in [(false, basic_floor), (true, verified_floor)] {
+        let modes = [(false, false), (true, false), (true, true)];
+        let mut got = [0.0; 3];
+        for (((verify, exact_shadows), floor), p) in modes.into_iter().zip(floors).zip(&mut got) {
             let opts = TraceOptions {
                 verify,
+                exact_shadows,
                 ..TraceOptions::default()
             };
             let (img, _) = draw(&vs, w, h, opts, 1, 0);
-            let p = psnr(&img.rgb, &expect);
-            eprintln!("{gt}: raster 512, verify {verify}: PSNR {p:.2} dB (floor {floor})");
-            assert!(p >= floor, "{gt} verify {verify}: PSNR {p:.2} dB < {floor}");
+            *p = psnr(&img.rgb, &expect);
+            eprintln!(
+                "{gt}: raster 512, verify {verify}, exact shadows {exact_shadows}: \
+                 PSNR {p:.2} dB (floor {floor})"
+            );
+            assert!(
+                *p >= floor,
+                "{gt} verify {verify} exact {exact_shadows}: PSNR {p:.2} dB < {floor}"
+            );
         }
+        // Exact shadows never make a verified image worse.
+        assert!(
+            got[2] >= got[1] - 0.05,
+            "{gt}: exact shadows {:.2} < verified {:.2}",
+            got[2],
+            got[1]
+        );
     }
 }

@@ -35,6 +35,11 @@ pub struct RenderArgs {
     /// object's exact geometry, use the true point and normal.
     #[arg(long)]
     pub verify: bool,
+    /// Exact shadows at verified hits: a render-time shadow ray per light,
+    /// each object it meets intersected exactly (slower; beyond the
+    /// paper, which uses the precomputed light visibility).
+    #[arg(long, requires = "verify")]
+    pub exact_shadows: bool,
     /// K×K rays per pixel, box-filtered.
     #[arg(long, value_name = "K", default_value_t = 1)]
     pub supersample: u32,
@@ -82,6 +87,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             depth: args.depth,
             verify: args.verify,
             packets: args.packets,
+            exact_shadows: args.exact_shadows,
             ..TraceOptions::default()
         },
     )?;
@@ -118,7 +124,13 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             d[1],
             d[2],
             rrt_core::Connectivity::from(args.raster.connectivity).name(),
-            if args.verify { ", verified" } else { "" },
+            if args.exact_shadows {
+                ", verified, exact shadows"
+            } else if args.verify {
+                ", verified"
+            } else {
+                ""
+            },
             args.depth,
             secs(time),
             stats.primary,
