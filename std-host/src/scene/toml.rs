@@ -348,8 +348,8 @@ struct SolidDef {
 #[derive(Deserialize)]
 #[serde(untagged)]
 enum CsgExpr {
-    Leaf(Spanned<String>),
-    Op(Spanned<CsgOp>),
+    Leaf(String),
+    Op(CsgOp),
 }
 
 #[derive(Deserialize)]
@@ -464,7 +464,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene
         let at = e.span().map_or(0, |s| s.start);
         SceneError::Toml {
             loc: byte_loc(&file, text.as_bytes(), at),
-            key: String::new(),
+            key: key_before(text, at),
             msg: e.message().trim().to_owned(),
         }
     })?;
@@ -1224,19 +1224,20 @@ impl Builder<'_> {
     fn solid(
         &self,
         doc: &Doc,
-        name: &Spanned<String>,
+        name: &str,
+        at: &std::ops::Range<usize>,
         default_material: Option<usize>,
     ) -> Result<CsgLeaf, SceneError> {
-        let Some(def) = doc.solid.get(name.get_ref()) else {
+        let Some(def) = doc.solid.get(name) else {
             return Err(self.err(
-                name.span(),
+                at.clone(),
                 "object.csg",
-                format!("no [solid.{}] in this scene", name.get_ref()),
+                format!("no [solid.{name}] in this scene"),
             ));
         };
         let s = def.span();
         let d = def.get_ref();
-        let key = format!("solid.{}", name.get_ref());
+        let key = format!("solid.{name}");
         let material = match (&d.material, default_material) {
             (Some(m), _) => self.material_of(Some(m), &s, &format!("{key}.material"))?,
             (None, Some(m)) => m,
@@ -1315,7 +1316,14 @@ impl Builder<'_> {
             leaves: Vec::new(),
             loc: self.loc(s.clone()),
         };
-        self.csg_op(doc, root, default_material, &mut csg, 0)?;
+        self.csg_op(
+            doc,
+            root.get_ref(),
+            &root.span(),
+            default_material,
+            &mut csg,
+            0,
+        )?;
         // The volume rule (module docs).
         let leaf_has_volume = |l: u16| {
             matches!(
@@ -1352,13 +1360,13 @@ impl Builder<'_> {
     fn csg_op(
         &self,
         doc: &Doc,
-        op: &Spanned<CsgOp>,
+        d: &CsgOp,
+        at: &std::ops::Range<usize>,
         material: Option<usize>,
         csg: &mut Csg,
         depth: usize,
     ) -> Result<u16, SceneError> {
-        let s = op.span();
-        let d = op.get_ref();
+        let s = at.clone();
         let too_big = || {
             self.err(
                 s.clone(),
@@ -1388,7 +1396,7 @@ impl Builder<'_> {
         for a in args {
             let id = match a {
                 CsgExpr::Leaf(name) => {
-                    let leaf = self.solid(doc, name, material)?;
+                    let leaf = self.solid(doc, name, at, material)?;
                     let l = u16::try_from(csg.leaves.len()).map_err(|_| too_big())?;
                     csg.leaves.push(leaf);
                     if csg.nodes.len() >= MAX_NODES {
@@ -1397,7 +1405,7 @@ impl Builder<'_> {
                     csg.nodes.push(CsgNode::Leaf(l));
                     u16::try_from(csg.nodes.len() - 1).map_err(|_| too_big())?
                 }
-                CsgExpr::Op(inner) => self.csg_op(doc, inner, material, csg, depth + 1)?,
+                CsgExpr::Op(inner) => self.csg_op(doc, inner, at, material, csg, depth + 1)?,
             };
             acc = Some(match acc {
                 None => id,
@@ -1447,6 +1455,24 @@ impl Builder<'_> {
         }));
         Ok(())
     }
+}
+
+/// The key whose value starts at byte `at` (`key = value` on that line),
+/// or empty: names the key of a wrong-typed value, which toml's message
+/// does not.
+fn key_before(text: &str, at: usize) -> String {
+    let Some(before) = text.get(..at) else {
+        return String::new();
+    };
+    let line = before.rsplit('\n').next().unwrap_or("");
+    let Some(lhs) = line.trim_end().strip_suffix('=') else {
+        return String::new();
+    };
+    let lhs = lhs.trim_end();
+    let start = lhs
+        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.'))
+        .map_or(0, |i| i + 1);
+    lhs.get(start..).unwrap_or("").to_owned()
 }
 
 /// A CSG tree of one solid: a closed primitive (torus, capped cone).
