@@ -194,12 +194,12 @@ impl Mask {
     fn contains(&self, v: [u32; 3]) -> bool {
         let mut i = 0usize;
         let mut stride = 1usize;
-        for k in 0..3 {
-            let Some(d) = v[k].checked_sub(self.lo[k]).filter(|&d| d < self.n[k]) else {
+        for ((&c, &lo), &n) in v.iter().zip(&self.lo).zip(&self.n) {
+            let Some(d) = c.checked_sub(lo).filter(|&d| d < n) else {
                 return false;
             };
             i += d as usize * stride;
-            stride *= self.n[k] as usize;
+            stride *= n as usize;
         }
         self.inside.get(i).copied().unwrap_or(false)
     }
@@ -289,7 +289,7 @@ pub fn volume(
 /// [`FitError::OutOfRange`] for a model too far out or cells too large.
 pub fn vox_placement(v: &VoxObject, frame: &RasterFrame) -> Result<VoxPlacement, BuildError> {
     let scale = (v.cell / frame.voxel_size).round().max(1.0);
-    if !(scale <= f64::from(MAX_VOX_SCALE)) {
+    if scale.is_nan() || scale > f64::from(MAX_VOX_SCALE) {
         return Err(out_of_range(&v.loc, "vox cell"));
     }
     let o = frame.world_to_raster(v.position).floor();

@@ -173,7 +173,6 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..tobj::LoadOptions::default()
     };
     let result = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)

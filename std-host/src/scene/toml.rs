@@ -955,11 +955,10 @@ impl Builder<'_> {
             None => DAffine3::IDENTITY,
             Some(t) => {
                 let tr = self.vec3(&s, "object.transform.translate", t.translate)?;
-                if !(t.scale.is_finite() && t.scale > 0.0)
-                    || ![t.rotate_x, t.rotate_y, t.rotate_z]
-                        .iter()
-                        .all(|a| a.is_finite())
-                {
+                let angles_ok = [t.rotate_x, t.rotate_y, t.rotate_z]
+                    .iter()
+                    .all(|a| a.is_finite());
+                if !(t.scale.is_finite() && t.scale > 0.0 && angles_ok) {
                     return Err(self.err(
                         s,
                         "object.transform",
