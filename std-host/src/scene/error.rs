@@ -192,7 +192,7 @@ pub enum SceneError {
         msg: String,
     },
     /// No object.
-    #[error("{file}: no objects: the scene has no s, c, p or pp (or TOML [[object]])")]
+    #[error("{file}: no objects: the scene has no s, c, p or pp")]
     NoObjects {
         /// The file.
         file: Arc<str>,

@@ -326,7 +326,8 @@ mod tests {
         )
         .unwrap_err()
         .to_string();
-        assert!(e.starts_with("t.obj:5:10: OBJ: face normal index"), "{e}");
+        // The column of the face vertex `2//0` that holds the bad index.
+        assert!(e.starts_with("t.obj:5:8: OBJ: face normal index"), "{e}");
         let e = parse("t.obj", "v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n")
             .unwrap_err()
             .to_string();
