@@ -67,3 +67,12 @@ fn nrrd_inputs_replay() {
         }
     }
 }
+
+#[test]
+fn scene_toml_inputs_replay() {
+    for (name, bytes) in inputs("scene_toml") {
+        if let Err(broken) = rrt_host::check::toml_input(&bytes) {
+            panic!("{name}: {broken}");
+        }
+    }
+}

@@ -25,6 +25,10 @@
 //! renderer ([`crate::trace`]) and the saved-raster file
 //! ([`crate::rasterfile`]) both start from it.
 //!
+//! Volumes, `.vox` models and CSG trees ([`crate::voxel_objects`]) go
+//! through both passes after the fitted primitives, with object ids after
+//! theirs. Textured materials colour each voxel once, in the fill pass.
+//!
 //! Materials are deduplicated (NFF files repeat identical `f` lines): the
 //! record's 16-bit material index then names a distinct material, and at
 //! most [`MAX_MATERIALS`] distinct ones are accepted.
@@ -51,9 +55,12 @@ use rrt_core::voxelize::{Separation, VoxelSink, cone, sphere, triangle};
 
 use crate::fit::{self, Bytes, FitError, FitOptions, Fitted, RasterFrame, Source};
 use crate::plane::Plane;
-use crate::scene::{Material, Scene, SourceLoc, View};
+use crate::scene::{Material, Scene, SourceLoc, TextureKind, View};
 use crate::shade;
-use crate::world::{WorldLight, WorldObject};
+use crate::texture::AnyTexture;
+use crate::texture::InRaster;
+use crate::voxel_objects::{self, Pass};
+use crate::world::{WorldLight, WorldObject, WorldShape};
 
 /// Records per run of the parallel light pass.
 const LIGHT_RUN: usize = 1 << 14;
@@ -375,6 +382,45 @@ fn core_shape(shape: &fit::Shape) -> object_table::Shape {
     }
 }
 
+/// The scene material of extra object `e` (volumes, then `.vox` models,
+/// then CSG trees, in scene order): a CSG tree's is its first leaf's.
+fn extra_material(scene: &Scene, e: usize) -> usize {
+    let nv = scene.volumes.len();
+    let nx = scene.voxes.len();
+    if let Some(v) = scene.volumes.get(e) {
+        v.material
+    } else if let Some(v) = scene.voxes.get(e.wrapping_sub(nv)) {
+        v.material
+    } else {
+        scene
+            .csgs
+            .get(e.wrapping_sub(nv + nx))
+            .and_then(|c| c.leaves.first())
+            .map_or(0, |l| l.material)
+    }
+}
+
+/// Voxelizes extra object `e` (see [`extra_material`]) into `pass`.
+fn extra(
+    scene: &Scene,
+    e: usize,
+    frame: &RasterFrame,
+    separation: Separation,
+    pass: Pass<'_, '_, '_, '_>,
+) -> Result<(), BuildError> {
+    let nv = scene.volumes.len();
+    let nx = scene.voxes.len();
+    if let Some(v) = scene.volumes.get(e) {
+        voxel_objects::volume(v, frame, separation, pass)
+    } else if let Some(v) = scene.voxes.get(e.wrapping_sub(nv)) {
+        voxel_objects::vox(v, frame, pass)
+    } else if let Some(c) = scene.csgs.get(e.wrapping_sub(nv + nx)) {
+        voxel_objects::csg(c, frame, separation, pass)
+    } else {
+        Ok(())
+    }
+}
+
 fn alloc_err(what: &'static str, bytes: usize) -> impl FnOnce(std::io::Error) -> BuildError {
     move |source| BuildError::Alloc {
         what,
@@ -414,8 +460,24 @@ pub fn build(
         directory_len(extent).ok_or_else(|| BuildError::Raster("too many bricks".into()))?;
     let mut directory = vec![0u32; dir_len];
 
-    let n = fitted.objects.len();
+    let n_fitted = fitted.objects.len();
+    let extras = scene.volumes.len() + scene.voxes.len() + scene.csgs.len();
+    let n = n_fitted + extras;
     progress.set_length(u64::try_from(2 * n).unwrap_or(u64::MAX));
+    // Each texture once, in the raster.
+    let textures: Vec<InRaster<AnyTexture>> = scene
+        .textures
+        .iter()
+        .map(|t| match &t.kind {
+            TextureKind::World(w) => voxel_objects::in_raster(w, frame, t.blend),
+        })
+        .collect();
+    let texture_of = |m: usize| {
+        scene
+            .material_textures
+            .get(&m)
+            .and_then(|&t| textures.get(t))
+    };
     progress.set_message("voxelizing (count pass)");
     let raster =
         RasterMut::new(extent, &mut plane).map_err(|e| BuildError::Raster(e.to_string()))?;
@@ -425,6 +487,10 @@ pub fn build(
             let (loc, what) = source_loc(scene, o.source);
             BuildError::Voxelize { loc, what, source }
         })?;
+        progress.inc(1);
+    }
+    for e in 0..extras {
+        extra(scene, e, &frame, separation, Pass::Count(&mut counter))?;
         progress.inc(1);
     }
     let offers = counter.report().offers;
@@ -462,10 +528,41 @@ pub fn build(
             material,
             color: colour,
         })?;
-        voxelize_shape(&o.shape, separation, extent, &mut filler).map_err(|source| {
+        let voxelized = match texture_of(o.material) {
+            Some(t) => voxelize_shape(&o.shape, separation, extent, &mut filler.textured(t)),
+            None => voxelize_shape(&o.shape, separation, extent, &mut filler),
+        };
+        voxelized.map_err(|source| {
             let (loc, what) = source_loc(scene, o.source);
             BuildError::Voxelize { loc, what, source }
         })?;
+        progress.inc(1);
+    }
+    let attrs_of = |id: usize, scene_material: usize| {
+        let material = mat_of(scene_material);
+        ObjectAttrs {
+            object: u32::try_from(id).unwrap_or(u32::MAX),
+            material,
+            color: materials
+                .get(usize::from(material))
+                .map_or([0; 3], |m| core_material(m).color_u8()),
+        }
+    };
+    for e in 0..extras {
+        let id = n_fitted + e;
+        let m = extra_material(scene, e);
+        let leaves = scene
+            .csgs
+            .get(e.wrapping_sub(scene.volumes.len() + scene.voxes.len()))
+            .map(|c| c.leaves.iter().map(|l| attrs_of(id, l.material)).collect())
+            .unwrap_or_default();
+        let pass = Pass::Fill {
+            filler: &mut filler,
+            attrs: attrs_of(id, m),
+            leaves,
+            texture: texture_of(m),
+        };
+        extra(scene, e, &frame, separation, pass)?;
         progress.inc(1);
     }
     let built = filler.finish()?;
@@ -481,6 +578,12 @@ pub fn build(
         let _ = table.push(Object {
             shape: core_shape(&o.shape),
             material: mat_of(o.material),
+        });
+    }
+    for e in 0..extras {
+        let _ = table.push(Object {
+            shape: object_table::Shape::Voxels,
+            material: mat_of(extra_material(scene, e)),
         });
     }
     let mut core_materials: Box<Materials<MAX_MATERIALS>> = Box::default();
@@ -549,6 +652,12 @@ pub fn build(
             WorldObject::from_fitted(scene, o, mat_of(o.material))
                 .ok_or_else(|| BuildError::Raster("fitted object without its source".into()))
         })
+        .chain((0..extras).map(|e| {
+            Ok(WorldObject {
+                shape: WorldShape::Voxels,
+                material: mat_of(extra_material(scene, e)),
+            })
+        }))
         .collect::<Result<Vec<_>, _>>()?;
     let world_lights = scene
         .lights

@@ -62,3 +62,36 @@ pub fn nff_input(data: &[u8]) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// The checks of the `scene_toml` fuzz target (shared with
+/// `tests/fuzz_regressions.rs`) on arbitrary bytes: the TOML scene parser
+/// (with no file reads) must not panic; an error must name the input file
+/// (`fuzz.toml`); a scene that parses must keep every guarantee of
+/// [`crate::scene::Scene`] and fit a small raster or return a `FitError`.
+///
+/// # Errors
+/// A description of the first broken guarantee.
+pub fn toml_input(data: &[u8]) -> Result<(), String> {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Ok(());
+    };
+    let opts = crate::scene::toml::Options {
+        read_files: false,
+        ..crate::scene::toml::Options::default()
+    };
+    match crate::scene::toml::parse("fuzz.toml", text, std::path::Path::new("."), &opts) {
+        Err(e) => {
+            let msg = e.to_string();
+            if msg.starts_with("fuzz.toml") {
+                Ok(())
+            } else {
+                Err(format!("error does not name the file: {msg}"))
+            }
+        }
+        Ok(scene) => {
+            check_scene(&scene)?;
+            let _ = fit(&scene, &FitOptions::new(16));
+            Ok(())
+        }
+    }
+}

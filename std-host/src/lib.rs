@@ -2,8 +2,8 @@
 //!
 //! Everything around the integer core `rrt-core`, with std and `f64`:
 //!
-//! * [`scene`]: NFF scenes in world coordinates and their strict parser,
-//!   with located errors.
+//! * [`scene`]: NFF and TOML scenes in world coordinates and their strict
+//!   parsers, with located errors.
 //! * [`camera`]: the pinhole camera of `embree_nff` (rays through pixel
 //!   centres), with supersampling positions.
 //! * [`fit`]: fitting the 3D raster to a scene: world → fixed-point raster
@@ -29,6 +29,8 @@
 //!   placement in the world and classification.
 //! * [`texture`]: image maps and solid textures, precomputed per voxel.
 //! * [`vox`]: MagicaVoxel `.vox` models.
+//! * [`voxel_objects`]: volumes, `.vox` models and CSG trees in the build
+//!   pipeline.
 
 #![forbid(unsafe_code)]
 
@@ -49,4 +51,5 @@ pub mod texture;
 pub mod trace;
 pub mod volume;
 pub mod vox;
+pub mod voxel_objects;
 pub mod world;

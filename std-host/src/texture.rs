@@ -348,7 +348,7 @@ impl Mapping {
 }
 
 /// An RGB image mapped onto surfaces.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ImageTexture {
     width: u32,
     height: u32,
@@ -877,7 +877,7 @@ impl WorldTexture for Wood {
 }
 
 /// Any of the textures, for scenes that choose one at run time.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum AnyTexture {
     /// An image map.
     Image(ImageTexture),

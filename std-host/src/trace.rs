@@ -530,6 +530,7 @@ impl<'s> Tracer<'s> {
         let lo = DVec3::from(v.map(f64::from));
         if self.opts.verify
             && let Some(obj) = self.objects.get(usize::try_from(rec.object).ok()?)
+            && obj.shape.is_exact()
         {
             let verdict = verify(&self.frame, obj, ray, v, tmin);
             if let Verdict::Hit(hit) = verdict {

@@ -44,6 +44,11 @@ pub enum WorldShape {
         /// Per-vertex normals, interpolated by [`intersect::triangle`].
         normals: Option<[DVec3; 3]>,
     },
+    /// No continuous definition: the voxels are the object (volumes,
+    /// `.vox` models, CSG results). It has no exact intersection, so
+    /// intersection verification keeps the discrete hit with the stored
+    /// normal.
+    Voxels,
 }
 
 impl WorldShape {
@@ -63,13 +68,21 @@ impl WorldShape {
             Self::Triangle { vertices, normals } => {
                 intersect::triangle(ray, vertices, normals, tmin, tmax)
             }
+            Self::Voxels => None,
         }
     }
 
     /// Whether the shape bounds a solid (only its outside is ever lit).
     #[must_use]
     pub const fn is_closed(&self) -> bool {
-        matches!(self, Self::Sphere { .. })
+        matches!(self, Self::Sphere { .. } | Self::Voxels)
+    }
+
+    /// Whether the shape has exact geometry to verify hits against (all
+    /// but [`WorldShape::Voxels`]).
+    #[must_use]
+    pub const fn is_exact(&self) -> bool {
+        !matches!(self, Self::Voxels)
     }
 
     /// Every coordinate is finite, radii are non-negative and a sphere's is
@@ -97,11 +110,13 @@ impl WorldShape {
                 vertices.iter().all(|v| v.is_finite())
                     && normals.is_none_or(|n| n.iter().all(|v| v.is_finite()))
             }
+            Self::Voxels => true,
         }
     }
 
     /// The core's fixed-point geometry in `frame` (as [`fit::fit`] makes
-    /// it), or `None` when a coordinate lies beyond the fixed-point range.
+    /// it), or `None` when a coordinate lies beyond the fixed-point range
+    /// or the shape is [`WorldShape::Voxels`].
     #[must_use]
     pub fn to_fixed(&self, frame: &RasterFrame) -> Option<fit::Shape> {
         Some(match *self {
@@ -139,6 +154,7 @@ impl WorldShape {
                     normals: n,
                 })
             }
+            Self::Voxels => return None,
         })
     }
 }

@@ -179,6 +179,18 @@ pub enum SceneError {
         /// The file.
         file: Arc<str>,
     },
+    /// A TOML scene's error: a syntax error, an unknown key, a wrong type,
+    /// a bad value or a file it refers to.
+    #[error("{loc}: {key}{}{msg}", if key.is_empty() { "" } else { ": " })]
+    Toml {
+        /// Where in the scene file.
+        loc: SourceLoc,
+        /// The key (dotted path) concerned, empty when toml names it in
+        /// the message.
+        key: String,
+        /// What is wrong.
+        msg: String,
+    },
     /// No object.
     #[error("{file}: no objects: the scene has no s, c, p or pp")]
     NoObjects {

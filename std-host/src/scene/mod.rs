@@ -1,21 +1,37 @@
-//! World-space scenes, as read from NFF files.
+//! World-space scenes, as read from NFF or TOML scene files.
 //!
-//! A [`Scene`] is what an NFF file (Eric Haines' Neutral File Format, the
-//! format of the Standard Procedural Databases) describes, in `f64` world
-//! coordinates: the view, the background, lights, materials and objects
-//! (spheres, open cones and cylinders, polygons and polygonal patches), each
-//! object referring to its material by index. Nothing here knows about the
-//! raster: [`crate::fit`] maps a scene into raster coordinates, once.
+//! A [`Scene`] is the description the build pipeline ([`crate::build`])
+//! takes, in `f64` world coordinates: the view, the background, lights,
+//! materials (with optional textures) and objects, each object referring
+//! to its material by index. Two front-ends make one:
 //!
-//! Read a scene with [`Scene::load`] (a file) or [`Scene::parse`] (bytes);
-//! [`nff`] documents the format and the checks.
+//! * [`nff`]: an NFF file (Eric Haines' Neutral File Format, the format of
+//!   the Standard Procedural Databases): spheres, open cones and
+//!   cylinders, polygons and polygonal patches;
+//! * [`toml`]: a TOML scene file, for what NFF cannot say: everything NFF
+//!   has plus boxes (as polygons), tori and capped cones (as one-solid CSG
+//!   trees), Bézier patches (`.bpt` files, tessellated into `pp`
+//!   patches), OBJ meshes, included NFF files, sampled and computed
+//!   volumes, MagicaVoxel models, CSG trees and textured materials.
+//!
+//! Nothing here knows about the raster: [`crate::fit`] maps a scene into
+//! raster coordinates, once.
+//!
+//! Read a scene with [`Scene::load`] (a file, NFF or TOML by its
+//! extension) or [`Scene::parse`] (NFF bytes).
 
 #![deny(missing_docs)]
 
+pub mod bpt;
 mod error;
 mod loc;
 pub mod nff;
+pub mod obj;
+pub mod objects;
+mod text;
+pub mod toml;
 
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use glam::DVec3;
@@ -23,6 +39,9 @@ use glam::DVec3;
 pub use error::{Found, SceneError};
 pub use loc::SourceLoc;
 pub use nff::ParseOptions;
+pub use objects::{
+    Csg, CsgLeaf, SceneTexture, SceneVolume, SolidShape, TextureKind, VolumeObject, VoxObject,
+};
 
 /// The NFF viewpoint (`v` block). The parser guarantees `from ≠ at`, `up`
 /// not parallel to `at − from`, `0 < angle < 180` and a resolution of at
@@ -192,11 +211,15 @@ impl Bounds {
 
 /// A scene in world coordinates (see the module docs).
 ///
-/// The parser guarantees: every number is finite; every object's
+/// The parsers guarantee: every number is finite; every object's
 /// `material` indexes [`Scene::materials`] (which is never empty); every
 /// polygon's range lies inside [`Scene::vertices`]; [`Scene::normals`] is
 /// as long as [`Scene::vertices`] (zero for plain polygons, non-zero for
-/// patches); there is at least one object.
+/// patches); every texture index of [`Scene::material_textures`] indexes
+/// [`Scene::textures`]; CSG trees are valid core trees
+/// ([`rrt_core::csg::CsgTree`]: children before parents, at most
+/// [`rrt_core::csg::MAX_NODES`] nodes, every leaf present); there is at
+/// least one object. [`check_scene`] checks all of it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// The file name the scene was read from, as given.
@@ -221,17 +244,64 @@ pub struct Scene {
     /// Per-vertex normals as written (not normalised), parallel to
     /// [`Scene::vertices`]; zero for vertices of plain polygons.
     pub normals: Vec<DVec3>,
+    /// Sampled and computed volumes.
+    pub volumes: Vec<VolumeObject>,
+    /// MagicaVoxel models.
+    pub voxes: Vec<VoxObject>,
+    /// CSG trees.
+    pub csgs: Vec<Csg>,
+    /// Textures, referred to by [`Scene::material_textures`].
+    pub textures: Vec<SceneTexture>,
+    /// The texture of each textured material: material index → index into
+    /// [`Scene::textures`]. The texture's colour replaces (or modulates)
+    /// the material's colour in each voxel record, computed once per voxel
+    /// at voxelization.
+    pub material_textures: BTreeMap<usize, usize>,
 }
 
 impl Scene {
-    /// Reads and parses the NFF file at `path` with default limits.
+    /// A scene with a view and nothing else (no material, no object):
+    /// what the front-ends start from.
+    #[must_use]
+    pub fn empty(file: Arc<str>, view: View) -> Self {
+        Self {
+            file,
+            view,
+            background: DVec3::ZERO,
+            lights: Vec::new(),
+            materials: Vec::new(),
+            spheres: Vec::new(),
+            cones: Vec::new(),
+            polygons: Vec::new(),
+            vertices: Vec::new(),
+            normals: Vec::new(),
+            volumes: Vec::new(),
+            voxes: Vec::new(),
+            csgs: Vec::new(),
+            textures: Vec::new(),
+            material_textures: BTreeMap::new(),
+        }
+    }
+
+    /// Reads and parses the scene file at `path` with default limits: a
+    /// TOML scene ([`toml`]) when its name ends in `.toml`, NFF ([`nff`])
+    /// otherwise.
     ///
     /// # Errors
-    /// [`SceneError`] naming the file (and line, column and field where
-    /// there is one): a missing or unreadable file, a directory, an empty
-    /// file, binary data, and every syntax or range error of [`nff`].
+    /// [`SceneError`] naming the file (and line, column and field or key
+    /// where there is one): a missing or unreadable file, a directory, an
+    /// empty file, binary data, and every syntax or range error of the
+    /// format (and of the files a TOML scene refers to).
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self, SceneError> {
-        nff::load(path.as_ref(), &ParseOptions::default())
+        let path = path.as_ref();
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+        {
+            toml::load(path, &toml::Options::default())
+        } else {
+            nff::load(path, &ParseOptions::default())
+        }
     }
 
     /// Parses NFF text held in memory; `file` names it in messages.
@@ -266,6 +336,23 @@ impl Scene {
         self.polygons.iter().filter(|p| p.patch).count()
     }
 
+    /// The texture of material `material`, if it has one.
+    #[must_use]
+    pub fn texture_of(&self, material: usize) -> Option<&SceneTexture> {
+        self.textures.get(*self.material_textures.get(&material)?)
+    }
+
+    /// Whether the scene has no object at all.
+    #[must_use]
+    pub fn has_no_objects(&self) -> bool {
+        self.spheres.is_empty()
+            && self.cones.is_empty()
+            && self.polygons.is_empty()
+            && self.volumes.is_empty()
+            && self.voxes.is_empty()
+            && self.csgs.is_empty()
+    }
+
     /// Number of triangles after fan-triangulating every polygon.
     #[must_use]
     pub fn triangle_count(&self) -> usize {
@@ -276,7 +363,9 @@ impl Scene {
     }
 
     /// The box around all geometry: spheres ± radius, polygon vertices,
-    /// cone end discs ± their radius (the same box as `embree_nff`'s).
+    /// cone end discs ± their radius (the same box as `embree_nff`'s for
+    /// NFF scenes); the cells of volumes and `.vox` models, and CSG trees
+    /// ([`Csg::world_bounds`]).
     #[must_use]
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::EMPTY;
@@ -290,6 +379,20 @@ impl Scene {
         for p in &self.polygons {
             for &v in self.polygon_vertices(p) {
                 b.include(v, v);
+            }
+        }
+        for v in &self.volumes {
+            let w = v.data.world_bounds();
+            b.include(w.min, w.max);
+        }
+        for v in &self.voxes {
+            if let Some(w) = v.world_bounds() {
+                b.include(w.min, w.max);
+            }
+        }
+        for c in &self.csgs {
+            if let Some(w) = c.world_bounds() {
+                b.include(w.min, w.max);
             }
         }
         b
@@ -315,7 +418,7 @@ pub fn check_scene(s: &Scene) -> Result<(), String> {
     if s.vertices.len() != s.normals.len() {
         return Err("normals not parallel to vertices".into());
     }
-    if s.spheres.is_empty() && s.cones.is_empty() && s.polygons.is_empty() {
+    if s.has_no_objects() {
         return Err("no objects".into());
     }
     let v = &s.view;
@@ -372,5 +475,5 @@ pub fn check_scene(s: &Scene) -> Result<(), String> {
             }
         }
     }
-    Ok(())
+    objects::check(s)
 }

@@ -467,8 +467,6 @@ impl<'a> Parser<'a> {
             b.materials.push(Material::DEFAULT);
         }
         Ok(Scene {
-            file: self.file,
-            view,
             background: self.background.map_or(DVec3::ZERO, |(c, _)| c),
             lights: b.lights,
             materials: b.materials,
@@ -477,6 +475,7 @@ impl<'a> Parser<'a> {
             polygons: b.polygons,
             vertices: b.vertices,
             normals: b.normals,
+            ..Scene::empty(self.file, view)
         })
     }
 

@@ -1,0 +1,351 @@
+//! Triangle meshes from Wavefront OBJ files, read with the `tobj` crate.
+//!
+//! Faces are triangulated (fans), points and lines are ignored, and
+//! per-vertex normals (`vn`) are kept when every face gives them. Groups,
+//! objects and materials (`.mtl`) do not matter here: the scene gives the
+//! mesh one material.
+//!
+//! # Bad input
+//! Before `tobj` parses the file, every face's indices are checked against
+//! the vertex, texture-coordinate and normal counts (1-based, negative
+//! indices counting back from the latest element, 0 is never valid), so
+//! an out-of-range index is reported with its line and column rather than
+//! as tobj's unlocated error. Errors tobj finds on a line (a malformed
+//! number, say) are located on the line tobj was reading. Files are capped
+//! at [`MAX_FILE_BYTES`] and meshes at [`MAX_TRIANGLES`] triangles.
+
+use std::io::{BufRead, Read};
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::error::SceneError;
+use super::loc::SourceLoc;
+use super::text::read_text;
+
+/// Largest OBJ file read, in bytes.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+/// Most triangles one mesh may have.
+pub const MAX_TRIANGLES: usize = 1 << 24;
+
+/// A triangle mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Per-vertex normals (parallel to `positions`), if the file gives a
+    /// normal for every face vertex.
+    pub normals: Option<Vec<DVec3>>,
+    /// Triangles as indices into `positions`, in the file's winding.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Reads the OBJ file at `path`; `name` names it in messages.
+///
+/// # Errors
+/// [`SceneError`]s naming the file (and line and column where there is
+/// one): I/O, size, binary data, an out-of-range index, a line tobj cannot
+/// parse, a non-finite coordinate, a mesh without faces or with more than
+/// [`MAX_TRIANGLES`] triangles.
+pub fn load(path: &Path, name: &str) -> Result<Mesh, SceneError> {
+    let name: Arc<str> = Arc::from(name);
+    let text = read_text(path, &name, MAX_FILE_BYTES)?;
+    parse(&name, &text)
+}
+
+fn invalid(file: &Arc<str>, line: usize, column: usize, problem: &'static str) -> SceneError {
+    SceneError::Invalid {
+        loc: SourceLoc::new(
+            Arc::clone(file),
+            u32::try_from(line).unwrap_or(u32::MAX),
+            u32::try_from(column).unwrap_or(u32::MAX),
+        ),
+        field: "OBJ",
+        problem,
+    }
+}
+
+/// Checks every face index (see the module docs).
+fn check_indices(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
+    // Totals for positive indices (tobj resolves them once the object is
+    // complete, against everything read by then; the whole file bounds
+    // that), running counts for negative ones.
+    let mut totals = [0i64; 3];
+    for line in text.lines() {
+        match line.split_whitespace().next() {
+            Some("v") => totals[0] += 1,
+            Some("vt") => totals[1] += 1,
+            Some("vn") => totals[2] += 1,
+            _ => {}
+        }
+    }
+    let mut seen = [0i64; 3];
+    const WHAT: [&str; 3] = [
+        "face vertex index out of range (indices count from 1; negative ones back from the latest vertex)",
+        "face texture coordinate index out of range",
+        "face normal index out of range",
+    ];
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => seen[0] += 1,
+            Some("vt") => seen[1] += 1,
+            Some("vn") => seen[2] += 1,
+            Some("f") => {
+                let mut at = line.find('f').map_or(0, |p| p + 1);
+                for word in words {
+                    let col = line
+                        .get(at..)
+                        .and_then(|r| r.find(word))
+                        .map_or(at, |p| at + p);
+                    at = col + word.len();
+                    for (k, part) in word.split('/').enumerate().take(3) {
+                        if part.is_empty() {
+                            continue;
+                        }
+                        let Ok(i) = part.parse::<i64>() else {
+                            // Malformed: tobj reports it on this line.
+                            continue;
+                        };
+                        let ok = if i > 0 {
+                            i <= totals[k]
+                        } else {
+                            i < 0 && seen[k] + i >= 0
+                        };
+                        if !ok {
+                            let column = line.get(..col).map_or(col, |s| s.chars().count()) + 1;
+                            return Err(invalid(file, n + 1, column, WHAT[k]));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// A reader that counts the lines tobj has taken.
+struct Counting<'a> {
+    bytes: &'a [u8],
+    at: usize,
+    /// Newlines consumed.
+    lines: usize,
+}
+
+impl Read for Counting<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let avail = self.fill_buf()?;
+        let n = avail.len().min(buf.len());
+        buf[..n].copy_from_slice(&avail[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl BufRead for Counting<'_> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        Ok(self.bytes.get(self.at..).unwrap_or(&[]))
+    }
+    fn consume(&mut self, amt: usize) {
+        let end = self.at.saturating_add(amt).min(self.bytes.len());
+        let taken = self.bytes.get(self.at..end).unwrap_or(&[]);
+        self.lines += taken.iter().filter(|&&b| b == b'\n').count();
+        self.at = end;
+    }
+}
+
+/// Parses OBJ text; `file` names it in messages.
+///
+/// # Errors
+/// As [`load`], less the file-system errors.
+pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
+    let file: Arc<str> = Arc::from(file);
+    check_indices(&file, text)?;
+    let mut reader = Counting {
+        bytes: text.as_bytes(),
+        at: 0,
+        lines: 0,
+    };
+    let options = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let result = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    });
+    let models = match result {
+        Ok((models, _)) => models,
+        Err(e) => {
+            // The line being read when tobj stopped (the last one read in
+            // full, or the unterminated last line).
+            let line = if text.ends_with('\n') || reader.at < text.len() {
+                reader.lines.max(1)
+            } else {
+                reader.lines + 1
+            };
+            let problem = match e {
+                tobj::LoadError::PositionParseError => "malformed vertex position",
+                tobj::LoadError::NormalParseError => "malformed vertex normal",
+                tobj::LoadError::TexcoordParseError => "malformed texture coordinate",
+                tobj::LoadError::FaceParseError => "malformed face",
+                tobj::LoadError::ColorParseError => "malformed vertex colour",
+                tobj::LoadError::ScalingByZeroError => "vertex with w = 0",
+                tobj::LoadError::InvalidPolygon => "face with fewer than three vertices",
+                tobj::LoadError::FaceVertexOutOfBounds
+                | tobj::LoadError::FaceTexCoordOutOfBounds
+                | tobj::LoadError::FaceNormalOutOfBounds
+                | tobj::LoadError::FaceColorOutOfBounds => "face index out of range",
+                _ => "not a readable OBJ file",
+            };
+            return Err(invalid(&file, line, 1, problem));
+        }
+    };
+    let mut mesh = Mesh {
+        positions: Vec::new(),
+        normals: Some(Vec::new()),
+        triangles: Vec::new(),
+    };
+    for m in &models {
+        let m = &m.mesh;
+        let base = mesh.positions.len();
+        let count = m.positions.len() / 3;
+        if mesh.triangles.len() + m.indices.len() / 3 > MAX_TRIANGLES {
+            return Err(SceneError::Invalid {
+                loc: SourceLoc::new(Arc::clone(&file), 1, 1),
+                field: "OBJ",
+                problem: "more triangles than a mesh may have (2^24)",
+            });
+        }
+        for p in m.positions.chunks_exact(3) {
+            let v = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+            if !v.is_finite() {
+                return Err(SceneError::Invalid {
+                    loc: SourceLoc::new(Arc::clone(&file), 1, 1),
+                    field: "OBJ",
+                    problem: "a vertex position is not finite",
+                });
+            }
+            mesh.positions.push(v);
+        }
+        if m.normals.len() == m.positions.len() {
+            if let Some(ns) = mesh.normals.as_mut() {
+                ns.extend(
+                    m.normals
+                        .chunks_exact(3)
+                        .map(|n| DVec3::new(f64::from(n[0]), f64::from(n[1]), f64::from(n[2]))),
+                );
+            }
+        } else {
+            mesh.normals = None;
+        }
+        for t in m.indices.chunks_exact(3) {
+            let idx = [t[0], t[1], t[2]];
+            if idx.iter().any(|&i| i as usize >= count) {
+                return Err(invalid(&file, 1, 1, "face index out of range"));
+            }
+            let off = |i: u32| u32::try_from(base + i as usize).unwrap_or(u32::MAX);
+            mesh.triangles.push(idx.map(off));
+        }
+    }
+    if mesh.triangles.is_empty() {
+        return Err(SceneError::Invalid {
+            loc: SourceLoc::new(Arc::clone(&file), 1, 1),
+            field: "OBJ",
+            problem: "no faces: the file holds no triangle mesh",
+        });
+    }
+    // Normals that cannot be normalised are dropped with the rest.
+    if mesh
+        .normals
+        .as_ref()
+        .is_some_and(|ns| ns.iter().any(|n| n.try_normalize().is_none()))
+    {
+        mesh.normals = None;
+    }
+    Ok(mesh)
+}
+
+/// Area-weighted vertex normals of `mesh` (for smooth shading of a file
+/// without `vn`); a vertex of only degenerate triangles gets the first
+/// triangle's direction or +z.
+#[must_use]
+pub fn smooth_normals(mesh: &Mesh) -> Vec<DVec3> {
+    let mut acc = vec![DVec3::ZERO; mesh.positions.len()];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| {
+            mesh.positions
+                .get(i as usize)
+                .copied()
+                .unwrap_or(DVec3::ZERO)
+        });
+        // The cross product's length is twice the area: area weighting.
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            if let Some(s) = acc.get_mut(i as usize) {
+                *s += n;
+            }
+        }
+    }
+    acc.into_iter()
+        .map(|n| n.try_normalize().unwrap_or(DVec3::Z))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn indices_are_checked_with_their_line() {
+        let ok = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n";
+        let m = parse("t.obj", ok).unwrap();
+        assert_eq!(m.triangles.len(), 2);
+        assert_eq!(m.normals, None);
+        let e = parse("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj:4:7: OBJ: face vertex index out of range"),
+            "{e}"
+        );
+        let e = parse("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.obj:4:3: OBJ: face vertex index"), "{e}");
+        let e = parse("t.obj", "v 0 0 0\nf -2 1 1\nv 1 0 0\nv 0 1 0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.obj:2:3:"), "{e}");
+        let e = parse(
+            "t.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//0 3//1\n",
+        )
+        .unwrap_err()
+        .to_string();
+        // The column of the face vertex `2//0` that holds the bad index.
+        assert!(e.starts_with("t.obj:5:8: OBJ: face normal index"), "{e}");
+        let e = parse("t.obj", "v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "t.obj:2:1: OBJ: malformed vertex position");
+        let e = parse("t.obj", "# nothing\n").unwrap_err().to_string();
+        assert!(e.contains("no faces"), "{e}");
+    }
+
+    #[test]
+    fn normals_and_quads() {
+        let m = parse(
+            "q.obj",
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n",
+        )
+        .unwrap();
+        assert_eq!(m.triangles.len(), 2);
+        assert_eq!(m.normals.as_ref().map(Vec::len), Some(m.positions.len()));
+        let s = smooth_normals(&m);
+        assert!(s.iter().all(|n| (*n - DVec3::Z).length() < 1e-12));
+    }
+}

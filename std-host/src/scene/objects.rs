@@ -1,0 +1,370 @@
+//! The objects a scene has beyond NFF's: volumes, MagicaVoxel models, CSG
+//! trees (tori and capped cones are one-solid trees), and textures.
+//!
+//! They are what the TOML front-end ([`super::toml`]) reads; the build
+//! pipeline ([`crate::build`]) voxelizes them next to the NFF objects, in
+//! the same raster, through the same two passes.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use rrt_core::csg::CsgNode;
+#[cfg(any(test, feature = "check"))]
+use rrt_core::csg::MAX_NODES;
+
+#[cfg(any(test, feature = "check"))]
+use super::Scene;
+use super::{Bounds, SourceLoc};
+use crate::texture::{AnyTexture, Blend};
+use crate::volume::{Classifier, PlacedVolume, Placement, Volume};
+use crate::vox::VoxScene;
+
+/// A classified volume placed in the world: the data, where it goes and
+/// which of its samples are non-transparent (and their colours).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneVolume {
+    /// The samples (shared: a volume can be an object, a CSG leaf and a
+    /// texture at once without a second copy).
+    pub volume: Arc<Volume>,
+    /// Physical → world.
+    pub placement: Placement,
+    /// Iso-value and ramps.
+    pub classifier: Classifier,
+}
+
+impl SceneVolume {
+    /// The volume at its placement.
+    #[must_use]
+    pub fn placed(&self) -> PlacedVolume<'_> {
+        self.placement.place(&self.volume)
+    }
+
+    /// The world box around the volume's cells.
+    #[must_use]
+    pub fn world_bounds(&self) -> Bounds {
+        self.placed().world_bounds()
+    }
+}
+
+/// A sampled or computed volume as an object: its boundary layer, normals
+/// from the gray-level gradient, colours from the classifier's colour ramp
+/// (or the material's colour and texture without one).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeObject {
+    /// The classified, placed data.
+    pub data: SceneVolume,
+    /// Index into [`Scene::materials`] (shading coefficients, and the
+    /// colour where the classifier has no colour ramp).
+    pub material: usize,
+    /// Where the object is defined.
+    pub loc: SourceLoc,
+}
+
+/// A MagicaVoxel model placed in the world: world cell `c` of the model
+/// (MagicaVoxel's frame, z up, see [`crate::vox`]) covers the cube
+/// `position + cell · (c + [0, 1)³)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VoxObject {
+    /// The model's voxels, palette and scene graph.
+    pub vox: Arc<VoxScene>,
+    /// World position of cell (0, 0, 0)'s lowest corner.
+    pub position: DVec3,
+    /// World edge length of a cell (> 0).
+    pub cell: f64,
+    /// Index into [`Scene::materials`] (shading coefficients; the colours
+    /// come from the palette).
+    pub material: usize,
+    /// Where the object is defined.
+    pub loc: SourceLoc,
+}
+
+impl VoxObject {
+    /// The world box around the model's cells, `None` for a model without
+    /// voxels.
+    #[must_use]
+    pub fn world_bounds(&self) -> Option<Bounds> {
+        let (lo, hi) = self.vox.world_bounds()?;
+        let corner = |c: [i64; 3]| self.position + DVec3::from(c.map(|v| v as f64)) * self.cell;
+        Some(Bounds {
+            min: corner(lo),
+            max: corner(hi.map(|v| v + 1)),
+        })
+    }
+}
+
+/// A solid a CSG tree combines.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SolidShape {
+    /// A ball.
+    Sphere {
+        /// Centre.
+        centre: DVec3,
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// An axis-aligned box.
+    Cuboid {
+        /// Lowest corner.
+        min: DVec3,
+        /// Highest corner.
+        max: DVec3,
+    },
+    /// A cone or cylinder closed by its end discs.
+    Cone {
+        /// Centre of the base disc.
+        base: DVec3,
+        /// Radius at the base (≥ 0).
+        base_radius: f64,
+        /// Centre of the apex disc.
+        apex: DVec3,
+        /// Radius at the apex (≥ 0, not both 0).
+        apex_radius: f64,
+    },
+    /// A solid torus.
+    Torus {
+        /// Centre.
+        centre: DVec3,
+        /// Unit axis.
+        axis: DVec3,
+        /// Radius of the centre circle (> 0).
+        major: f64,
+        /// Radius of the tube (> 0).
+        minor: f64,
+    },
+    /// The non-transparent samples of a classified volume.
+    Volume(SceneVolume),
+}
+
+impl SolidShape {
+    /// The world box holding the solid.
+    #[must_use]
+    pub fn world_bounds(&self) -> Bounds {
+        match self {
+            Self::Sphere { centre, radius } => Bounds {
+                min: *centre - *radius,
+                max: *centre + *radius,
+            },
+            Self::Cuboid { min, max } => Bounds {
+                min: *min,
+                max: *max,
+            },
+            Self::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+            } => {
+                let r = base_radius.max(*apex_radius);
+                Bounds {
+                    min: base.min(*apex) - r,
+                    max: base.max(*apex) + r,
+                }
+            }
+            Self::Torus {
+                centre,
+                major,
+                minor,
+                ..
+            } => Bounds {
+                min: *centre - (major + minor),
+                max: *centre + (major + minor),
+            },
+            Self::Volume(v) => v.world_bounds(),
+        }
+    }
+
+    /// The kind, for messages.
+    #[must_use]
+    pub const fn kind(&self) -> &'static str {
+        match self {
+            Self::Sphere { .. } => "sphere",
+            Self::Cuboid { .. } => "box",
+            Self::Cone { .. } => "cone",
+            Self::Torus { .. } => "torus",
+            Self::Volume(_) => "volume",
+        }
+    }
+}
+
+/// A leaf of a CSG tree: a solid and the material its part of the result's
+/// surface gets.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CsgLeaf {
+    /// The solid.
+    pub shape: SolidShape,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+    /// Where the solid is defined.
+    pub loc: SourceLoc,
+}
+
+/// A CSG tree: core nodes ([`CsgNode`], children before parents, the root
+/// last) over world-space leaves. Voxelized by voxel Booleans
+/// ([`rrt_core::csg`]); each surface voxel of the result carries the
+/// attributes of the leaf that forms the surface there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Csg {
+    /// The nodes; `Leaf(i)` refers to `leaves[i]`.
+    pub nodes: Vec<CsgNode>,
+    /// The solids.
+    pub leaves: Vec<CsgLeaf>,
+    /// Where the CSG object is defined.
+    pub loc: SourceLoc,
+}
+
+impl Csg {
+    /// A world box holding the result (as [`rrt_core::csg::CsgTree::bounds`]
+    /// does in the raster): `None` when it is provably empty.
+    #[must_use]
+    pub fn world_bounds(&self) -> Option<Bounds> {
+        let mut b: Vec<Option<Bounds>> = Vec::with_capacity(self.nodes.len());
+        for n in &self.nodes {
+            let get = |k: u16| b.get(usize::from(k)).copied().flatten();
+            let v = match *n {
+                CsgNode::Leaf(l) => self
+                    .leaves
+                    .get(usize::from(l))
+                    .map(|leaf| leaf.shape.world_bounds()),
+                CsgNode::Union(x, y) => match (get(x), get(y)) {
+                    (Some(p), Some(q)) => {
+                        let mut u = p;
+                        u.include(q.min, q.max);
+                        Some(u)
+                    }
+                    (p, q) => p.or(q),
+                },
+                CsgNode::Intersection(x, y) => match (get(x), get(y)) {
+                    (Some(p), Some(q)) => {
+                        let o = Bounds {
+                            min: p.min.max(q.min),
+                            max: p.max.min(q.max),
+                        };
+                        (!o.is_empty()).then_some(o)
+                    }
+                    _ => None,
+                },
+                CsgNode::Difference(x, _) => get(x),
+            };
+            b.push(v);
+        }
+        b.last().copied().flatten()
+    }
+}
+
+/// What a texture computes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureKind {
+    /// An image map or a solid texture ([`crate::texture`]).
+    World(AnyTexture),
+}
+
+/// A texture of a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneTexture {
+    /// The colour function.
+    pub kind: TextureKind,
+    /// How it meets the material's colour.
+    pub blend: Blend,
+    /// Where it is defined.
+    pub loc: SourceLoc,
+}
+
+#[cfg(any(test, feature = "check"))]
+fn finite(v: DVec3, what: &str) -> Result<(), String> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{what} not finite: {v}"))
+    }
+}
+
+#[cfg(any(test, feature = "check"))]
+fn positive(x: f64) -> bool {
+    x > 0.0 && x.is_finite()
+}
+
+#[cfg(any(test, feature = "check"))]
+fn check_solid(s: &SolidShape) -> Result<(), String> {
+    let ok = match s {
+        SolidShape::Sphere { centre, radius } => centre.is_finite() && positive(*radius),
+        SolidShape::Cuboid { min, max } => {
+            min.is_finite() && max.is_finite() && min.cmplt(*max).all()
+        }
+        SolidShape::Cone {
+            base,
+            base_radius,
+            apex,
+            apex_radius,
+        } => {
+            base.is_finite()
+                && apex.is_finite()
+                && base != apex
+                && *base_radius >= 0.0
+                && *apex_radius >= 0.0
+                && positive(base_radius + apex_radius)
+        }
+        SolidShape::Torus {
+            centre,
+            axis,
+            major,
+            minor,
+        } => centre.is_finite() && axis.is_normalized() && positive(*major) && positive(*minor),
+        SolidShape::Volume(v) => v.classifier.validate().is_ok(),
+    };
+    if ok {
+        Ok(())
+    } else {
+        Err(format!("bad solid {s:?}"))
+    }
+}
+
+/// The guarantees of [`Scene`] about the objects of this module (part of
+/// [`super::check_scene`]).
+#[cfg(any(test, feature = "check"))]
+pub(crate) fn check(s: &Scene) -> Result<(), String> {
+    let nm = s.materials.len();
+    let mat = |m: usize, what: &str| {
+        if m < nm {
+            Ok(())
+        } else {
+            Err(format!("{what}: material {m} of {nm}"))
+        }
+    };
+    for v in &s.volumes {
+        mat(v.material, "volume")?;
+        v.data.classifier.validate().map_err(|e| e.to_string())?;
+    }
+    for v in &s.voxes {
+        mat(v.material, "vox")?;
+        finite(v.position, "vox position")?;
+        if !positive(v.cell) {
+            return Err(format!("vox cell {}", v.cell));
+        }
+    }
+    for c in &s.csgs {
+        if c.nodes.is_empty() || c.nodes.len() > MAX_NODES {
+            return Err(format!("CSG tree of {} nodes", c.nodes.len()));
+        }
+        for (i, n) in c.nodes.iter().enumerate() {
+            let ok = match *n {
+                CsgNode::Leaf(l) => usize::from(l) < c.leaves.len(),
+                CsgNode::Union(a, b) | CsgNode::Intersection(a, b) | CsgNode::Difference(a, b) => {
+                    usize::from(a) < i && usize::from(b) < i
+                }
+            };
+            if !ok {
+                return Err(format!("CSG node {i}: {n:?}"));
+            }
+        }
+        for l in &c.leaves {
+            mat(l.material, "CSG leaf")?;
+            check_solid(&l.shape)?;
+        }
+    }
+    for (&m, &t) in &s.material_textures {
+        if m >= nm || t >= s.textures.len() {
+            return Err(format!("material {m} → texture {t}"));
+        }
+    }
+    Ok(())
+}

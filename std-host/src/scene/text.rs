@@ -1,0 +1,90 @@
+//! Reading the text files a scene is made of, with a size limit checked
+//! before reading and located errors for binary data.
+
+use std::fs;
+use std::io::Read;
+use std::path::Path;
+use std::sync::Arc;
+
+use super::error::SceneError;
+use super::loc::SourceLoc;
+
+/// Reads the file at `path` (at most `limit` bytes) as UTF-8 text; `name`
+/// is what messages call it.
+///
+/// # Errors
+/// [`SceneError::Io`], [`SceneError::IsDirectory`],
+/// [`SceneError::FileTooLarge`], [`SceneError::NotText`] (a NUL byte or
+/// invalid UTF-8, located).
+pub(crate) fn read_text(path: &Path, name: &Arc<str>, limit: u64) -> Result<String, SceneError> {
+    let io = |source| SceneError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let meta = fs::metadata(path).map_err(io)?;
+    if meta.is_dir() {
+        return Err(SceneError::IsDirectory {
+            path: path.to_owned(),
+        });
+    }
+    if meta.len() > limit {
+        return Err(SceneError::FileTooLarge {
+            file: Arc::clone(name),
+            size: meta.len(),
+            limit,
+        });
+    }
+    let mut bytes = Vec::new();
+    // `take` guards against a file that grows after the size check.
+    fs::File::open(path)
+        .map_err(io)?
+        .take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    text(name, bytes, limit)
+}
+
+/// `bytes` as text (at most `limit` bytes).
+///
+/// # Errors
+/// [`SceneError::FileTooLarge`], [`SceneError::NotText`].
+pub(crate) fn text(name: &Arc<str>, bytes: Vec<u8>, limit: u64) -> Result<String, SceneError> {
+    let size = u64::try_from(bytes.len()).unwrap_or(u64::MAX);
+    if size > limit {
+        return Err(SceneError::FileTooLarge {
+            file: Arc::clone(name),
+            size,
+            limit,
+        });
+    }
+    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+        return Err(SceneError::NotText {
+            loc: byte_loc(name, &bytes, at),
+            what: "a NUL byte (binary data?)",
+        });
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        SceneError::NotText {
+            loc: byte_loc(name, e.as_bytes(), at),
+            what: "invalid UTF-8 (binary data?)",
+        }
+    })
+}
+
+/// The line and column (from 1; columns count characters) of byte `at`.
+pub(crate) fn byte_loc(file: &Arc<str>, bytes: &[u8], at: usize) -> SourceLoc {
+    let before = bytes.get(..at).unwrap_or(bytes);
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |p| p + 1);
+    let lines = before.iter().filter(|&&b| b == b'\n').count();
+    let tail = before.get(line_start..).unwrap_or(&[]);
+    let column = std::str::from_utf8(tail).map_or(tail.len(), |s| s.chars().count());
+    SourceLoc::new(
+        Arc::clone(file),
+        u32::try_from(lines + 1).unwrap_or(u32::MAX),
+        u32::try_from(column + 1).unwrap_or(u32::MAX),
+    )
+}

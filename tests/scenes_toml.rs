@@ -1,0 +1,356 @@
+//! TOML scenes: the scenes of `scenes/` parse and build; every kind of
+//! object reaches the raster (asserted on the records); bad scenes give one
+//! error naming the file, line and key.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use indicatif::ProgressBar;
+use rrt_host::build::{BuildOptions, VoxelScene, build};
+use rrt_host::scene::Scene;
+
+fn scenes_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes")
+}
+
+fn temp_dir(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rrt-toml-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn built(scene: &Scene, raster: u32) -> VoxelScene {
+    build(scene, &BuildOptions::new(raster), &ProgressBar::hidden())
+        .unwrap_or_else(|e| panic!("{}: {e}", scene.file))
+        .0
+}
+
+/// World centre of each record with its object id and colour.
+fn records(vs: &VoxelScene) -> Vec<(DVec3, u32, [u8; 3])> {
+    let store = vs.store().unwrap();
+    store
+        .iter()
+        .map(|(v, r)| {
+            let p = vs
+                .frame
+                .raster_to_world(DVec3::from(v.map(f64::from)) + 0.5);
+            (p, r.object, r.color)
+        })
+        .collect()
+}
+
+#[test]
+fn whitted_scene_has_both_checker_colours_on_the_board() {
+    let scene = Scene::load(scenes_dir().join("fig6-whitted.toml")).unwrap();
+    assert_eq!(scene.spheres.len(), 2);
+    assert_eq!(scene.textures.len(), 1);
+    let vs = built(&scene, 64);
+    let board = records(&vs)
+        .into_iter()
+        .filter(|(p, _, _)| p.z.abs() < 0.2)
+        .collect::<Vec<_>>();
+    let red = board.iter().filter(|r| r.2 == [230, 30, 20]).count();
+    let yellow = board.iter().filter(|r| r.2 == [240, 220, 40]).count();
+    assert!(red > 100 && yellow > 100, "red {red} yellow {yellow}");
+    // The checker's squares: a voxel centre's colour follows its square.
+    for (p, _, c) in &board {
+        let sq = (p.x / 0.6).floor() + (p.y / 0.6).floor() + (p.z / 0.6).floor();
+        let near_edge = [p.x, p.y, p.z]
+            .iter()
+            .any(|v| (v / 0.6 - (v / 0.6).round()).abs() < 0.02);
+        if !near_edge && (*c == [230, 30, 20] || *c == [240, 220, 40]) {
+            let want = if sq.rem_euclid(2.0) == 0.0 {
+                [230, 30, 20]
+            } else {
+                [240, 220, 40]
+            };
+            assert_eq!(*c, want, "at {p}");
+        }
+    }
+}
+
+const FEATURES: &str = r#"
+[camera]
+from = [6, -8, 5]
+at = [0, 0, 0.5]
+angle = 40
+resolution = [32, 32]
+
+[[light]]
+position = [5, -5, 10]
+
+[material.red]
+colour = [1, 0, 0]
+
+[material.green]
+colour = [0, 1, 0]
+
+[material.wood]
+[material.wood.texture.wood]
+origin = [0, 0, 0]
+direction = [0, 0, 1]
+period = 0.3
+colours = [[120, 70, 20], [200, 150, 90]]
+
+[volume.blob]
+metaballs = { dims = [24, 24, 24], min = [-1, -1, -1], max = [1, 1, 1], balls = [[0, 0, 0, 1.0, 1.0]] }
+iso = 0.3
+translate = [3, 3, 1]
+
+[solid.ball]
+sphere = { centre = [-3, 3, 1], radius = 1 }
+
+[solid.cut]
+box = { min = [-3, 2, 1], max = [-1.5, 4.5, 2.5] }
+material = "green"
+
+[[object]]
+material = "red"
+box = { min = [-1, -1, 0], max = [0, 0, 1] }
+
+[[object]]
+material = "green"
+torus = { centre = [2, -2, 0.5], axis = [0, 0, 1], major = 0.8, minor = 0.3 }
+
+[[object]]
+material = "red"
+cone = { base = [-2, -2, 0], base_radius = 0.5, apex = [-2, -2, 1.5], apex_radius = 0.1, capped = true }
+
+[[object]]
+material = "green"
+bezier = { file = "flat.bpt", steps = 4 }
+
+[[object]]
+material = "red"
+mesh = { file = "tri.obj" }
+transform = { translate = [0, 2, 0] }
+
+[[object]]
+material = "wood"
+volume = "blob"
+
+[[object]]
+material = "red"
+csg = { difference = ["ball", "cut"] }
+"#;
+
+fn features_dir(test: &str) -> PathBuf {
+    let d = temp_dir(test);
+    let bpt = "1\n3 3\n".to_string()
+        + &(0..16)
+            .map(|k| format!("{} {} 0\n", f64::from(k / 4) - 1.5, f64::from(k % 4) - 1.5))
+            .collect::<String>();
+    std::fs::write(d.join("flat.bpt"), bpt).unwrap();
+    std::fs::write(d.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 1\nf 1 2 3\n").unwrap();
+    std::fs::write(d.join("features.toml"), FEATURES).unwrap();
+    d
+}
+
+#[test]
+fn every_object_kind_reaches_the_raster() {
+    let d = features_dir("kinds");
+    let scene = Scene::load(d.join("features.toml")).unwrap();
+    // Box: 6 polygons; Bézier: 4 × 4 patch quads; mesh: 1 triangle.
+    assert_eq!(scene.polygons.len(), 6 + 16 + 1);
+    assert!(scene.polygons[6..22].iter().all(|p| p.patch));
+    // Torus and capped cone as one-solid CSG trees, plus the cut ball.
+    assert_eq!(scene.csgs.len(), 3);
+    assert_eq!(scene.volumes.len(), 1);
+    rrt_host::check::check_scene(&scene).unwrap();
+    let vs = built(&scene, 96);
+    let recs = records(&vs);
+    let n_objects = vs.objects.len();
+    // Volumes, then CSG trees come last, in scene order: torus, cone, ball.
+    let volume_id = u32::try_from(n_objects - 4).unwrap();
+    let torus_id = volume_id + 1;
+    let ball_id = volume_id + 3;
+    let of = |id: u32| recs.iter().filter(|r| r.1 == id).collect::<Vec<_>>();
+    let blob = of(volume_id);
+    assert!(blob.len() > 50, "volume voxels {}", blob.len());
+    // The metaball's iso-surface f = 0.3 lies at r = sqrt(1 − 0.3^(1/3)).
+    let r = (1.0 - 0.3f64.cbrt()).sqrt();
+    for (p, _, _) in &blob {
+        let d = (*p - DVec3::new(3.0, 3.0, 1.0)).length();
+        assert!((d - r).abs() < 0.15, "blob voxel at distance {d}, want {r}");
+    }
+    let torus = of(torus_id);
+    assert!(torus.len() > 50);
+    assert!(torus.iter().all(|t| t.2 == [0, 255, 0]));
+    // Wood colours the volume (not the flat material colour).
+    assert!(blob.iter().any(|t| t.2 != blob[0].2));
+    // The ball minus the box: no ball voxel deep inside the cut, and the
+    // cut face carries the cutting solid's (green) material.
+    let ball = of(ball_id);
+    assert!(ball.len() > 100);
+    let vsz = vs.frame.voxel_size;
+    for (p, _, _) in &ball {
+        let inside = p.x > -3.0 + 2.0 * vsz
+            && p.x < -1.5 - 2.0 * vsz
+            && p.y > 2.0 + 2.0 * vsz
+            && p.z > 1.0 + 2.0 * vsz;
+        assert!(!inside, "ball voxel at {p} inside the cut");
+    }
+    assert!(ball.iter().any(|b| b.2 == [0, 255, 0]));
+    assert!(ball.iter().any(|b| b.2 == [255, 0, 0]));
+}
+
+#[test]
+fn toml_scene_renders_through_the_cli() {
+    let d = features_dir("cli");
+    let out = d.join("out.png");
+    let c = <rrt_host::cli::Cli as clap::Parser>::try_parse_from([
+        "rrt",
+        "render",
+        d.join("features.toml").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--raster",
+        "64",
+        "--verify",
+        "--quiet",
+    ])
+    .unwrap();
+    rrt_host::cli::run(&c, &mut Vec::new()).unwrap();
+    let img = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (32, 32));
+    // Something besides the background (black) was hit.
+    assert!(img.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 50);
+}
+
+fn error_of(name: &str, text: &str) -> String {
+    let d = temp_dir(name);
+    let p = d.join("bad.toml");
+    std::fs::write(&p, text).unwrap();
+    Scene::load(&p).unwrap_err().to_string()
+}
+
+const CAMERA: &str =
+    "[camera]\nfrom = [0, -5, 1]\nat = [0, 0, 0]\nangle = 40\nresolution = [8, 8]\n";
+
+fn assert_located(msg: &str, line: u32, key: &str) {
+    assert!(
+        msg.contains(&format!("bad.toml:{line}:")),
+        "want line {line}: {msg}"
+    );
+    assert!(msg.contains(key), "want key {key}: {msg}");
+}
+
+#[test]
+fn unknown_key_is_named_with_its_line() {
+    let msg = error_of(
+        "unknown",
+        &format!(
+            "{CAMERA}[material.m]\nshininess = 3\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n"
+        ),
+    );
+    assert_located(&msg, 7, "shininess");
+}
+
+#[test]
+fn wrong_type_is_named_with_its_line() {
+    let msg = error_of(
+        "type",
+        &format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = \"big\" }}\n"
+        ),
+    );
+    assert_located(&msg, 9, "radius");
+}
+
+#[test]
+fn missing_file_is_named_with_its_line_and_key() {
+    let msg = error_of(
+        "path",
+        &format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nmesh = {{ file = \"nowhere.obj\" }}\n"
+        ),
+    );
+    assert_located(&msg, 9, "object.mesh.file");
+    assert!(msg.contains("nowhere.obj: no such file"), "{msg}");
+}
+
+#[test]
+fn huge_volume_is_refused_before_allocating() {
+    let msg = error_of(
+        "huge",
+        &format!(
+            "{CAMERA}[material.m]\n[volume.v]\nmetaballs = {{ dims = [60000, 60000, 60000], min = [0,0,0], max = [1,1,1], balls = [] }}\niso = 1\n[[object]]\nmaterial = \"m\"\nvolume = \"v\"\n"
+        ),
+    );
+    assert_located(&msg, 7, "volume.v.metaballs");
+}
+
+#[test]
+fn unknown_material_and_solid_are_named() {
+    let msg = error_of(
+        "material",
+        &format!(
+            "{CAMERA}[[object]]\nmaterial = \"nope\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n"
+        ),
+    );
+    assert_located(&msg, 7, "object.material");
+    assert!(msg.contains("no [material.nope]"), "{msg}");
+    let msg = error_of(
+        "solid",
+        &format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\ncsg = {{ union = [\"a\", \"b\"] }}\n"
+        ),
+    );
+    assert_located(&msg, 9, "object.csg");
+    assert!(msg.contains("no [solid.a]"), "{msg}");
+}
+
+#[test]
+fn two_shapes_in_one_object_are_refused() {
+    let msg = error_of(
+        "two",
+        &format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\nbox = {{ min = [0,0,0], max = [1,1,1] }}\n"
+        ),
+    );
+    assert_located(&msg, 7, "exactly one of");
+}
+
+/// The scenes that need `../shared/data`: parse them all, build the
+/// teapot's at a small raster (the head's volume is read, not built: it
+/// takes seconds).
+#[test]
+fn shared_data_scenes_parse() {
+    if rrt_tests::shared_data().is_none() {
+        eprintln!("skipped: ../shared/data is absent");
+        return;
+    }
+    for f in [
+        "fig1-head.toml",
+        "fig2-teapot.toml",
+        "fig4-balls3.toml",
+        "fig5-balls2.toml",
+    ] {
+        let s = Scene::load(scenes_dir().join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        rrt_host::check::check_scene(&s).unwrap();
+    }
+    let s = Scene::load(scenes_dir().join("fig4-balls3.toml")).unwrap();
+    assert_eq!(s.spheres.len(), 820);
+    let s = Scene::load(scenes_dir().join("fig2-teapot.toml")).unwrap();
+    assert_eq!(s.polygons.len(), 992 + 3);
+    let vs = built(&s, 48);
+    assert!(records(&vs).iter().any(|r| r.1 < 992));
+}
+
+#[test]
+fn scene_files_are_not_read_outside_the_options() {
+    let opts = rrt_host::scene::toml::Options {
+        read_files: false,
+        ..Default::default()
+    };
+    let e = rrt_host::scene::toml::parse(
+        "x.toml",
+        &format!("{CAMERA}[[object]]\nnff = \"a.nff\"\n"),
+        Path::new("."),
+        &opts,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("x.toml:7:"), "{e}");
+}
