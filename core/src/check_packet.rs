@@ -4,7 +4,7 @@
 //! `packet` (enable the `check` feature outside this crate's own tests).
 //! Each check walks a packet and, beside it, each lane's scalar
 //! [`DiscreteRay`] the same way, and after **every** walk compares, lane by
-//! lane, how the walk ended, the voxels the test saw, the [`Hit`] and the
+//! lane, how the walk ended, the voxels the test saw, the [`Hit`](crate::discrete_ray::Hit) and the
 //! whole ray (constants and resume state, through `DiscreteRay`'s
 //! equality). They allocate nothing and are bounded by the rays' lengths.
 

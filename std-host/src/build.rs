@@ -10,7 +10,7 @@
 //!    ([`Separation::for_rays`]); the exact record count is then checked
 //!    against the memory limit before the records are allocated;
 //! 4. **fill pass**: every object again, named with its object id,
-//!    material and colour; [`Filler::finish`] sorts the bricks and sets the
+//!    material and colour; [`Filler::finish`](rrt_core::store::Filler::finish) sorts the bricks and sets the
 //!    proximity flags; then (after step 5) the proximity distance field
 //!    ([`distance_field`]), which lets 26-runs skip empty space;
 //! 5. **light visibility** ([`rrt_core::light::illuminate_run`], in runs of

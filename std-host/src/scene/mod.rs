@@ -219,7 +219,7 @@ impl Bounds {
 /// [`Scene::textures`]; CSG trees are valid core trees
 /// ([`rrt_core::csg::CsgTree`]: children before parents, at most
 /// [`rrt_core::csg::MAX_NODES`] nodes, every leaf present); there is at
-/// least one object. [`check_scene`] checks all of it.
+/// least one object. `check_scene` (feature `check`) checks all of it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// The file name the scene was read from, as given.

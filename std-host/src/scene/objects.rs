@@ -53,7 +53,7 @@ impl SceneVolume {
 pub struct VolumeObject {
     /// The classified, placed data.
     pub data: SceneVolume,
-    /// Index into [`Scene::materials`] (shading coefficients, and the
+    /// Index into [`Scene::materials`](super::Scene::materials) (shading coefficients, and the
     /// colour where the classifier has no colour ramp).
     pub material: usize,
     /// Where the object is defined.
@@ -71,7 +71,7 @@ pub struct VoxObject {
     pub position: DVec3,
     /// World edge length of a cell (> 0).
     pub cell: f64,
-    /// Index into [`Scene::materials`] (shading coefficients; the colours
+    /// Index into [`Scene::materials`](super::Scene::materials) (shading coefficients; the colours
     /// come from the palette).
     pub material: usize,
     /// Where the object is defined.
@@ -192,7 +192,7 @@ impl SolidShape {
 pub struct CsgLeaf {
     /// The solid.
     pub shape: SolidShape,
-    /// Index into [`Scene::materials`].
+    /// Index into [`Scene::materials`](super::Scene::materials).
     pub material: usize,
     /// Where the solid is defined.
     pub loc: SourceLoc,

@@ -1173,7 +1173,7 @@ pub fn write(path: impl AsRef<Path>, volume: &Volume, gzip: bool) -> Result<(), 
     })
 }
 
-/// The bytes of [`write`].
+/// The bytes of [`write()`].
 #[must_use]
 pub fn to_bytes(volume: &Volume, gzip: bool) -> Vec<u8> {
     use std::io::Write;
