@@ -294,27 +294,30 @@ pub fn unit_to_fixed(n: DVec3) -> Option<UnitVector> {
 }
 
 /// `x.round()` (halves away from zero), exactly, without the libm call
-/// that `f64::round` compiles to on the baseline x86-64 target (no SSE4.1):
-/// it runs for every secondary ray. For `|x| < 2^63` the truncation `t` is
-/// exact and so is `x − t`; larger or non-finite values go to `f64::round`.
+/// that `f64::round` compiles to on the baseline x86-64 target (no SSE4.1),
+/// and without a data-dependent branch: it runs for every ray.
 #[inline]
 #[must_use]
 pub fn round(x: f64) -> f64 {
-    if x.is_nan() || x.abs() >= 9.223_372_036_854_775e18 {
-        return x.round();
-    }
-    let t = (x as i64) as f64;
-    let r = x - t;
-    if r >= 0.5 {
-        t + 1.0
-    } else if r <= -0.5 {
-        t - 1.0
-    } else if t == 0.0 {
-        // Keep the sign of zero as f64::round does.
-        0.0f64.copysign(x)
+    // From 2^52 up every f64 is an integer (and inf and NaN stay as they are).
+    if x.abs() < 4_503_599_627_370_496.0 {
+        // The sign of x keeps −0.0 for −0.5 < x ≤ −0.0, as f64::round does.
+        (round_to_i64(x) as f64).copysign(x)
     } else {
-        t
+        x
     }
+}
+
+/// `x.round() as i64` (halves away from zero, saturating, NaN → 0),
+/// exactly, branch-free: the truncation `t` is exact for `|x| < 2^63` and
+/// so is `x − t`, which decides the step away from zero.
+#[inline]
+#[must_use]
+pub fn round_to_i64(x: f64) -> i64 {
+    let t = x as i64;
+    let r = x - t as f64;
+    t.saturating_add(i64::from(r >= 0.5))
+        .saturating_sub(i64::from(r <= -0.5))
 }
 
 /// A core object in fixed-point raster coordinates.
@@ -781,7 +784,9 @@ mod tests {
         }
         for v in vals {
             assert_eq!(round(v).to_bits(), v.round().to_bits(), "{v:e}");
+            assert_eq!(round_to_i64(v), v.round() as i64, "{v:e}");
         }
+        assert_eq!(round_to_i64(f64::NAN), 0);
         assert!(round(f64::NAN).is_nan());
     }
 

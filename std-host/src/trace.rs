@@ -231,6 +231,10 @@ pub struct FirstWalk {
     ray: Option<DiscreteRay>,
     end: WalkEnd,
     steps: u64,
+    /// The record of the hit voxel when the walk's hit test already
+    /// fetched it (index, record), so that resolving does not look it up
+    /// again.
+    found: Option<(usize, VoxelRecord)>,
 }
 
 /// The slab intersection of the line `o + t·d` with the box `[lo, hi]`:
@@ -259,7 +263,7 @@ fn slab(o: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
 /// gives: any deterministic rounding would do.)
 #[inline]
 fn round_to_int(x: f64) -> i64 {
-    crate::fit::round(x) as i64
+    crate::fit::round_to_i64(x)
 }
 
 /// The unit vector of a stored octahedral normal (unfolded in integers,
@@ -437,6 +441,7 @@ impl<'s> Tracer<'s> {
                 ray: None,
                 end: WalkEnd::Exit,
                 steps: 0,
+                found: None,
             };
         };
         let end = dray
@@ -448,6 +453,7 @@ impl<'s> Tracer<'s> {
             steps: u64::from(dray.steps()),
             ray: Some(dray),
             end,
+            found: None,
         }
     }
 
@@ -488,7 +494,11 @@ impl<'s> Tracer<'s> {
                 return None;
             }
             let h = dray.hit();
-            let accepted = match self.store.get(h.index) {
+            let rec = match walk.found.take() {
+                Some((i, rec)) if i == h.index => Some(rec),
+                _ => self.store.get(h.index).copied(),
+            };
+            let accepted = match &rec {
                 None => {
                     stats.missing += 1;
                     None
@@ -506,7 +516,15 @@ impl<'s> Tracer<'s> {
             let mut missing = 0u64;
             end = dray
                 .walk_skipping(&raster, self.opts.connectivity, u32::MAX, |index, c| {
-                    hit_test(&store, extent, leave, index, c, &mut missing)
+                    hit_test(
+                        &store,
+                        extent,
+                        leave,
+                        index,
+                        c,
+                        &mut missing,
+                        &mut walk.found,
+                    )
                 })
                 .unwrap_or(WalkEnd::Exit);
             stats.missing += missing;
@@ -677,15 +695,25 @@ impl<'s> Tracer<'s> {
                 ray: None,
                 end: WalkEnd::Exit,
                 steps: 0,
+                found: None,
             };
         };
         let raster = self.raster;
         let store = self.store;
         let extent = self.extent;
         let mut missing = 0u64;
+        let mut found = None;
         let end = dray
             .walk_skipping(&raster, self.opts.connectivity, u32::MAX, |index, c| {
-                hit_test(&store, extent, Some(rule), index, c, &mut missing)
+                hit_test(
+                    &store,
+                    extent,
+                    Some(rule),
+                    index,
+                    c,
+                    &mut missing,
+                    &mut found,
+                )
             })
             .unwrap_or(WalkEnd::Exit);
         stats.missing += missing;
@@ -693,6 +721,7 @@ impl<'s> Tracer<'s> {
             steps: u64::from(dray.steps()),
             ray: Some(dray),
             end,
+            found,
         }
     }
 
@@ -931,6 +960,7 @@ impl<'s> Tracer<'s> {
                     WalkEnd::Exit
                 },
                 ray,
+                found: None,
             })
         })
     }
@@ -943,7 +973,8 @@ impl<'s> Tracer<'s> {
 }
 
 /// The hit test of a secondary walk: an opaque voxel with a record that
-/// the acne rule does not ignore.
+/// the acne rule does not ignore. A hit leaves its index and record in
+/// `found`.
 fn hit_test(
     store: &RecordStore<'_>,
     extent: Extent,
@@ -951,6 +982,7 @@ fn hit_test(
     index: usize,
     c: u8,
     missing: &mut u64,
+    found: &mut Option<(usize, VoxelRecord)>,
 ) -> bool {
     if c & cell::OPAQUE == 0 {
         return false;
@@ -967,6 +999,12 @@ fn hit_test(
             *missing += 1;
             false
         }
-        Some(rec) => leave.is_none_or(|l| !l.ignores_voxel(v, rec)),
+        Some(rec) => {
+            let hit = leave.is_none_or(|l| !l.ignores_voxel(v, rec));
+            if hit {
+                *found = Some((index, *rec));
+            }
+            hit
+        }
     }
 }
