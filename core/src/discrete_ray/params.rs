@@ -76,20 +76,85 @@ struct Param {
 }
 
 impl Param {
-    /// `self < other`, exactly (products < 2^81).
-    fn lt(self, other: Self) -> bool {
-        i128::from(self.n).wrapping_mul(i128::from(other.d))
-            < i128::from(other.n).wrapping_mul(i128::from(self.d))
+    /// `self < other`, exactly (products < 2^81, or < 2^62 in a
+    /// [`Narrow`] setup).
+    fn lt<W: Wide>(self, other: Self) -> bool {
+        W::of(self.n).mul(W::of(other.d)) < W::of(other.n).mul(W::of(self.d))
     }
 }
 
-/// `floor(x / d)` for `d > 0`, in 64 bits when `x` fits.
-fn floor_div(x: i128, d: i64) -> Result<i128, RayError> {
-    match i64::try_from(x) {
-        Ok(x64) => x64.checked_div_euclid(d).map(i128::from),
-        Err(_) => x.checked_div_euclid(i128::from(d)),
+/// The integer type the setup's products are formed in: `i128` in
+/// general, `i64` when the ray and the raster are small enough that every
+/// comparison's products are below 2^62 ([`narrow`]). Both give the same
+/// ray: the quantities compared are exact in either, and the ones only
+/// stored (a decision term, an endpoint's position times a denominator) are
+/// known to fit `i64`, so a wrapping `i64` computation of them is exact.
+trait Wide: Copy + Ord {
+    fn of(v: i64) -> Self;
+    fn mul(self, o: Self) -> Self;
+    fn add(self, o: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+    fn to_i64(self) -> Result<i64, RayError>;
+    /// `floor(self / d)` for `d > 0`.
+    fn floor_div(self, d: i64) -> Result<Self, RayError>;
+}
+
+impl Wide for i64 {
+    fn of(v: i64) -> Self {
+        v
     }
-    .ok_or(RayError::Arithmetic)
+    fn mul(self, o: Self) -> Self {
+        self.wrapping_mul(o)
+    }
+    fn add(self, o: Self) -> Self {
+        self.wrapping_add(o)
+    }
+    fn sub(self, o: Self) -> Self {
+        self.wrapping_sub(o)
+    }
+    fn to_i64(self) -> Result<i64, RayError> {
+        Ok(self)
+    }
+    fn floor_div(self, d: i64) -> Result<Self, RayError> {
+        self.checked_div_euclid(d).ok_or(RayError::Arithmetic)
+    }
+}
+
+impl Wide for i128 {
+    fn of(v: i64) -> Self {
+        i128::from(v)
+    }
+    fn mul(self, o: Self) -> Self {
+        self.wrapping_mul(o)
+    }
+    fn add(self, o: Self) -> Self {
+        self.wrapping_add(o)
+    }
+    fn sub(self, o: Self) -> Self {
+        self.wrapping_sub(o)
+    }
+    fn to_i64(self) -> Result<i64, RayError> {
+        i64::try_from(self).map_err(|_| RayError::Arithmetic)
+    }
+    /// In 64 bits when `self` fits.
+    fn floor_div(self, d: i64) -> Result<Self, RayError> {
+        match i64::try_from(self) {
+            Ok(x64) => x64.checked_div_euclid(d).map(i128::from),
+            Err(_) => self.checked_div_euclid(i128::from(d)),
+        }
+        .ok_or(RayError::Arithmetic)
+    }
+}
+
+/// Whether the `i64` setup is exact for this ray: every `|O_k| < 2^30`
+/// and every raster side `≤ 2^30` fixed units (16384 voxels). Then every
+/// crossing numerator is below 2^31 and `|D| ≤ 2^31`, so the comparisons'
+/// products are below 2^62; an endpoint lies within a voxel of the box, so
+/// its position times a denominator is below 2^62; and the decision terms
+/// are below 2^49 (module notes).
+fn narrow(origin: [i64; 3], size: [i64; 3]) -> bool {
+    const LIM: i64 = 1 << 30;
+    origin.iter().all(|o| o.unsigned_abs() < LIM.unsigned_abs()) && size.iter().all(|&s| s <= LIM)
 }
 
 /// An endpoint of the clipped ray: its parameter, and the axis whose face
@@ -116,6 +181,23 @@ pub(crate) fn setup(
     }
     let n = extent.dims();
     let size = n.map(|v| i64::from(v) << FRAC_BITS);
+    if narrow(origin, size) {
+        setup_in::<i64>(extent, origin, dir, segment, n, size)
+    } else {
+        setup_in::<i128>(extent, origin, dir, segment, n, size)
+    }
+}
+
+/// [`setup`] with its products formed in `W` (see [`Wide`]).
+#[inline(always)]
+fn setup_in<W: Wide>(
+    extent: Extent,
+    origin: [i64; 3],
+    dir: [i32; 3],
+    segment: bool,
+    n: [u32; 3],
+    size: [i64; 3],
+) -> Result<Option<DiscreteRay>, RayError> {
     let ad = dir.map(|v| i64::from(v.unsigned_abs()));
 
     // Clip: t_in = max(0, near crossings), t_out = min(t_max, far crossings).
@@ -150,13 +232,13 @@ pub(crate) fn setup(
         };
         // `>=`: on a tie the later axis wins, matching the x-before-y-before-z
         // order of simultaneous crossings (the last crossing names the face).
-        if !tn.lt(t_in.t) {
+        if !tn.lt::<W>(t_in.t) {
             t_in = End {
                 t: tn,
                 face: Some(k),
             };
         }
-        if t_out.is_none_or(|e| tf.lt(e.t)) {
+        if t_out.is_none_or(|e| tf.lt::<W>(e.t)) {
             t_out = Some(End {
                 t: tf,
                 face: Some(k),
@@ -164,7 +246,7 @@ pub(crate) fn setup(
         }
     }
     if let Some(e) = t_out
-        && !t_in.t.lt(e.t)
+        && !t_in.t.lt::<W>(e.t)
     {
         return Ok(None); // empty or single-point contact
     }
@@ -195,11 +277,11 @@ pub(crate) fn setup(
             return Ok(if below { p.wrapping_sub(1) } else { p } >> FRAC_BITS);
         }
         // P·den = O·den + num·D, exact in i128 (< 2^82).
-        let x = i128::from(o)
-            .wrapping_mul(i128::from(t.d))
-            .wrapping_add(i128::from(t.n).wrapping_mul(i128::from(d)));
-        let q = floor_div(if below { x.wrapping_sub(1) } else { x }, t.d)? >> FRAC_BITS;
-        i64::try_from(q).map_err(|_| RayError::Arithmetic)
+        let x = W::of(o)
+            .mul(W::of(t.d))
+            .add(W::of(t.n).mul(W::of(i64::from(d))));
+        let x = if below { x.sub(W::of(1)) } else { x };
+        Ok(x.floor_div(t.d)?.to_i64()? >> FRAC_BITS)
     };
 
     let mut entry = [0u32; 3];
@@ -250,11 +332,12 @@ pub(crate) fn setup(
         _ => (0, 1),
     };
     let before = |j: usize, k: usize| -> Result<i64, RayError> {
-        let raw = i128::from(dist[j])
-            .wrapping_mul(i128::from(ad[k]))
-            .wrapping_sub(i128::from(dist[k]).wrapping_mul(i128::from(ad[j])));
-        let v = raw.wrapping_mul(2).wrapping_add(if j < k { -1 } else { 1 });
-        i64::try_from(v).map_err(|_| RayError::Arithmetic)
+        let raw = W::of(dist[j])
+            .mul(W::of(ad[k]))
+            .sub(W::of(dist[k]).mul(W::of(ad[j])));
+        raw.mul(W::of(2))
+            .add(W::of(if j < k { -1 } else { 1 }))
+            .to_i64()
     };
     let strides = extent.strides();
     let step = |k: usize| match dir[k] {
@@ -311,4 +394,77 @@ pub(crate) fn setup(
             done: false,
         },
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The `i64` setup gives the very ray the `i128` setup gives, on
+    /// random rays within its domain: rays from far outside, from inside,
+    /// grazing faces, axis-parallel, and segments.
+    #[test]
+    fn narrow_setup_is_the_wide_setup() {
+        let mut x = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut compared = 0u32;
+        let mut some = 0u32;
+        for _ in 0..200_000 {
+            let r = next();
+            let dims = [
+                1 + (r % 300) as u32,
+                1 + ((r >> 9) % 300) as u32,
+                1 + ((r >> 18) % 300) as u32,
+            ];
+            let Ok(extent) = Extent::new(dims[0], dims[1], dims[2]) else {
+                continue;
+            };
+            let size = dims.map(|v| i64::from(v) << FRAC_BITS);
+            let pick = next();
+            let origin: [i64; 3] = core::array::from_fn(|k| {
+                let v = next();
+                match (pick >> (2 * k)) & 3 {
+                    // Anywhere in the narrow range.
+                    0 => (v % (1 << 31)) as i64 - (1 << 30),
+                    // On a voxel boundary near the box.
+                    1 => ((v % 700) as i64 - 200) << FRAC_BITS,
+                    // Inside the box.
+                    _ => (v % size[k].unsigned_abs()) as i64,
+                }
+            });
+            let dir: [i32; 3] = core::array::from_fn(|k| {
+                let v = next();
+                match (pick >> (6 + 2 * k)) & 3 {
+                    0 => 0,
+                    1 => (v as i32) >> (v % 31),
+                    _ => v as i32,
+                }
+            });
+            let segment = pick & (1 << 12) != 0;
+            if !narrow(origin, size) {
+                continue;
+            }
+            if segment
+                && origin
+                    .iter()
+                    .zip(dir.iter())
+                    .any(|(o, d)| (o + i64::from(*d)).unsigned_abs() >= 1 << 30)
+            {
+                continue;
+            }
+            let a = setup_in::<i64>(extent, origin, dir, segment, dims, size);
+            let b = setup_in::<i128>(extent, origin, dir, segment, dims, size);
+            assert_eq!(a, b, "{dims:?} {origin:?} {dir:?} {segment}");
+            compared += 1;
+            if matches!(a, Ok(Some(_))) {
+                some += 1;
+            }
+        }
+        assert!(compared > 100_000 && some > 20_000, "{compared} {some}");
+    }
 }
