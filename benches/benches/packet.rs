@@ -1,12 +1,15 @@
 //! Rays per second of `RayPacket8` against the scalar discrete ray on the
 //! same rays, in all three connectivities.
 //!
-//! Scene: a sphereflake in the spirit of SPD's `balls` at depth 4 (7381
-//! solid spheres, made here with a few lines of code while the real
-//! voxelizers are written), voxelized into a raster of 512 and of 1024
+//! Scene: a sphereflake built like SPD's `balls` at depth 4 (7381 solid
+//! spheres, each with nine children of a third its radius; generated here
+//! so that the bench needs neither `../shared/data` nor the host's
+//! pipeline, and without balls4's floor polygon, so that every ray's walk
+//! is decided by spheres), voxelized into a raster of 512 and of 1024
 //! voxels along its longest axis, with proximity flags from
 //! `flag_neighbourhood` (which writes every cell, so every page of the
-//! plane is touched before timing: no calloc'ed zero pages).
+//! plane is touched before timing: no calloc'ed zero pages). The renderer's
+//! end-to-end comparison on the real `balls4.nff` is in the README.
 //!
 //! Rays: coherent primary rays of a 512² camera in 4×2 pixel blocks (one
 //! block = one packet), and incoherent rays (random origins in empty voxels,
