@@ -419,6 +419,7 @@ fn run() -> Res<()> {
         no_embree: args.no_embree,
     };
     let t_start = Instant::now();
+    let load_start = load_average();
     let mut body = Md::default();
     std::mem::swap(&mut body, &mut ctx.md);
 
@@ -454,13 +455,14 @@ fn run() -> Res<()> {
         total
     ));
     md.para(&format!(
-        "Machine: {}, {} hardware threads, shared with other jobs (load average at the end: {}). \
+        "Machine: {}, {} hardware threads, shared with other jobs (load average at the start: {}, at the end: {}). \
          {}. Every time is the median of {} repetitions, interleaved round by round with what it \
          is compared to, so ratios are taken under the same load; absolute times swing with the \
          load. Paper figures are from a 1992 workstation (about 20 MIPS): compare ratios and \
          trends, not seconds.",
         cpu_name(),
         std::thread::available_parallelism().map_or(0, std::num::NonZero::get),
+        load_start,
         load_average(),
         rustc_version(),
         ctx.cfg.reps

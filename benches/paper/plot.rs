@@ -88,6 +88,15 @@ pub fn log_log(
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(y_label)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| {
+            if *v >= 1.0 {
+                format!("{v:.1}")
+            } else {
+                format!("{v:.3}")
+            }
+        })
+        .light_line_style(RGBColor(235, 235, 235))
         .label_style(("sans-serif", 14))
         .draw()?;
     for (i, s) in series.iter().enumerate() {
