@@ -628,8 +628,7 @@ fn table1(ctx: &mut Ctx) -> Res<()> {
          thread. The paper's image size is not stated. The head is the Colin 27 MRI (181×217×181, \
          1 mm) classified at iso 20, voxelized by the core's volume voxelizer with gray-level \
          gradient normals, lit by one light beside the eye, seen from the front \
-         ([image]({1}/head.png)); it counts as one object, the teapot as its triangles
-.",
+         ([image]({1}/head.png)); it counts as one object, the teapot as its triangles.",
         cfg.image, ctx.plots_link
     ));
     md.table(
