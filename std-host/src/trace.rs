@@ -432,6 +432,14 @@ impl<'s> Tracer<'s> {
             .flatten()
     }
 
+    /// The discrete ray the tracer walks for a world ray (unit direction),
+    /// clipped to the raster; `None` if it misses the raster. For
+    /// benchmarks and tools that walk the same rays themselves.
+    #[must_use]
+    pub fn discrete_ray(&self, ray: &Ray) -> Option<DiscreteRay> {
+        self.discrete(ray)
+    }
+
     /// Stage one of a primary ray: its walk to the first non-transparent
     /// voxel (what a ray packet does).
     #[must_use]
