@@ -354,3 +354,85 @@ fn scene_files_are_not_read_outside_the_options() {
     .to_string();
     assert!(e.starts_with("x.toml:7:"), "{e}");
 }
+
+/// Exact shadows keep the shadows of objects without exact geometry: a
+/// metaball volume over a floor, lit from one side, shadows the floor
+/// beside it with and without `exact_shadows`.
+#[test]
+fn exact_shadows_keep_volume_shadows() {
+    use rrt_host::camera::Camera;
+    use rrt_host::render::{RenderOptions, render};
+    use rrt_host::trace::{TraceOptions, Tracer};
+    let d = temp_dir("exact-volume");
+    let p = d.join("s.toml");
+    std::fs::write(
+        &p,
+        r#"
+[camera]
+from = [0, 0, 10]
+at = [0, 0, 0]
+up = [0, 1, 0]
+angle = 40
+resolution = [33, 33]
+
+[[light]]
+position = [10, 0, 20]
+
+[material.grey]
+colour = [0.8, 0.8, 0.8]
+
+[volume.blob]
+metaballs = { dims = [24, 24, 24], min = [-1, -1, -1], max = [1, 1, 1], balls = [[0, 0, 0, 1.0, 1.0]] }
+iso = 0.3
+translate = [0, 0, 2]
+
+[[object]]
+material = "grey"
+polygon = [[-4, -4, 0], [4, -4, 0], [4, 4, 0], [-4, 4, 0]]
+
+[[object]]
+material = "grey"
+volume = "blob"
+"#,
+    )
+    .unwrap();
+    let scene = Scene::load(&p).unwrap();
+    let vs = built(&scene, 128);
+    let camera = Camera::new(&scene.view, 33, 33).unwrap();
+    let draw = |exact_shadows: bool| {
+        let opts = TraceOptions {
+            verify: true,
+            exact_shadows,
+            ..TraceOptions::default()
+        };
+        let tracer = Tracer::new(&vs, opts).unwrap();
+        let (img, _, _) = render(
+            &tracer,
+            &camera,
+            &RenderOptions {
+                supersample: 1,
+                threads: 1,
+            },
+            &ProgressBar::hidden(),
+        )
+        .unwrap();
+        img
+    };
+    for exact in [false, true] {
+        let img = draw(exact);
+        let px = |x: usize, y: usize| img.rgb[3 * (y * 33 + x)];
+        // The blob (radius about 0.58 at height 2) covers the image's
+        // centre, about 3 pixels each way. Its shadow from the light at
+        // (10, 0, 20) falls around (−1.1, 0, 0), 5 pixels from the centre
+        // towards −x; the floor as far the other way is lit. Which image
+        // side −x is does not matter here.
+        let (a, b) = (px(11, 16), px(21, 16));
+        let (dark, lit) = (a.min(b), a.max(b));
+        assert!(lit > 40, "exact {exact}: floor not lit ({a}, {b})");
+        // In shadow only the ambient term is left (0.5 · 0.8 of 255 = 102).
+        assert!(
+            dark <= 104 && dark + 40 < lit,
+            "exact {exact}: no volume shadow ({a}, {b})"
+        );
+    }
+}

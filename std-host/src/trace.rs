@@ -20,8 +20,10 @@
 //! (each object once). With [`TraceOptions::exact_shadows`] (and
 //! verification), every verified hit fires a 6-connected shadow ray to each
 //! light it faces and counts only objects the continuous segment really
-//! intersects: exact shadow edges, at the cost of those rays. The reflected ray (when `Ks > 0`) and the refracted
-//! ray (when `T > 0`: Snell's law with the material's index of refraction,
+//! intersects (voxels of objects without exact geometry count as they
+//! are): exact shadow edges, at the cost of those rays. The reflected ray
+//! (when `Ks > 0`) and the refracted ray (when `T > 0`: Snell's law with
+//! the material's index of refraction,
 //! total internal reflection falling back to the mirror direction) are
 //! spawned from the stored normal and traced recursively to
 //! [`TraceOptions::depth`] (the eye ray is depth 1). A ray that leaves the
@@ -886,7 +888,10 @@ impl<'s> Tracer<'s> {
                     return false;
                 }
                 if let Some((ray, dist)) = &segment
-                    && let Some(obj) = usize::try_from(b.object).ok().and_then(|i| objects.get(i))
+                    && let Some(obj) = usize::try_from(b.object)
+                        .ok()
+                        .and_then(|i| objects.get(i))
+                        .filter(|o| o.shape.is_exact())
                 {
                     if seen.contains(&b.object) || clear.contains(&b.object) {
                         return false;
