@@ -506,7 +506,7 @@ impl<'s> Tracer<'s> {
             let h = dray.hit();
             let rec = match walk.found.take() {
                 Some((i, rec)) if i == h.index => Some(rec),
-                _ => self.store.get(h.index).copied(),
+                _ => self.store.get_voxel(h.voxel).copied(),
             };
             let accepted = match &rec {
                 None => {
@@ -923,26 +923,38 @@ impl<'s> Tracer<'s> {
     /// Stage one walks every ray to its first non-transparent voxel; stage
     /// two resolves and shades each (module docs, *For packets*).
     pub fn trace_block(&self, rays: &[Option<Ray>; BLOCK], stats: &mut RayStats) -> [DVec3; BLOCK] {
-        let mut walks = if self.opts.packets {
-            self.first_walks_packet(rays)
-        } else {
-            rays.map(|r| r.map(|r| self.first_walk(&r)))
-        };
         let mut out = [DVec3::ZERO; BLOCK];
-        for ((o, r), w) in out.iter_mut().zip(rays).zip(walks.iter_mut()) {
-            let (Some(r), Some(w)) = (r, w.as_mut()) else {
-                continue;
-            };
-            stats.primary += 1;
-            *o = match self.resolve(r, w, 0.0, None, stats) {
-                None => self.background,
-                Some(h) => {
-                    stats.hits += 1;
-                    self.shade(r, &h, 1, stats)
+        if self.opts.packets {
+            let mut walks = self.first_walks_packet(rays);
+            for ((o, r), w) in out.iter_mut().zip(rays).zip(walks.iter_mut()) {
+                if let (Some(r), Some(w)) = (r, w.as_mut()) {
+                    *o = self.primary(r, w, stats);
                 }
-            };
+            }
+        } else {
+            // One lane at a time: no array of walks to move around (a
+            // first walk does not touch the counts, so the order is the
+            // packet path's).
+            for (o, r) in out.iter_mut().zip(rays) {
+                if let Some(r) = r {
+                    let mut w = self.first_walk(r);
+                    *o = self.primary(r, &mut w, stats);
+                }
+            }
         }
         out
+    }
+
+    /// Stage two of a primary ray: resolve its walk and shade the hit.
+    fn primary(&self, r: &Ray, w: &mut FirstWalk, stats: &mut RayStats) -> DVec3 {
+        stats.primary += 1;
+        match self.resolve(r, w, 0.0, None, stats) {
+            None => self.background,
+            Some(h) => {
+                stats.hits += 1;
+                self.shade(r, &h, 1, stats)
+            }
+        }
     }
 
     /// Stage one for eight rays at once: a [`RayPacket8`] walks every lane
