@@ -400,8 +400,18 @@ pub mod baseline {
         let (a, b) = seg_points(r, n);
         let a = (a[0] as i32, a[1] as i32, a[2] as i32);
         let b = (b[0] as i32, b[1] as i32, b[2] as i32);
+        first_occupied(plane, n, Bresenham3d::new(a, b))
+    }
+
+    /// The walk of a voxel iterator to its first occupied voxel, indexing
+    /// the plane from each `(x, y, z)`.
+    fn first_occupied(
+        plane: &[u8],
+        n: u32,
+        voxels: impl Iterator<Item = (i32, i32, i32)>,
+    ) -> Trace {
         let mut steps = 0;
-        for (x, y, z) in Bresenham3d::new(a, b) {
+        for (x, y, z) in voxels {
             steps += 1;
             if let Some(i) = occupied(plane, n, x, y, z) {
                 return Trace {
@@ -418,21 +428,15 @@ pub mod baseline {
     #[must_use]
     pub fn line_drawing_walk(plane: &[u8], n: u32, r: &BenchRay) -> Trace {
         let (a, b) = seg_points(r, n);
-        let mut steps = 0;
-        for (x, y, z) in WalkVoxels::<f32, i32>::new(
-            (a[0], a[1], a[2]),
-            (b[0], b[1], b[2]),
-            &VoxelOrigin::Corner,
-        ) {
-            steps += 1;
-            if let Some(i) = occupied(plane, n, x, y, z) {
-                return Trace {
-                    steps,
-                    hit: Some(i),
-                };
-            }
-        }
-        Trace { steps, hit: None }
+        first_occupied(
+            plane,
+            n,
+            WalkVoxels::<f32, i32>::new(
+                (a[0], a[1], a[2]),
+                (b[0], b[1], b[2]),
+                &VoxelOrigin::Corner,
+            ),
+        )
     }
 
     /// A straightforward integer 3D Bresenham with an incremental index

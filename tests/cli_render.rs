@@ -5,9 +5,6 @@
 
 use std::path::PathBuf;
 
-use clap::Parser;
-use rrt_host::cli::{Cli, run};
-
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("data")
@@ -23,19 +20,7 @@ fn temp_dir(test: &str) -> PathBuf {
 
 /// Runs the command line; the error message with its sources on failure.
 fn cli(args: &[&str]) -> Result<String, String> {
-    let c = Cli::try_parse_from(std::iter::once("rrt").chain(args.iter().copied()))
-        .map_err(|e| e.to_string())?;
-    let mut out = Vec::new();
-    run(&c, &mut out).map_err(|e| {
-        let mut msg = e.to_string();
-        let mut src = std::error::Error::source(&e);
-        while let Some(s) = src {
-            msg.push_str(&format!(": {s}"));
-            src = s.source();
-        }
-        msg
-    })?;
-    Ok(String::from_utf8(out).unwrap())
+    rrt_tests::run_cli(args)
 }
 
 #[track_caller]

@@ -1,6 +1,6 @@
 //! Support code for the integration tests in `tests/`: a seeded RNG, an
-//! exact rational oracle for discrete rays, and the location of the shared
-//! data folder.
+//! exact rational oracle for discrete rays, the location of the shared
+//! data folder, and the `rrt` command line run in-process.
 
 use std::path::PathBuf;
 
@@ -47,6 +47,29 @@ impl Rng {
 pub fn shared_data() -> Option<PathBuf> {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
     p.is_dir().then_some(p)
+}
+
+/// Runs the `rrt` command line with `args` (without the program name):
+/// its standard output, or its error with every source in the chain, as a
+/// user would read it.
+///
+/// # Errors
+/// The argument parser's or the command's message.
+pub fn run_cli(args: &[&str]) -> Result<String, String> {
+    use clap::Parser;
+    let c = rrt_host::cli::Cli::try_parse_from(std::iter::once("rrt").chain(args.iter().copied()))
+        .map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    rrt_host::cli::run(&c, &mut out).map_err(|e| {
+        let mut msg = e.to_string();
+        let mut src = std::error::Error::source(&e);
+        while let Some(s) = src {
+            msg.push_str(&format!(": {s}"));
+            src = s.source();
+        }
+        msg
+    })?;
+    String::from_utf8(out).map_err(|e| e.to_string())
 }
 
 pub mod oracle {

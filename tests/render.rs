@@ -4,13 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::Parser;
 use glam::DVec3;
 use indicatif::ProgressBar;
 use rrt_core::Connectivity;
 use rrt_host::build::{BuildOptions, VoxelScene, build};
 use rrt_host::camera::Camera;
-use rrt_host::cli::{Cli, run};
 use rrt_host::output::png_bytes;
 use rrt_host::rasterfile;
 use rrt_host::render::{Image, RenderOptions, render};
@@ -62,19 +60,7 @@ fn draw(
 }
 
 fn cli(args: &[&str]) -> Result<String, String> {
-    let c = Cli::try_parse_from(std::iter::once("rrt").chain(args.iter().copied()))
-        .map_err(|e| e.to_string())?;
-    let mut out = Vec::new();
-    run(&c, &mut out).map_err(|e| {
-        let mut msg = e.to_string();
-        let mut src = std::error::Error::source(&e);
-        while let Some(s) = src {
-            msg.push_str(&format!(": {s}"));
-            src = s.source();
-        }
-        msg
-    })?;
-    Ok(String::from_utf8(out).unwrap())
+    rrt_tests::run_cli(args)
 }
 
 /// PSNR in dB of two RGB images of the same size.

@@ -696,18 +696,13 @@ mod tests {
     #[test]
     fn decode_is_normalize_of_unfold_within_one_unit() {
         // Every 97th code on each axis, and the extremes.
-        let codes = (i16::MIN..=i16::MAX)
-            .step_by(97)
-            .chain([i16::MAX, -1, 0, 1]);
-        let codes: [i16; 680] = {
-            let mut a = [0i16; 680];
-            for (slot, c) in a.iter_mut().zip(codes) {
-                *slot = c;
-            }
-            a
+        let codes = || {
+            (i16::MIN..=i16::MAX)
+                .step_by(97)
+                .chain([i16::MAX, -1, 0, 1])
         };
-        for &u in &codes {
-            for &v in &codes {
+        for u in codes() {
+            for v in codes() {
                 let fast = decode_normal([u, v]);
                 let slow = normalize(unfold([u, v])).unwrap();
                 for (f, s) in fast.iter().zip(slow.iter()) {

@@ -684,9 +684,8 @@ impl<'s> Tracer<'s> {
             None => self.first_walk(ray),
             Some(rule) => self.secondary_walk(ray, rule, stats),
         };
-        // A secondary ray must not verify onto the point it leaves.
         let tmin = if leave.is_some() {
-            1e-3 * self.frame.voxel_size
+            self.leaving_tmin()
         } else {
             0.0
         };
@@ -733,6 +732,13 @@ impl<'s> Tracer<'s> {
             end,
             found,
         }
+    }
+
+    /// The smallest ray parameter at which an exact intersection counts
+    /// for a ray leaving a surface (a thousandth of a voxel): it must not
+    /// verify onto, or be shadowed by, the point it leaves.
+    fn leaving_tmin(&self) -> f64 {
+        1e-3 * self.frame.voxel_size
     }
 
     /// The acne rule for a ray leaving hit `h` towards the side `side`.
@@ -869,24 +875,20 @@ impl<'s> Tracer<'s> {
         // Objects the exact segment was found not to intersect.
         let mut clear: Vec<u32> = Vec::new();
         let segment = exact.map(|(l, dist)| (Ray::new(h.point, l), dist));
-        let tmin = 1e-3 * self.frame.voxel_size;
+        let tmin = self.leaving_tmin();
         let objects = self.objects;
         let mode = if exact.is_some() {
             Connectivity::Six
         } else {
             self.opts.light.mode
         };
+        let mut missing = 0u64;
         let end = dray
             .walk_skipping(&self.raster, mode, u32::MAX, |index, c| {
-                if c & cell::OPAQUE == 0 {
-                    return false;
-                }
-                let Some(b) = store.get(index) else {
+                let Some(b) = surface_voxel(&store, extent, Some(&rule), index, c, &mut missing)
+                else {
                     return false;
                 };
-                if rule.ignores(extent, index, b) {
-                    return false;
-                }
                 if let Some((ray, dist)) = &segment
                     && let Some(obj) = usize::try_from(b.object)
                         .ok()
@@ -915,6 +917,7 @@ impl<'s> Tracer<'s> {
             })
             .unwrap_or(WalkEnd::Exit);
         stats.steps += u64::from(dray.steps());
+        stats.missing += missing;
         if end == WalkEnd::Hit { 0.0 } else { att }
     }
 
@@ -997,9 +1000,8 @@ impl<'s> Tracer<'s> {
     }
 }
 
-/// The hit test of a secondary walk: an opaque voxel with a record that
-/// the acne rule does not ignore. A hit leaves its index and record in
-/// `found`.
+/// The hit test of a secondary walk ([`surface_voxel`]); a hit leaves its
+/// index and record in `found`.
 fn hit_test(
     store: &RecordStore<'_>,
     extent: Extent,
@@ -1009,27 +1011,39 @@ fn hit_test(
     missing: &mut u64,
     found: &mut Option<(usize, VoxelRecord)>,
 ) -> bool {
+    let rec = surface_voxel(store, extent, leave, index, c, missing);
+    if let Some(rec) = rec {
+        *found = Some((index, *rec));
+    }
+    rec.is_some()
+}
+
+/// The record of the voxel at `index` (plane cell `c`) if it is a surface
+/// a ray leaving `leave` can hit: opaque, with a record (one missing is
+/// counted in `missing`), and not part of the surface being left (the acne
+/// rule). The one test of every ray that leaves a surface: reflected,
+/// refracted and render-time shadow rays.
+fn surface_voxel<'s>(
+    store: &RecordStore<'s>,
+    extent: Extent,
+    leave: Option<&LeavingSurface>,
+    index: usize,
+    c: u8,
+    missing: &mut u64,
+) -> Option<&'s VoxelRecord> {
     if c & cell::OPAQUE == 0 {
-        return false;
+        return None;
     }
     // The voxel being left is never a hit (and has a record: it was hit).
     if leave.is_some_and(|l| l.start == Some(index)) {
-        return false;
+        return None;
     }
-    let Some(v) = extent.coord(index) else {
-        return false;
+    let v = extent.coord(index)?;
+    let Some(rec) = store.get_voxel(v) else {
+        *missing += 1;
+        return None;
     };
-    match store.get_voxel(v) {
-        None => {
-            *missing += 1;
-            false
-        }
-        Some(rec) => {
-            let hit = leave.is_none_or(|l| !l.ignores_voxel(v, rec));
-            if hit {
-                *found = Some((index, *rec));
-            }
-            hit
-        }
-    }
+    leave
+        .is_none_or(|l| !l.ignores_voxel(v, rec))
+        .then_some(rec)
 }

@@ -1001,60 +1001,18 @@ fn fill<R: Read>(reader: &mut R, buf: &mut [u8]) -> Result<(), ReadFail> {
     Ok(())
 }
 
-/// Reads `count` binary samples straight into their typed vector (no
-/// second copy), then fixes the byte order.
+/// Reads `count` binary samples of the header's type and byte order.
 fn read_binary<R: Read>(
     reader: &mut R,
     header: &Header,
     count: usize,
 ) -> Result<Samples, ReadFail> {
-    let little = header.endian.unwrap_or(Endian::Little) == Endian::Little;
-    Ok(match header.sample_type {
-        SampleType::U8 => {
-            let mut v = vec![0u8; count];
-            fill(reader, &mut v)?;
-            Samples::U8(v)
-        }
-        SampleType::I16 => {
-            let mut v = vec![0i16; count];
-            fill(reader, bytemuck::cast_slice_mut(&mut v))?;
-            for x in &mut v {
-                *x = if little {
-                    i16::from_le(*x)
-                } else {
-                    i16::from_be(*x)
-                };
-            }
-            Samples::I16(v)
-        }
-        SampleType::U16 => {
-            let mut v = vec![0u16; count];
-            fill(reader, bytemuck::cast_slice_mut(&mut v))?;
-            for x in &mut v {
-                *x = if little {
-                    u16::from_le(*x)
-                } else {
-                    u16::from_be(*x)
-                };
-            }
-            Samples::U16(v)
-        }
-        SampleType::F32 => {
-            let mut v = vec![0u32; count];
-            fill(reader, bytemuck::cast_slice_mut(&mut v))?;
-            Samples::F32(
-                v.into_iter()
-                    .map(|b| {
-                        f32::from_bits(if little {
-                            u32::from_le(b)
-                        } else {
-                            u32::from_be(b)
-                        })
-                    })
-                    .collect(),
-            )
-        }
-    })
+    Samples::read_binary(
+        header.sample_type,
+        header.endian.unwrap_or(Endian::Little),
+        count,
+        |buf| fill(reader, buf),
+    )
 }
 
 /// Reads `count` whitespace- (or comma-) separated numbers.

@@ -137,58 +137,8 @@ fn decode<R: Read>(
         source,
     };
     std::io::copy(&mut reader.by_ref().take(spec.skip), &mut std::io::sink()).map_err(io)?;
-    let little = spec.endian == Endian::Little;
-    let samples = match spec.sample_type {
-        SampleType::U8 => {
-            let mut v = vec![0u8; count];
-            reader.read_exact(&mut v).map_err(io)?;
-            Samples::U8(v)
-        }
-        SampleType::I16 => {
-            let mut v = vec![0i16; count];
-            reader
-                .read_exact(bytemuck::cast_slice_mut(&mut v))
-                .map_err(io)?;
-            v.iter_mut().for_each(|x| {
-                *x = if little {
-                    i16::from_le(*x)
-                } else {
-                    i16::from_be(*x)
-                };
-            });
-            Samples::I16(v)
-        }
-        SampleType::U16 => {
-            let mut v = vec![0u16; count];
-            reader
-                .read_exact(bytemuck::cast_slice_mut(&mut v))
-                .map_err(io)?;
-            v.iter_mut().for_each(|x| {
-                *x = if little {
-                    u16::from_le(*x)
-                } else {
-                    u16::from_be(*x)
-                };
-            });
-            Samples::U16(v)
-        }
-        SampleType::F32 => {
-            let mut v = vec![0u32; count];
-            reader
-                .read_exact(bytemuck::cast_slice_mut(&mut v))
-                .map_err(io)?;
-            Samples::F32(
-                v.into_iter()
-                    .map(|b| {
-                        f32::from_bits(if little {
-                            u32::from_le(b)
-                        } else {
-                            u32::from_be(b)
-                        })
-                    })
-                    .collect(),
-            )
-        }
-    };
+    let samples = Samples::read_binary(spec.sample_type, spec.endian, count, |buf| {
+        reader.read_exact(buf).map_err(io)
+    })?;
     Volume::new(spec.dims, spec.grid, samples)
 }
