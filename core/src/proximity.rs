@@ -102,15 +102,22 @@ pub const DISTANCE_LIMIT: u8 = cell::DISTANCE_MASK;
 
 /// The proximity distance stored in a cell: a lower bound on the chessboard
 /// distance from the voxel to the nearest [`cell::OPAQUE`] voxel (0 = no
-/// information, or opaque).
+/// information). Always 0 for an opaque cell, whose distance bits hold its
+/// record's rank hint instead ([`crate::store::rank_hint`]).
 ///
 /// ```
 /// use rrt_core::proximity::distance;
+/// use rrt_core::raster::cell;
 /// assert_eq!(distance(5 << 2), 5);
+/// assert_eq!(distance((5 << 2) | cell::OPAQUE), 0);
 /// ```
 #[must_use]
 pub const fn distance(c: u8) -> u8 {
-    (c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK
+    if c & cell::OPAQUE != 0 {
+        0
+    } else {
+        (c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK
+    }
 }
 
 /// Computes the proximity distance field: every cell gets the chessboard
@@ -118,10 +125,11 @@ pub const fn distance(c: u8) -> u8 {
 /// saturated at [`DISTANCE_LIMIT`], in its distance bits, and
 /// [`cell::PROXIMITY`] where that distance is at most 1 (exactly what
 /// [`flag_neighbourhood`] sets). A raster without opaque voxels gets the
-/// limit everywhere.
+/// limit everywhere. Opaque cells get distance bits 0, which clears their
+/// rank hints: write them afterwards ([`crate::store::write_rank_hints`]).
 ///
 /// Cohen & Sheffer's proximity clouds, generalizing the paper's one-bit flag:
-/// a 26-connected ray at a voxel of distance `d` can take `d − 2` steps at
+/// a 26-connected ray at a voxel of distance `d` can take `d − 1` steps at
 /// once without passing a non-transparent or flagged voxel (see
 /// [`crate::discrete_ray::DiscreteRay::first_hit_skipping`]).
 ///

@@ -25,8 +25,10 @@ pub const MAX_AXIS: u32 = 1 << 16;
 ///   bit 0      OPAQUE     the voxel is non-transparent (holds an object)
 ///   bit 1      PROXIMITY  the voxel is near a non-transparent voxel: adaptive
 ///                         rays take 6-connected steps here
-///   bits 2..8  DISTANCE   reserved for a saturating proximity distance
-///                         (empty-space skipping); 0 means "unknown / none"
+///   bits 2..8  DISTANCE   in a transparent voxel: a saturating proximity
+///                         distance (empty-space skipping), 0 meaning
+///                         "unknown / none"; in an OPAQUE voxel: the rank
+///                         hint of its record (crate::store::rank_hint)
 /// ```
 pub mod cell {
     /// The voxel is non-transparent: the default hit test.
@@ -34,9 +36,11 @@ pub mod cell {
     /// The voxel lies in the 26-neighbourhood of a non-transparent voxel (or
     /// is one): adaptive rays slow down to 6-connected steps here.
     pub const PROXIMITY: u8 = 1 << 1;
-    /// Shift of the proximity-distance field.
+    /// Shift of the proximity-distance field (the rank hint in an opaque
+    /// cell).
     pub const DISTANCE_SHIFT: u32 = 2;
-    /// Mask of the proximity-distance field (after shifting).
+    /// Mask of the proximity-distance field (the rank hint in an opaque
+    /// cell), after shifting.
     pub const DISTANCE_MASK: u8 = 0x3f;
     /// An empty cell: transparent and far from everything.
     pub const EMPTY: u8 = 0;

@@ -9,7 +9,10 @@
 //! `u32` offset per brick plus one: brick `b`'s records are
 //! `records[dir[b]..dir[b + 1]]`, and `dir[last] == records.len()`. A lookup
 //! finds the brick from the coordinates and binary-searches the position
-//! among at most 512 records: O(log 512).
+//! among at most 512 records: O(log 512). An opaque cell's distance bits
+//! carry its record's *rank hint* ([`write_rank_hints`]), which narrows a
+//! lookup from the plane ([`RecordStore::get_hinted`]) to a window of about
+//! `n/64 + 1` of the brick's `n` records.
 //!
 //! **Memory.** Everything that scales with the raster volume is the plane
 //! (1 byte per voxel) and the directory (4 bytes per 512 voxels): 1.008
@@ -377,8 +380,17 @@ fn validate(extent: Extent, dir: &[u32], records: &[VoxelRecord]) -> Result<(), 
     Ok(())
 }
 
-/// The record of voxel `v` among `records` under `dir`.
-fn find(extent: Extent, dir: &[u32], records: &[VoxelRecord], v: [u32; 3]) -> Option<usize> {
+/// The record of voxel `v` among `records` under `dir`. With a rank `hint`
+/// (see [`rank_hint`]) only the hint's window is scanned first; a record
+/// not there (a stale or made-up hint) is found by the binary search, so a
+/// hint changes the cost of a lookup, never its result.
+fn find(
+    extent: Extent,
+    dir: &[u32],
+    records: &[VoxelRecord],
+    v: [u32; 3],
+    hint: Option<u8>,
+) -> Option<usize> {
     if !extent.contains(v) {
         return None;
     }
@@ -387,10 +399,109 @@ fn find(extent: Extent, dir: &[u32], records: &[VoxelRecord], v: [u32; 3]) -> Op
     let hi = to_usize(*dir.get(b.checked_add(1)?)?);
     let slice = records.get(lo..hi)?;
     let pos = brick_position(v);
+    if let Some(h) = hint {
+        let (from, to) = hint_window(h, slice.len());
+        if let Some(k) = slice
+            .get(from..to)
+            .and_then(|w| w.iter().position(|r| r.position() == pos))
+        {
+            return lo.checked_add(from)?.checked_add(k);
+        }
+    }
     let k = slice
         .binary_search_by_key(&pos, VoxelRecord::position)
         .ok()?;
     lo.checked_add(k)
+}
+
+/// Ranks with hint `h` among `n` records: `⌈h·n/64⌉ .. ⌈(h+1)·n/64⌉`.
+fn hint_window(h: u8, n: usize) -> (usize, usize) {
+    let at = |h: usize| h.saturating_mul(n).saturating_add(HINT_SCALE - 1) / HINT_SCALE;
+    let h = usize::from(h);
+    (at(h), at(h.saturating_add(1)))
+}
+
+/// Rank hints take the 64 values of a cell's distance bits.
+const HINT_SCALE: usize = cell::DISTANCE_MASK as usize + 1;
+
+/// The rank hint of the record of rank `rank` among its brick's `n`
+/// records: `⌊rank·64/n⌋`, in `0..64`. An opaque cell carries its record's
+/// hint in its distance bits ([`write_rank_hints`]), so that a lookup
+/// ([`RecordStore::get_hinted`]) scans a window of about `n/64 + 1`
+/// records (one for bricks of at most 64) instead of binary-searching up
+/// to 512.
+///
+/// ```
+/// use rrt_core::store::rank_hint;
+/// assert_eq!(rank_hint(0, 10), 0);
+/// assert_eq!(rank_hint(9, 10), 57);
+/// assert_eq!(rank_hint(511, 512), 63);
+/// ```
+#[must_use]
+pub fn rank_hint(rank: usize, n: usize) -> u8 {
+    let h = rank.saturating_mul(HINT_SCALE).checked_div(n).unwrap_or(0);
+    u8::try_from(h.min(HINT_SCALE - 1)).unwrap_or(0)
+}
+
+/// The rank hint an opaque cell carries (`None` for a transparent cell,
+/// whose distance bits hold a proximity distance).
+#[must_use]
+pub const fn cell_hint(c: u8) -> Option<u8> {
+    if c & cell::OPAQUE != 0 {
+        Some((c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK)
+    } else {
+        None
+    }
+}
+
+/// Writes every record's [`rank_hint`] into its opaque cell's distance
+/// bits, keeping the OPAQUE and PROXIMITY bits. O(records). Run it after
+/// [`crate::proximity::distance_field`], which clears them. A raster
+/// without hints (or with wrong ones) gives the same lookups, only slower.
+///
+/// ```
+/// use rrt_core::raster::{cell, Extent, RasterMut};
+/// use rrt_core::store::{cell_hint, write_rank_hints, RecordStore};
+/// use rrt_core::voxel::VoxelRecord;
+/// let e = Extent::cube(8).unwrap();
+/// // Voxels (1, 0, 0) and (2, 0, 0): ranks 0 and 1 of 2.
+/// let recs = [1u16, 2].map(|key| VoxelRecord { key, ..Default::default() });
+/// let store = RecordStore::new(e, &[0, 2], &recs).unwrap();
+/// let mut plane = vec![cell::EMPTY; e.len()];
+/// plane[1] = cell::OPAQUE | cell::PROXIMITY;
+/// plane[2] = cell::OPAQUE | cell::PROXIMITY;
+/// write_rank_hints(&mut RasterMut::new(e, &mut plane).unwrap(), &store);
+/// assert_eq!((cell_hint(plane[1]), cell_hint(plane[2])), (Some(0), Some(32)));
+/// assert_eq!(store.get_hinted([2, 0, 0], plane[2]), Some(&recs[1]));
+/// ```
+pub fn write_rank_hints(raster: &mut RasterMut<'_>, store: &RecordStore<'_>) {
+    let extent = raster.extent();
+    if store.extent() != extent {
+        return;
+    }
+    let plane = raster.plane_mut();
+    for (b, w) in store.dir.windows(2).enumerate() {
+        let (lo, hi) = match w {
+            [lo, hi] => (to_usize(*lo), to_usize(*hi)),
+            _ => continue,
+        };
+        let Some(slice) = store.records.get(lo..hi) else {
+            continue;
+        };
+        let Some(origin) = brick_origin(extent, b) else {
+            continue;
+        };
+        for (rank, r) in slice.iter().enumerate() {
+            let hint = rank_hint(rank, slice.len());
+            if let Some(c) = extent
+                .index(voxel_at(origin, r.position()))
+                .and_then(|i| plane.get_mut(i))
+                .filter(|c| **c & cell::OPAQUE != 0)
+            {
+                *c = (*c & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
+            }
+        }
+    }
 }
 
 impl<'a> RecordStore<'a> {
@@ -435,7 +546,16 @@ impl<'a> RecordStore<'a> {
     /// outside the raster.
     #[must_use]
     pub fn get_voxel(&self, v: [u32; 3]) -> Option<&'a VoxelRecord> {
-        let i = find(self.extent, self.dir, self.records, v)?;
+        let i = find(self.extent, self.dir, self.records, v, None)?;
+        self.records.get(i)
+    }
+
+    /// [`RecordStore::get_voxel`] for a voxel whose plane cell is `c`: an
+    /// opaque cell's rank hint ([`write_rank_hints`]) narrows the search.
+    /// The same result as `get_voxel` whatever `c` holds.
+    #[must_use]
+    pub fn get_hinted(&self, v: [u32; 3], c: u8) -> Option<&'a VoxelRecord> {
+        let i = find(self.extent, self.dir, self.records, v, cell_hint(c))?;
         self.records.get(i)
     }
 
@@ -609,7 +729,7 @@ impl<'a> RecordStoreMut<'a> {
 
     /// The record of voxel `v`, mutably.
     pub fn get_voxel_mut(&mut self, v: [u32; 3]) -> Option<&mut VoxelRecord> {
-        let i = find(self.extent, self.dir, self.records, v)?;
+        let i = find(self.extent, self.dir, self.records, v, None)?;
         self.records.get_mut(i)
     }
 }

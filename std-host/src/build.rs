@@ -48,7 +48,9 @@ use rrt_core::object_table::{
 };
 use rrt_core::proximity::distance_field;
 use rrt_core::raster::{Extent, Raster, RasterMut};
-use rrt_core::store::{self, Counter, Limits, ObjectAttrs, RecordStore, StoreError, directory_len};
+use rrt_core::store::{
+    self, Counter, Limits, ObjectAttrs, RecordStore, StoreError, directory_len, write_rank_hints,
+};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::error::VoxelizeError;
 use rrt_core::voxelize::{Separation, VoxelSink, cone, sphere, triangle};
@@ -642,6 +644,10 @@ pub fn build(
     let t2 = Instant::now();
     if let Ok(mut raster) = RasterMut::new(extent, &mut plane) {
         distance_field(&mut raster);
+        // Opaque cells: the records' rank hints (cleared by the field).
+        if let Ok(store) = RecordStore::new(extent, &directory, &records) {
+            write_rank_hints(&mut raster, &store);
+        }
     }
     let voxelize = voxelize + t2.elapsed();
 

@@ -87,8 +87,8 @@
 //! # Empty-space skipping
 //! The scalar walks use the plane's proximity distances
 //! ([`rrt_core::proximity::distance_field`], computed by the builder):
-//! where the nearest non-transparent voxel is `d ≥ 3` voxels away, a
-//! 26-run takes `d − 2` steps at once, landing exactly where single steps
+//! where the nearest non-transparent voxel is `d ≥ 5` voxels away, a
+//! 26-run takes `d − 1` steps at once, landing exactly where single steps
 //! would. [`RayStats::steps`] counts voxels visited, a jump as one.
 
 #![deny(missing_docs)]
@@ -506,7 +506,10 @@ impl<'s> Tracer<'s> {
             let h = dray.hit();
             let rec = match walk.found.take() {
                 Some((i, rec)) if i == h.index => Some(rec),
-                _ => self.store.get_voxel(h.voxel).copied(),
+                _ => {
+                    let c = self.raster.plane().get(h.index).copied().unwrap_or(0);
+                    self.store.get_hinted(h.voxel, c).copied()
+                }
             };
             let accepted = match &rec {
                 None => {
@@ -626,15 +629,11 @@ impl<'s> Tracer<'s> {
                     let Some(index) = self.extent.index([x, y, z]) else {
                         continue;
                     };
-                    if self
-                        .raster
-                        .plane()
-                        .get(index)
-                        .is_none_or(|c| c & cell::OPAQUE == 0)
-                    {
+                    let c = self.raster.plane().get(index).copied().unwrap_or(0);
+                    if c & cell::OPAQUE == 0 {
                         continue;
                     }
-                    let Some(nrec) = self.store.get(index) else {
+                    let Some(nrec) = self.store.get_hinted([x, y, z], c) else {
                         continue;
                     };
                     if tried[..n_tried].contains(&nrec.object)
@@ -1039,7 +1038,7 @@ fn surface_voxel<'s>(
         return None;
     }
     let v = extent.coord(index)?;
-    let Some(rec) = store.get_voxel(v) else {
+    let Some(rec) = store.get_hinted(v, c) else {
         *missing += 1;
         return None;
     };

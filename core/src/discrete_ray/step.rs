@@ -350,15 +350,11 @@ fn twenty_six_run<
         let k = if SKIP { skip_count(cur, todo) } else { 1 };
         if SKIP && k > 1 {
             let by_a = *by_a.get_or_insert_with(|| Reciprocal::new(inc_a));
-            let (nb, lb) = jump_count(f1, k, by_a, inc_b);
-            let (nc, lc) = jump_count(f2, k, by_a, inc_c);
+            let (nb, f1k, lb) = jump_count(f1, k, by_a, inc_a, inc_b);
+            let (nc, f2k, lc) = jump_count(f2, k, by_a, inc_a, inc_c);
             let kk = i64::from(k);
-            f1 = f1
-                .wrapping_add(kk.wrapping_mul(inc_b))
-                .wrapping_sub(nb.wrapping_mul(inc_a));
-            f2 = f2
-                .wrapping_add(kk.wrapping_mul(inc_c))
-                .wrapping_sub(nc.wrapping_mul(inc_a));
+            f1 = f1k;
+            f2 = f2k;
             let [off_a, off_b, off_c] = p.off;
             let times = |off: usize, n: i64| off.wrapping_mul(usize::try_from(n).unwrap_or(0));
             idx = idx
@@ -462,53 +458,58 @@ fn twenty_six_run<
 /// just loaded, so the next load waits for this one, while single steps
 /// compute their addresses without looking at the cells and overlap their
 /// loads; a jump pays only when it replaces several steps. Measured on
-/// balls4 (raster 1024, 512², one thread, five interleaved runs): minimum
-/// jumps of 2, 4 and 8 rendered in 0.147, 0.142 and 0.142 s (medians) with
-/// 14.7, 16.6 and 21.9 steps per ray; 4 keeps the time and saves steps.
+/// balls4 (raster 1024, 512², one thread, seven interleaved runs, jumps of
+/// `d − 1`): minimum jumps of 2, 3 and 4 rendered in 0.156, 0.148 and
+/// 0.143 s (medians) with 13.5, 14.5 and 15.9 camera-ray steps per ray.
 pub(crate) const MIN_JUMP: u8 = 4;
 
 /// How many 26-steps a run may take at once from a voxel whose cell is
-/// `cur`, with `todo` driving crossings left: `d − 2` for a proximity
-/// distance `d ≥ MIN_JUMP + 2`, else 1.
+/// `cur`, with `todo` driving crossings left: `d − 1` for a proximity
+/// distance `d ≥ MIN_JUMP + 1`, else 1.
 ///
-/// Why `d − 2`: every voxel those steps pass (on the 26-ray or on the 6-ray
-/// between its voxels) lies within chessboard distance `d − 2` of the
-/// current voxel, so at distance at least 2 from every non-transparent
-/// voxel: transparent and unflagged. Single steps would have visited only
-/// such voxels, decided nothing on them (no hit, no switch to 6-steps), and
-/// arrived at the same state.
+/// Why `d − 1`: after `i` 26-steps the ray is at chessboard distance at
+/// most `i` from the current voxel, so the voxels a jump passes over (steps
+/// `1 ..= d − 2`) lie at distance at least 2 from every non-transparent
+/// voxel: transparent and unflagged. Single steps would have visited them,
+/// decided nothing on them (no hit, no switch to 6-steps), and arrived at
+/// the same state; the voxel the jump lands on (step `d − 1`, possibly
+/// flagged) is visited as single steps would visit it.
 #[inline(always)]
 fn skip_count(cur: u8, todo: u32) -> u32 {
     let d = crate::proximity::distance(cur);
-    if d >= MIN_JUMP.wrapping_add(2) {
-        u32::from(d.wrapping_sub(2)).min(todo)
+    if d > MIN_JUMP {
+        u32::from(d.wrapping_sub(1)).min(todo)
     } else {
         1
     }
 }
 
 /// The number of crossings `n` of a minor axis among the next `k ≥ 2`
-/// 26-steps from the threshold-shifted term `f`, and whether the last of
-/// those steps took one.
+/// 26-steps from the threshold-shifted term `f`, the term after them, and
+/// whether the last of those steps took a crossing.
 ///
 /// A 26-step maps `f` to `f + inc_m − inc_a·[f > 0]`, which keeps it in
 /// `(inc_m − inc_a, inc_m]` after the first step from any reachable
 /// `f ∈ (−inc_a, inc_a]`; so after `i ≥ 1` steps the count is the unique
 /// `n_i` putting `f + i·inc_m − n_i·inc_a` in that interval:
 /// `n_i = ⌈(f + (i − 1)·inc_m) / inc_a⌉`, which is 0 when the numerator is
-/// not positive. The values are below 2^55 (k ≤ 61).
+/// not positive. The values are below 2^55 (k ≤ 62).
+///
+/// The last step (from a term `f'` already in that interval, as `k ≥ 2`)
+/// took a crossing iff `f' > 0`, which leaves the new term in
+/// `(inc_m − inc_a, 2·inc_m − inc_a]`; otherwise it lands in
+/// `(2·inc_m − inc_a, inc_m]`. One comparison tells them apart.
 #[inline(always)]
-fn jump_count(f: i64, k: u32, by_a: Reciprocal, inc_m: i64) -> (i64, bool) {
-    let ceil = |i: u32| -> i64 {
-        let x = f.wrapping_add(i64::from(i.wrapping_sub(1)).wrapping_mul(inc_m));
-        match u64::try_from(x.wrapping_sub(1)) {
-            // ⌈x / inc_a⌉ = ⌊(x − 1) / inc_a⌋ + 1 for x > 0.
-            Ok(x1) if x > 0 => i64::try_from(by_a.div(x1)).unwrap_or(0).wrapping_add(1),
-            _ => 0,
-        }
+fn jump_count(f: i64, k: u32, by_a: Reciprocal, inc_a: i64, inc_m: i64) -> (i64, i64, bool) {
+    let x = f.wrapping_add(i64::from(k.wrapping_sub(1)).wrapping_mul(inc_m));
+    let n = match u64::try_from(x.wrapping_sub(1)) {
+        // ⌈x / inc_a⌉ = ⌊(x − 1) / inc_a⌋ + 1 for x > 0.
+        Ok(x1) if x > 0 => i64::try_from(by_a.div(x1)).unwrap_or(0).wrapping_add(1),
+        _ => 0,
     };
-    let n = ceil(k);
-    (n, n != ceil(k.wrapping_sub(1)))
+    let after = x.wrapping_add(inc_m).wrapping_sub(n.wrapping_mul(inc_a));
+    let took = after <= inc_m.wrapping_mul(2).wrapping_sub(inc_a);
+    (n, after, took)
 }
 
 /// Exact division by a constant through a multiplication: `⌊x / d⌋` for
@@ -540,7 +541,44 @@ impl Reciprocal {
 
 #[cfg(test)]
 mod tests {
-    use super::Reciprocal;
+    use super::{Reciprocal, jump_count};
+
+    /// A jump's crossing count, term and last-step crossing are those of
+    /// `k` single 26-steps, ties included (small increments make `f` hit
+    /// the interval ends often).
+    #[test]
+    fn jump_count_is_k_single_steps() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |m: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % m
+        };
+        for case in 0..200_000u32 {
+            let big = case % 2 == 0;
+            let inc_a = i64::try_from(if big { 2 + next(1 << 40) } else { 2 + next(12) }).unwrap();
+            let inc_m = i64::try_from(next(u64::try_from(inc_a).unwrap() + 1)).unwrap();
+            // Any reachable term: (−inc_a, inc_a].
+            let f0 = i64::try_from(next(u64::try_from(2 * inc_a).unwrap())).unwrap() - inc_a + 1;
+            let k = 2 + u32::try_from(next(61)).unwrap();
+            let (mut f, mut n, mut took) = (f0, 0i64, false);
+            for _ in 0..k {
+                took = f > 0;
+                if took {
+                    n += 1;
+                    f -= inc_a;
+                }
+                f += inc_m;
+            }
+            let by_a = Reciprocal::new(inc_a);
+            assert_eq!(
+                jump_count(f0, k, by_a, inc_a, inc_m),
+                (n, f, took),
+                "f0 {f0} k {k} inc_a {inc_a} inc_m {inc_m}"
+            );
+        }
+    }
 
     #[test]
     fn reciprocal_division_is_exact() {

@@ -519,3 +519,53 @@ fn store_mut_updates_in_place() {
     assert!(st.get_voxel_mut([4, 4, 5]).is_none());
     assert_eq!(st.as_store().get_voxel([4, 4, 4]).unwrap().illum, [1, 2, 3]);
 }
+
+/// With rank hints written, hinted lookups find every record through its
+/// window (checked by counting window hits); with any other cell contents
+/// (stale, made up, transparent) they still give `get_voxel`'s answer.
+#[test]
+fn hinted_lookups_are_plain_lookups() {
+    for seed in 0..12u64 {
+        let mut rng = Rng(seed ^ 0xabcd);
+        let extent = Extent::new(1 + rng.below(40), 1 + rng.below(40), 1 + rng.below(40)).unwrap();
+        // Dense enough that bricks hold well over 64 records.
+        let offers = rng.below(40_000) as usize;
+        let script = random_script(extent, 2, offers, seed.wrapping_mul(31));
+        let mut scene = build(extent, &script).unwrap();
+        let store = RecordStore::new(extent, &scene.dir, &scene.records).unwrap();
+        write_rank_hints(
+            &mut RasterMut::new(extent, &mut scene.plane).unwrap(),
+            &store,
+        );
+        let mut in_window = 0usize;
+        for i in 0..extent.len() {
+            let v = extent.coord(i).unwrap();
+            let c = scene.plane[i];
+            let plain = store.get_voxel(v);
+            assert_eq!(store.get_hinted(v, c), plain, "seed {seed}: {v:?}");
+            if let (Some(h), Some(r)) = (cell_hint(c), plain) {
+                let b = brick_of(extent, v);
+                let lo = scene.dir[b] as usize;
+                let n = scene.dir[b + 1] as usize - lo;
+                let rank = (r as *const VoxelRecord as usize - scene.records.as_ptr() as usize)
+                    / core::mem::size_of::<VoxelRecord>()
+                    - lo;
+                let (from, to) = hint_window(h, n);
+                assert!(
+                    (from..to).contains(&rank),
+                    "seed {seed}: rank {rank} of {n}, hint {h}"
+                );
+                assert!(to - from <= n.div_ceil(HINT_SCALE) + 1);
+                in_window += 1;
+            }
+            for junk in [0u8, 0xff, cell::OPAQUE, rng.below(256) as u8] {
+                assert_eq!(
+                    store.get_hinted(v, junk),
+                    plain,
+                    "seed {seed}: {v:?} {junk:#x}"
+                );
+            }
+        }
+        assert_eq!(in_window, scene.records.len());
+    }
+}
