@@ -8,8 +8,8 @@
 use rrt_core::check::{check_adaptive_matches_six, check_lattice_counts, check_skipping};
 use rrt_core::discrete_ray::Connectivity;
 use rrt_core::fixed::{VOXEL, voxel_centre};
-use rrt_core::proximity::{distance_field, flag_neighbourhood};
-use rrt_core::raster::{Extent, Raster, RasterMut, cell};
+use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 use rrt_tests::Rng;
 use rrt_tests::oracle::{Case, check_exact, make_ray};
 
@@ -349,7 +349,7 @@ fn full_diagonals_of_4096_rasters() {
 /// long jumps.
 #[test]
 fn skipping_changes_nothing_but_the_step_count() {
-    let (mut plain_steps, mut skipping_steps) = (0u64, 0u64);
+    let (mut plain_steps, mut skipping_steps, mut line_steps) = (0u64, 0u64, 0u64);
     for i in 0..4_000u64 {
         let seed = seed_of(i) ^ 0x5_1C1F;
         let mut rng = Rng::new(seed);
@@ -370,22 +370,32 @@ fn skipping_changes_nothing_but_the_step_count() {
         let mut rm = RasterMut::new(e, &mut plane).unwrap();
         distance_field(&mut rm);
         let r = rm.as_raster();
+        let mut lines = vec![0u8; line_count(e.len())];
+        line_distances(&r, &mut lines).unwrap();
+        let rl = r.with_lines(&lines).unwrap();
         let Some(ray) = make_ray(&case) else { continue };
-        for mode in Connectivity::ALL {
-            if let Err(v) = check_skipping(&r, &ray, mode) {
-                panic!("seed {seed} {mode:?}: {v:?}, {case:?}");
+        for (raster, what) in [(r, "plane"), (rl, "line level")] {
+            for mode in Connectivity::ALL {
+                if let Err(v) = check_skipping(&raster, &ray, mode) {
+                    panic!("seed {seed} {mode:?} ({what}): {v:?}, {case:?}");
+                }
             }
         }
-        let (mut a, mut b) = (ray, ray);
+        let (mut a, mut b, mut c) = (ray, ray, ray);
         a.first_hit(&r, Connectivity::Adaptive).unwrap();
         b.first_hit_skipping(&r, Connectivity::Adaptive).unwrap();
+        c.first_hit_skipping(&rl, Connectivity::Adaptive).unwrap();
         plain_steps += u64::from(a.steps());
         skipping_steps += u64::from(b.steps());
+        line_steps += u64::from(c.steps());
     }
     // Guard against a generator whose rays never get to jump.
-    println!("adaptive first hits: {plain_steps} steps plain, {skipping_steps} skipping");
+    println!(
+        "adaptive first hits: {plain_steps} steps plain, {skipping_steps} skipping, \
+         {line_steps} skipping through the line level"
+    );
     assert!(
-        plain_steps > 2 * skipping_steps,
-        "skipping saved too little: {plain_steps} vs {skipping_steps} steps"
+        plain_steps > 2 * skipping_steps && plain_steps > 2 * line_steps,
+        "skipping saved too little: {plain_steps} vs {skipping_steps} / {line_steps} steps"
     );
 }

@@ -450,8 +450,8 @@ pub mod fuzz {
     use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
     use rrt_core::error::RayError;
     use rrt_core::fixed::VOXEL;
-    use rrt_core::proximity::{distance_field, flag_neighbourhood};
-    use rrt_core::raster::{Extent, RasterMut, cell};
+    use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+    use rrt_core::raster::{Extent, RasterMut, cell, line_count};
 
     use crate::oracle::{Case, check_exact};
 
@@ -559,13 +559,19 @@ pub mod fuzz {
         {
             panic!("adaptive missed a six hit: {v:?} {c:?}");
         }
-        // With proximity distances, skipping finds the same hits and states.
+        // With proximity distances, skipping finds the same hits and states,
+        // from the plane alone and through its line level.
         distance_field(&mut raster);
         let r = raster.as_raster();
+        let mut lines = vec![0u8; line_count(r.plane().len())];
+        line_distances(&r, &mut lines).expect("line level length");
+        let with_lines = r.with_lines(&lines).expect("line level length");
         if let Ok(Some(ray)) = set_up {
-            for mode in Connectivity::ALL {
-                if let Err(v) = check_skipping(&r, &ray, mode) {
-                    panic!("skipping diverged in {mode:?}: {v:?} {c:?}");
+            for raster in [r, with_lines] {
+                for mode in Connectivity::ALL {
+                    if let Err(v) = check_skipping(&raster, &ray, mode) {
+                        panic!("skipping diverged in {mode:?}: {v:?} {c:?}");
+                    }
                 }
             }
         }

@@ -22,7 +22,7 @@ use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
-use rrt_host::build::{MAX_MATERIALS, VoxelScene};
+use rrt_host::build::{MAX_MATERIALS, VoxelScene, line_level};
 use rrt_host::fit::RasterFrame;
 use rrt_host::plane::Plane;
 use rrt_host::scene::{Material, View};
@@ -183,6 +183,7 @@ pub fn build(
         scene: VoxelScene {
             frame,
             separation,
+            lines: line_level(extent, &plane),
             plane,
             directory,
             records,

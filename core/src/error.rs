@@ -31,6 +31,14 @@ pub enum RasterError {
         /// The slice length given.
         found: usize,
     },
+    /// The line level does not hold exactly one byte per line of
+    /// [`crate::raster::LINE_CELLS`] cells.
+    LineLength {
+        /// `ceil(plane length / LINE_CELLS)`.
+        expected: usize,
+        /// The slice length given.
+        found: usize,
+    },
 }
 
 impl fmt::Display for RasterError {
@@ -52,6 +60,11 @@ impl fmt::Display for RasterError {
                     "raster plane holds {found} bytes, expected {expected} (one per voxel)"
                 )
             }
+            Self::LineLength { expected, found } => write!(
+                f,
+                "raster line level holds {found} bytes, expected {expected} (one per {} cells)",
+                crate::raster::LINE_CELLS
+            ),
         }
     }
 }

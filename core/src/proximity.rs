@@ -11,7 +11,8 @@
 //! each reading only bytes the same sweep has not yet written, so it needs no
 //! scratch memory and touches each cell a constant number of times.
 
-use crate::raster::{RasterMut, cell, to_usize};
+use crate::error::RasterError;
+use crate::raster::{LINE_CELLS, Raster, RasterMut, cell, line_count, to_usize};
 
 /// Sets [`cell::PROXIMITY`] on every voxel within chessboard distance 1 of an
 /// [`cell::OPAQUE`] voxel, and clears it everywhere else.
@@ -118,6 +119,59 @@ pub const fn distance(c: u8) -> u8 {
     } else {
         (c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK
     }
+}
+
+/// Computes the raster's line level ([`Raster::with_lines`]): per line of
+/// [`LINE_CELLS`] consecutive plane cells, a stand-in cell carrying the
+/// smallest proximity distance of the line's cells when that is at least 2
+/// and no cell of the line is opaque or flagged, else [`cell::EMPTY`] (read
+/// the plane). O(plane), after [`distance_field`].
+///
+/// ```
+/// use rrt_core::proximity::{distance, distance_field, line_distances};
+/// use rrt_core::raster::{cell, line_count, Extent, RasterMut};
+/// let e = Extent::new(128, 4, 4).unwrap();
+/// let mut plane = vec![cell::EMPTY; e.len()];
+/// plane[e.index([100, 0, 0]).unwrap()] = cell::OPAQUE;
+/// let mut r = RasterMut::new(e, &mut plane).unwrap();
+/// distance_field(&mut r);
+/// let mut lines = vec![0u8; line_count(e.len())];
+/// line_distances(&r.as_raster(), &mut lines).unwrap();
+/// let line = |v| lines[e.index(v).unwrap() / 64];
+/// // x = 64..128 of row (y, z) = (0, 3): 3 to 36 voxels from the opaque one.
+/// assert_eq!(distance(line([64, 0, 3])), 3);
+/// // x = 0..64 of that row: 37 voxels and more.
+/// assert_eq!(distance(line([0, 0, 3])), 37);
+/// // The opaque voxel's own line: read the plane.
+/// assert_eq!(line([64, 0, 0]), cell::EMPTY);
+/// ```
+///
+/// # Errors
+/// [`RasterError::LineLength`] unless `lines.len()` is
+/// [`line_count`]`(plane length)`.
+pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), RasterError> {
+    let plane = raster.plane();
+    let expected = line_count(plane.len());
+    if lines.len() != expected {
+        return Err(RasterError::LineLength {
+            expected,
+            found: lines.len(),
+        });
+    }
+    for (out, line) in lines.iter_mut().zip(plane.chunks(LINE_CELLS)) {
+        let mut m = DISTANCE_LIMIT;
+        let mut near = false;
+        for &c in line {
+            near |= c & (cell::OPAQUE | cell::PROXIMITY) != 0;
+            m = m.min(distance(c));
+        }
+        *out = if near || m < 2 {
+            cell::EMPTY
+        } else {
+            m << cell::DISTANCE_SHIFT
+        };
+    }
+    Ok(())
 }
 
 /// Computes the proximity distance field: every cell gets the chessboard
@@ -349,6 +403,29 @@ mod tests {
                     flags[i] & cell::PROXIMITY,
                     "case {case}"
                 );
+            }
+            // The line level: each line's smallest distance when that is at
+            // least 2, else EMPTY.
+            let mut lines = vec![0xffu8; line_count(e.len())];
+            line_distances(
+                &RasterMut::new(e, &mut plane).unwrap().as_raster(),
+                &mut lines,
+            )
+            .unwrap();
+            for (l, &got) in lines.iter().enumerate() {
+                let m = want
+                    .iter()
+                    .skip(l * LINE_CELLS)
+                    .take(LINE_CELLS)
+                    .min()
+                    .copied()
+                    .unwrap();
+                let expect = if m >= 2 {
+                    m << cell::DISTANCE_SHIFT
+                } else {
+                    cell::EMPTY
+                };
+                assert_eq!(got, expect, "case {case} line {l}");
             }
         }
     }

@@ -196,6 +196,9 @@ pub struct Raster<'a> {
     extent: Extent,
     /// Invariant: `plane.len() == extent.len()`.
     plane: &'a [u8],
+    /// Empty, or one stand-in cell per line (invariant: then
+    /// `lines.len() == line_count(plane.len())`).
+    lines: &'a [u8],
 }
 
 impl<'a> Raster<'a> {
@@ -210,7 +213,38 @@ impl<'a> Raster<'a> {
                 found: plane.len(),
             });
         }
-        Ok(Self { extent, plane })
+        Ok(Self {
+            extent,
+            plane,
+            lines: &[],
+        })
+    }
+
+    /// The same raster with a *line level*: one stand-in cell per line of
+    /// [`LINE_CELLS`] consecutive cells of the plane, as
+    /// [`crate::proximity::line_distances`] computes it. Skipping walks
+    /// ([`crate::discrete_ray::DiscreteRay::walk_skipping`]) read a line's
+    /// stand-in instead of the plane where it says the whole line is at
+    /// distance 2 or more from every non-transparent voxel: the level is
+    /// 1/64 of the plane and stays in cache where the plane does not.
+    ///
+    /// **Contract:** every stand-in must be [`cell::EMPTY`] or a transparent,
+    /// unflagged cell whose distance is at most that of every cell of its
+    /// line. Otherwise skipping walks may report other hits than plain
+    /// walks (never a panic).
+    ///
+    /// # Errors
+    /// [`RasterError::LineLength`] unless `lines.len()` is
+    /// [`line_count`]`(plane length)`.
+    pub fn with_lines(self, lines: &'a [u8]) -> Result<Self, RasterError> {
+        let expected = line_count(self.plane.len());
+        if lines.len() != expected {
+            return Err(RasterError::LineLength {
+                expected,
+                found: lines.len(),
+            });
+        }
+        Ok(Self { lines, ..self })
     }
 
     /// The raster's dimensions.
@@ -225,11 +259,35 @@ impl<'a> Raster<'a> {
         self.plane
     }
 
+    /// The line level (empty when the raster has none).
+    #[must_use]
+    pub const fn lines(&self) -> &'a [u8] {
+        self.lines
+    }
+
     /// The cell of voxel `v`, or `None` outside the raster.
     #[must_use]
     pub fn cell(&self, v: [u32; 3]) -> Option<u8> {
         self.plane.get(self.extent.index(v)?).copied()
     }
+}
+
+/// Cells per line of the line level ([`Raster::with_lines`]): one 64-byte
+/// cache line of the plane.
+pub const LINE_CELLS: usize = 64;
+
+/// Bits of [`LINE_CELLS`]: cell `i` lies in line `i >> LINE_BITS`.
+pub const LINE_BITS: u32 = LINE_CELLS.trailing_zeros();
+
+/// Number of lines of a plane of `len` cells: `ceil(len / LINE_CELLS)`.
+///
+/// ```
+/// use rrt_core::raster::line_count;
+/// assert_eq!((line_count(0), line_count(64), line_count(65)), (0, 1, 2));
+/// ```
+#[must_use]
+pub const fn line_count(len: usize) -> usize {
+    len.div_ceil(LINE_CELLS)
 }
 
 /// A writable raster, used by voxelizers and the proximity pass.
@@ -267,6 +325,7 @@ impl<'a> RasterMut<'a> {
         Raster {
             extent: self.extent,
             plane: self.plane,
+            lines: &[],
         }
     }
 

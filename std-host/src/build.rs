@@ -46,8 +46,8 @@ use rrt_core::light::{LightError, LightParams, LightReport, illuminate_run};
 use rrt_core::object_table::{
     self, Light, Lights, MAX_LIGHTS, Materials, Object, ObjectTable, SCALAR_ONE,
 };
-use rrt_core::proximity::distance_field;
-use rrt_core::raster::{Extent, Raster, RasterMut};
+use rrt_core::proximity::{distance_field, line_distances};
+use rrt_core::raster::{Extent, Raster, RasterMut, line_count};
 use rrt_core::store::{
     self, Counter, Limits, ObjectAttrs, RecordStore, StoreError, directory_len, write_rank_hints,
 };
@@ -83,6 +83,9 @@ pub struct VoxelScene {
     pub separation: Separation,
     /// One cell per voxel ([`rrt_core::raster::cell`]).
     pub plane: Plane,
+    /// The plane's line level ([`Raster::with_lines`], from [`line_level`]):
+    /// computed from the plane, never saved.
+    pub lines: Vec<u8>,
     /// The brick directory of the record store.
     pub directory: Vec<u32>,
     /// The voxel records, sorted by brick and position.
@@ -106,13 +109,19 @@ impl VoxelScene {
         self.frame.extent
     }
 
-    /// The raster (the plane over the extent).
+    /// The raster (the plane over the extent, with its line level when
+    /// the scene has one).
     ///
     /// # Errors
-    /// Only if the plane does not match the extent, which the constructors
-    /// rule out.
+    /// Only if the plane or the line level does not match the extent, which
+    /// the constructors rule out.
     pub fn raster(&self) -> Result<Raster<'_>, rrt_core::RasterError> {
-        Raster::new(self.frame.extent, &self.plane)
+        let r = Raster::new(self.frame.extent, &self.plane)?;
+        if self.lines.is_empty() {
+            Ok(r)
+        } else {
+            r.with_lines(&self.lines)
+        }
     }
 
     /// The record store, validated (O(bricks + records)).
@@ -129,7 +138,7 @@ impl VoxelScene {
         shade::light_intensity(self.lights.len())
     }
 
-    /// Bytes held by the plane, directory and records.
+    /// Bytes held by the plane, its line level, directory and records.
     #[must_use]
     pub fn memory(&self) -> u64 {
         let dir = self.directory.len().saturating_mul(4);
@@ -137,7 +146,25 @@ impl VoxelScene {
             .records
             .len()
             .saturating_mul(std::mem::size_of::<VoxelRecord>());
-        u64::try_from(self.plane.len().saturating_add(dir).saturating_add(rec)).unwrap_or(u64::MAX)
+        let bytes = self
+            .plane
+            .len()
+            .saturating_add(self.lines.len())
+            .saturating_add(dir)
+            .saturating_add(rec);
+        u64::try_from(bytes).unwrap_or(u64::MAX)
+    }
+}
+
+/// The line level of a plane over `extent` ([`line_distances`]): one
+/// stand-in cell per 64 cells, which lets skipping walks stay off the plane
+/// far from surfaces. Empty if the plane does not match the extent.
+#[must_use]
+pub fn line_level(extent: Extent, plane: &[u8]) -> Vec<u8> {
+    let mut lines = vec![0u8; line_count(plane.len())];
+    match Raster::new(extent, plane).map(|r| line_distances(&r, &mut lines)) {
+        Ok(Ok(())) => lines,
+        _ => Vec::new(),
     }
 }
 
@@ -649,6 +676,7 @@ pub fn build(
             write_rank_hints(&mut raster, &store);
         }
     }
+    let lines = line_level(extent, &plane);
     let voxelize = voxelize + t2.elapsed();
 
     let objects = fitted
@@ -687,6 +715,7 @@ pub fn build(
             frame,
             separation,
             plane,
+            lines,
             directory,
             records,
             objects,

@@ -28,7 +28,7 @@ use std::fmt;
 use glam::DVec3;
 use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::{self, NORMAL_ONE, Point, UnitVector};
-use rrt_core::raster::{Extent, MAX_AXIS};
+use rrt_core::raster::{Extent, LINE_CELLS, MAX_AXIS};
 
 use crate::intersect::{self, Hit, Ray};
 use crate::scene::{Bounds, Scene, SourceLoc};
@@ -177,6 +177,8 @@ pub struct MemoryEstimate {
     pub voxels: u64,
     /// The plane: one byte per voxel.
     pub plane: u64,
+    /// The plane's line level: one byte per 64 voxels.
+    pub lines: u64,
     /// The brick directory: [`BRICK_ENTRY_BYTES`] per [`BRICK_VOXELS`] voxels.
     pub directory: u64,
     /// Upper bound on the non-transparent voxels (at most `voxels`).
@@ -190,6 +192,7 @@ impl MemoryEstimate {
     #[must_use]
     pub fn total(&self) -> u64 {
         self.plane
+            .saturating_add(self.lines)
             .saturating_add(self.directory)
             .saturating_add(self.records)
     }
@@ -199,8 +202,9 @@ impl fmt::Display for MemoryEstimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "plane {}, brick directory {}, records for up to {} voxels {}",
+            "plane {}, line level {}, brick directory {}, records for up to {} voxels {}",
             Bytes(self.plane),
+            Bytes(self.lines),
             Bytes(self.directory),
             self.record_voxels,
             Bytes(self.records)
@@ -652,8 +656,8 @@ pub fn frame(scene: &Scene, opts: &FitOptions) -> Result<RasterFrame, FitError> 
 /// Upper-bound memory estimate for `scene` voxelized into `frame`,
 /// computed from the world geometry without allocating.
 ///
-/// The plane takes 1 byte per voxel and the brick directory 4 bytes per
-/// 512 voxels. Non-transparent voxels are bounded by surface area `A`
+/// The plane takes 1 byte per voxel, its line level 1 byte per 64 voxels
+/// and the brick directory 4 bytes per 512 voxels. Non-transparent voxels are bounded by surface area `A`
 /// and boundary length `P` (in voxel units): a surface generates at most
 /// `1.8·(A + P + 3)` voxels in the thickest (26-tunnel-free)
 /// voxelization, the `P` and constant terms covering edges and tiny
@@ -701,6 +705,7 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
     MemoryEstimate {
         voxels,
         plane: voxels,
+        lines: voxels.div_ceil(LINE_CELLS as u64),
         directory: voxels
             .div_ceil(BRICK_VOXELS)
             .saturating_mul(BRICK_ENTRY_BYTES),
@@ -992,6 +997,7 @@ mod tests {
         let m = estimate_memory(&s, &f, true);
         assert_eq!(m.voxels, 104 * 104 * 4);
         assert_eq!(m.plane, m.voxels);
+        assert_eq!(m.lines, m.voxels.div_ceil(64));
         assert_eq!(m.directory, 4 * m.voxels.div_ceil(512));
         // Two triangles of area 5000 and perimeter 100 + 100 + 141.4.
         let per_tri = 1.8 * (5000.0 + 200.0 + 100.0 * 2f64.sqrt() + 3.0);
@@ -1002,8 +1008,8 @@ mod tests {
             "at least one layer of the square"
         );
 
-        // 43264 + 340 + 19240·20 = 428404 bytes = 418.4 KiB.
-        assert_eq!(m.total(), 428_404);
+        // 43264 + 676 + 340 + 19240·20 = 429080 bytes = 419.0 KiB.
+        assert_eq!(m.total(), 429_080);
         let e = fit(
             &s,
             &FitOptions {
@@ -1014,8 +1020,8 @@ mod tests {
         .unwrap_err();
         assert_eq!(
             e.to_string(),
-            "raster 104×104×4: needs about 418.4 KiB (plane 42.2 KiB, brick directory 340 B, \
-             records for up to 19240 voxels 375.8 KiB), more than the limit of 256.0 KiB; use a \
+            "raster 104×104×4: needs about 419.0 KiB (plane 42.2 KiB, line level 676 B, brick \
+             directory 340 B, records for up to 19240 voxels 375.8 KiB), more than the limit of 256.0 KiB; use a \
              smaller raster or a larger memory limit"
         );
         assert!(

@@ -55,7 +55,7 @@ use rrt_core::store::{RecordStore, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
-use crate::build::{MAX_MATERIALS, VoxelScene};
+use crate::build::{MAX_MATERIALS, VoxelScene, line_level};
 use crate::fit::RasterFrame;
 use crate::plane::Plane;
 use crate::scene::{Material, SourceLoc, View};
@@ -856,6 +856,7 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
             voxel_size: m.voxel_size,
         },
         separation: m.separation,
+        lines: line_level(extent, &plane),
         plane,
         directory,
         records,

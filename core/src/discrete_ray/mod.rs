@@ -77,7 +77,7 @@ mod step;
 mod tests;
 
 use crate::error::RayError;
-use crate::raster::{Extent, Raster, cell};
+use crate::raster::{Extent, LINE_BITS, Raster, cell};
 use params::Params;
 
 pub use crate::connectivity::Connectivity;
@@ -361,6 +361,11 @@ impl DiscreteRay {
     /// `steps` differs: it counts the voxels actually visited, one per jump.
     /// A plane without distances (all distance bits 0) never skips.
     ///
+    /// With a line level ([`Raster::with_lines`]) a voxel whose line is at
+    /// distance 2 or more from every non-transparent voxel is decided from
+    /// the line's stand-in cell, without reading the plane; its jump is the
+    /// line's (smaller or equal) distance less one.
+    ///
     /// # Errors
     /// As [`DiscreteRay::walk`].
     pub fn walk_skipping<T: FnMut(usize, u8) -> bool>(
@@ -374,7 +379,17 @@ impl DiscreteRay {
             return Err(RayError::ExtentMismatch);
         }
         let plane = raster.plane();
-        Ok(self.run::<true, _, _>(mode, |i| plane.get(i).copied(), budget, test))
+        let lines = raster.lines();
+        Ok(if lines.is_empty() {
+            self.run::<true, _, _>(mode, |i| plane.get(i).copied(), budget, test)
+        } else {
+            // A line's stand-in where it allows a jump, else the plane.
+            let cells = |i: usize| match lines.get(i >> LINE_BITS) {
+                Some(&l) if l >= step::LINE_JUMP => Some(l),
+                _ => plane.get(i).copied(),
+            };
+            self.run::<true, _, _>(mode, cells, budget, test)
+        })
     }
 
     /// [`DiscreteRay::first_hit`] with empty-space skipping (see

@@ -463,6 +463,12 @@ fn twenty_six_run<
 /// 0.143 s (medians) with 13.5, 14.5 and 15.9 camera-ray steps per ray.
 pub(crate) const MIN_JUMP: u8 = 4;
 
+/// The smallest line stand-in ([`crate::raster::Raster::with_lines`]) a
+/// skipping walk reads instead of the plane: one whose distance allows a
+/// jump (`d > MIN_JUMP`). Nearer lines send the walk to the plane, whose
+/// cell may allow a jump where the line's smallest distance does not.
+pub(crate) const LINE_JUMP: u8 = (MIN_JUMP + 1) << crate::raster::cell::DISTANCE_SHIFT;
+
 /// How many 26-steps a run may take at once from a voxel whose cell is
 /// `cur`, with `todo` driving crossings left: `d − 1` for a proximity
 /// distance `d ≥ MIN_JUMP + 1`, else 1.
