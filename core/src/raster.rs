@@ -225,7 +225,7 @@ impl<'a> Raster<'a> {
     /// [`crate::proximity::line_distances`] computes it. Skipping walks
     /// ([`crate::discrete_ray::DiscreteRay::walk_skipping`]) read a line's
     /// stand-in instead of the plane where it says the whole line is at
-    /// distance 2 or more from every non-transparent voxel: the level is
+    /// distance 8 or more from every non-transparent voxel: the level is
     /// 1/64 of the plane and stays in cache where the plane does not.
     ///
     /// **Contract:** every stand-in must be [`cell::EMPTY`] or a transparent,

@@ -89,7 +89,10 @@
 //! ([`rrt_core::proximity::distance_field`], computed by the builder):
 //! where the nearest non-transparent voxel is `d ≥ 5` voxels away, a
 //! 26-run takes `d − 1` steps at once, landing exactly where single steps
-//! would. [`RayStats::steps`] counts voxels visited, a jump as one.
+//! would. Far from surfaces they read the scene's line level instead of the
+//! plane ([`rrt_core::raster::Raster::with_lines`]: one stand-in cell per
+//! 64 plane cells, small enough to stay in cache). [`RayStats::steps`]
+//! counts voxels visited, a jump as one.
 
 #![deny(missing_docs)]
 // `!(x < y)` is deliberate: it is true for NaN, which must be refused too.

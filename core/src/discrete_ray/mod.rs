@@ -362,7 +362,7 @@ impl DiscreteRay {
     /// A plane without distances (all distance bits 0) never skips.
     ///
     /// With a line level ([`Raster::with_lines`]) a voxel whose line is at
-    /// distance 2 or more from every non-transparent voxel is decided from
+    /// distance 8 or more from every non-transparent voxel is decided from
     /// the line's stand-in cell, without reading the plane; its jump is the
     /// line's (smaller or equal) distance less one.
     ///
@@ -383,7 +383,8 @@ impl DiscreteRay {
         Ok(if lines.is_empty() {
             self.run::<true, _, _>(mode, |i| plane.get(i).copied(), budget, test)
         } else {
-            // A line's stand-in where it allows a jump, else the plane.
+            // A line's stand-in where the line is far from surfaces, else
+            // the plane.
             let cells = |i: usize| match lines.get(i >> LINE_BITS) {
                 Some(&l) if l >= step::LINE_JUMP => Some(l),
                 _ => plane.get(i).copied(),
