@@ -159,16 +159,14 @@ pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), Raste
         });
     }
     for (out, line) in lines.iter_mut().zip(plane.chunks(LINE_CELLS)) {
-        let mut m = DISTANCE_LIMIT;
-        let mut near = false;
-        for &c in line {
-            near |= c & (cell::OPAQUE | cell::PROXIMITY) != 0;
-            m = m.min(distance(c));
-        }
-        *out = if near || m < 2 {
+        // Without OPAQUE or PROXIMITY in any cell, every cell is its distance
+        // bits alone, and the smallest cell holds the smallest distance.
+        let any = line.iter().fold(0u8, |a, &c| a | c);
+        let least = line.iter().fold(u8::MAX, |a, &c| a.min(c));
+        *out = if any & (cell::OPAQUE | cell::PROXIMITY) != 0 || distance(least) < 2 {
             cell::EMPTY
         } else {
-            m << cell::DISTANCE_SHIFT
+            least
         };
     }
     Ok(())
