@@ -10,6 +10,12 @@
 //! The pass is a separable dilation: two in-place sweeps along each axis,
 //! each reading only bytes the same sweep has not yet written, so it needs no
 //! scratch memory and touches each cell a constant number of times.
+//!
+//! [`distance_field`] generalizes the flag to a saturating chessboard
+//! distance (Cohen & Sheffer's proximity clouds) for empty-space skipping,
+//! and [`line_distances`] condenses it into the raster's line level: one
+//! stand-in cell per 64 plane cells, which skipping walks read instead of
+//! the plane far from surfaces.
 
 use crate::error::RasterError;
 use crate::raster::{LINE_CELLS, Raster, RasterMut, cell, line_count, to_usize};
