@@ -17,12 +17,11 @@ use rrt_core::light::{LightParams, LightReport, illuminate_run};
 use rrt_core::object_table::{
     self, Light, Lights, Materials, Object, ObjectTable, SCALAR_ONE, Shape,
 };
-use rrt_core::proximity::distance_field;
 use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
-use rrt_host::build::{MAX_MATERIALS, VoxelScene, line_level};
+use rrt_host::build::{MAX_MATERIALS, VoxelScene, finish_plane};
 use rrt_host::fit::RasterFrame;
 use rrt_host::plane::Plane;
 use rrt_host::scene::{Material, View};
@@ -168,8 +167,7 @@ pub fn build(
     records = lit;
     let lights_time = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let mut raster_mut = RasterMut::new(extent, &mut plane)?;
-    distance_field(&mut raster_mut);
+    let lines = finish_plane(extent, &mut plane, &directory, &records);
     voxelize += t2.elapsed().as_secs_f64();
 
     let view = View {
@@ -183,7 +181,7 @@ pub fn build(
         scene: VoxelScene {
             frame,
             separation,
-            lines: line_level(extent, &plane),
+            lines,
             plane,
             directory,
             records,

@@ -1277,14 +1277,10 @@ fn skipping(ctx: &mut Ctx) -> Res<()> {
             let nr = rays.len().max(1) as f64;
             let saving = first[0].steps as f64 / first[1].steps.max(1) as f64;
             let line_saving = first[0].steps as f64 / first[2].steps.max(1) as f64;
-            min_line_saving_large = if r >= 1024 || cfg.quick {
-                min_line_saving_large.min(line_saving)
-            } else {
-                min_line_saving_large
-            };
             min_saving = min_saving.min(saving);
             if r >= 1024 || cfg.quick {
                 min_saving_large = min_saving_large.min(saving);
+                min_line_saving_large = min_line_saving_large.min(line_saving);
             }
             let [tn, ts, tl] = [median(&t[0]), median(&t[1]), median(&t[2])];
             left.push((r, first[1].steps as f64 / nr, first[0].steps as f64 / nr));

@@ -156,6 +156,27 @@ impl VoxelScene {
     }
 }
 
+/// The last pass over a voxelized plane, once its records are final: the
+/// proximity distance field (empty-space skipping for 26-runs; it sets the
+/// same PROXIMITY flags the builder set), the records' rank hints in their
+/// opaque cells (which the field clears), and the line level, returned.
+/// A plane, directory or record array that does not match `extent` is left
+/// as it is, with no line level.
+pub fn finish_plane(
+    extent: Extent,
+    plane: &mut [u8],
+    directory: &[u32],
+    records: &[VoxelRecord],
+) -> Vec<u8> {
+    if let Ok(mut raster) = RasterMut::new(extent, plane) {
+        distance_field(&mut raster);
+        if let Ok(store) = RecordStore::new(extent, directory, records) {
+            write_rank_hints(&mut raster, &store);
+        }
+    }
+    line_level(extent, plane)
+}
+
 /// The line level of a plane over `extent` ([`line_distances`]): one
 /// stand-in cell per 64 cells, which lets skipping walks stay off the plane
 /// far from surfaces. Empty if the plane does not match the extent.
@@ -666,17 +687,8 @@ pub fn build(
     records = lit;
     let lights_time = t1.elapsed();
 
-    // The proximity distance field (empty-space skipping for 26-runs); it
-    // sets the same PROXIMITY flags the builder set.
     let t2 = Instant::now();
-    if let Ok(mut raster) = RasterMut::new(extent, &mut plane) {
-        distance_field(&mut raster);
-        // Opaque cells: the records' rank hints (cleared by the field).
-        if let Ok(store) = RecordStore::new(extent, &directory, &records) {
-            write_rank_hints(&mut raster, &store);
-        }
-    }
-    let lines = line_level(extent, &plane);
+    let lines = finish_plane(extent, &mut plane, &directory, &records);
     let voxelize = voxelize + t2.elapsed();
 
     let objects = fitted
