@@ -1,7 +1,12 @@
 //! The image: primary rays for every pixel, in parallel, deterministic.
 //!
-//! The image is cut into tiles of [`TILE_W`] × [`TILE_H`] pixels, which
-//! rayon hands to its threads; each tile is cut into 4×2 pixel blocks
+//! The image is cut into tiles of [`TILE_W`] × [`TILE_H`] pixels. The
+//! threads of a rayon pool take them in scanline order from one shared
+//! counter, so at any moment they work on neighbouring tiles, whose rays
+//! read largely the same raster lines: the threads share those lines in
+//! the last-level cache instead of each streaming its own half of the
+//! raster (rayon's split of the tile range gave each thread one half of
+//! the image). Each tile is cut into 4×2 pixel blocks
 //! traced through [`Tracer::trace_block`] (eight rays: the lanes of a ray
 //! packet). With supersampling `K`, each pixel gets `K × K` rays at the
 //! sub-pixel offsets of [`crate::camera::sample_offset`] (row by row), and
@@ -18,7 +23,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
-use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::camera::{Camera, sample_offset};
 use crate::intersect::Ray;
@@ -146,24 +151,29 @@ pub fn render(
             source,
         })?;
     let t0 = Instant::now();
-    let done: Vec<(Vec<[u8; 3]>, RayStats)> = pool.install(|| {
-        (0..tiles)
-            .into_par_iter()
-            .map(|t| {
-                let tx = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0);
-                let ty = u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
-                let r = render_tile(tracer, camera, k, tx * TILE_W, ty * TILE_H);
-                progress.inc(1);
-                r
-            })
-            .collect()
+    // Every thread takes the next tile in scanline order from one counter
+    // (module docs: neighbouring tiles share the raster lines they read).
+    let next = AtomicU64::new(0);
+    let per_thread: Vec<Vec<(u64, TileResult)>> = pool.broadcast(|_| {
+        let mut mine = Vec::new();
+        loop {
+            let t = next.fetch_add(1, Ordering::Relaxed);
+            if t >= tiles {
+                break mine;
+            }
+            let tx = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0);
+            let ty = u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
+            mine.push((t, render_tile(tracer, camera, k, tx * TILE_W, ty * TILE_H)));
+            progress.inc(1);
+        }
     });
     let elapsed = t0.elapsed();
+    let mut done: Vec<(u64, TileResult)> = per_thread.into_iter().flatten().collect();
+    done.sort_unstable_by_key(|&(t, _)| t);
     let mut rgb = vec![0u8; 3 * w as usize * h as usize];
     let mut stats = RayStats::default();
-    for (t, (pixels, s)) in done.iter().enumerate() {
+    for (t, (pixels, s)) in &done {
         stats.add(s);
-        let t = t as u64;
         let x0 = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0) * TILE_W;
         let y0 = u32::try_from(t / u64::from(tiles_x)).unwrap_or(0) * TILE_H;
         let tw = TILE_W.min(w - x0);
@@ -187,13 +197,10 @@ pub fn render(
 }
 
 /// One tile's pixels, row by row, and its ray counts.
-fn render_tile(
-    tracer: &Tracer<'_>,
-    camera: &Camera,
-    k: u32,
-    x0: u32,
-    y0: u32,
-) -> (Vec<[u8; 3]>, RayStats) {
+type TileResult = (Vec<[u8; 3]>, RayStats);
+
+/// Renders the tile whose top left pixel is `(x0, y0)`.
+fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, x0: u32, y0: u32) -> TileResult {
     let x1 = (x0 + TILE_W).min(camera.width);
     let y1 = (y0 + TILE_H).min(camera.height);
     let tw = (x1 - x0) as usize;
