@@ -4,9 +4,8 @@
 //! threads of a rayon pool take them in scanline order from one shared
 //! counter, so at any moment they work on neighbouring tiles, whose rays
 //! read largely the same raster lines: the threads share those lines in
-//! the last-level cache instead of each streaming its own half of the
-//! raster (rayon's split of the tile range gave each thread one half of
-//! the image). Each tile is cut into 4×2 pixel blocks
+//! the last-level cache instead of each streaming its own part of the
+//! raster. Each tile is cut into 4×2 pixel blocks
 //! traced through [`Tracer::trace_block`] (eight rays: the lanes of a ray
 //! packet). With supersampling `K`, each pixel gets `K × K` rays at the
 //! sub-pixel offsets of [`crate::camera::sample_offset`] (row by row), and
@@ -19,11 +18,11 @@
 
 #![deny(missing_docs)]
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::camera::{Camera, sample_offset};
 use crate::intersect::Ray;
