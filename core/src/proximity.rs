@@ -18,7 +18,7 @@
 //! the plane far from surfaces.
 
 use crate::error::RasterError;
-use crate::raster::{LINE_CELLS, Raster, RasterMut, cell, line_count, to_usize};
+use crate::raster::{LINE_CELLS, Raster, RasterMut, cell, check_line_count, to_usize};
 
 /// Sets [`cell::PROXIMITY`] on every voxel within chessboard distance 1 of an
 /// [`cell::OPAQUE`] voxel, and clears it everywhere else.
@@ -154,16 +154,10 @@ pub const fn distance(c: u8) -> u8 {
 ///
 /// # Errors
 /// [`RasterError::LineLength`] unless `lines.len()` is
-/// [`line_count`]`(plane length)`.
+/// [`line_count`](crate::raster::line_count)`(plane length)`.
 pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), RasterError> {
     let plane = raster.plane();
-    let expected = line_count(plane.len());
-    if lines.len() != expected {
-        return Err(RasterError::LineLength {
-            expected,
-            found: lines.len(),
-        });
-    }
+    check_line_count(plane.len(), lines.len())?;
     for (out, line) in lines.iter_mut().zip(plane.chunks(LINE_CELLS)) {
         // Without OPAQUE or PROXIMITY in any cell, every cell is its distance
         // bits alone, and the smallest cell holds the smallest distance.
@@ -348,6 +342,7 @@ mod tests {
 
     use super::*;
     use crate::raster::Extent;
+    use crate::raster::line_count;
 
     /// Chessboard distance to the nearest opaque voxel, by brute force.
     fn brute(e: Extent, opaque: &[[u32; 3]]) -> Vec<u8> {

@@ -237,13 +237,7 @@ impl<'a> Raster<'a> {
     /// [`RasterError::LineLength`] unless `lines.len()` is
     /// [`line_count`]`(plane length)`.
     pub fn with_lines(self, lines: &'a [u8]) -> Result<Self, RasterError> {
-        let expected = line_count(self.plane.len());
-        if lines.len() != expected {
-            return Err(RasterError::LineLength {
-                expected,
-                found: lines.len(),
-            });
-        }
+        check_line_count(self.plane.len(), lines.len())?;
         Ok(Self { lines, ..self })
     }
 
@@ -288,6 +282,19 @@ pub const LINE_BITS: u32 = LINE_CELLS.trailing_zeros();
 #[must_use]
 pub const fn line_count(len: usize) -> usize {
     len.div_ceil(LINE_CELLS)
+}
+
+/// [`RasterError::LineLength`] unless `lines` is [`line_count`]`(plane)`.
+pub(crate) const fn check_line_count(plane: usize, lines: usize) -> Result<(), RasterError> {
+    let expected = line_count(plane);
+    if lines == expected {
+        Ok(())
+    } else {
+        Err(RasterError::LineLength {
+            expected,
+            found: lines,
+        })
+    }
 }
 
 /// A writable raster, used by voxelizers and the proximity pass.

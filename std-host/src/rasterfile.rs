@@ -50,7 +50,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use rrt_core::object_table::MAX_LIGHTS;
-use rrt_core::raster::Extent;
+use rrt_core::raster::{Extent, LINE_CELLS};
 use rrt_core::store::{RecordStore, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
@@ -454,7 +454,8 @@ pub struct Info {
     pub lights: u32,
     /// The file's length.
     pub file_bytes: u64,
-    /// Memory for plane, directory and records once loaded.
+    /// Memory for plane, its line level (built on load), directory and
+    /// records once loaded.
     pub memory: u64,
 }
 
@@ -698,6 +699,7 @@ pub fn info(path: &Path) -> Result<Info, RasterFileError> {
         lights: m.lights,
         file_bytes: h.file_len,
         memory: h.sections[1].2
+            + h.sections[1].2.div_ceil(LINE_CELLS as u64)
             + h.sections[2].2
             + m.records * std::mem::size_of::<VoxelRecord>() as u64,
     })

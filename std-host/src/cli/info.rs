@@ -60,7 +60,7 @@ pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
     )?;
     writeln!(
         out,
-        "memory: {} (plane, brick directory, records)",
+        "memory: {} (plane, line level, brick directory, records)",
         Bytes(i.memory)
     )?;
     Ok(())

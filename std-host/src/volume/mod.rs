@@ -157,52 +157,34 @@ impl Samples {
         count: usize,
         mut fill: impl FnMut(&mut [u8]) -> Result<(), E>,
     ) -> Result<Self, E> {
+        /// `count` samples of `T` read by `fill`, each converted from the
+        /// file's byte order (`from_le` or `from_be`, as `little` says).
+        fn typed<T: bytemuck::Pod, E>(
+            count: usize,
+            fill: &mut impl FnMut(&mut [u8]) -> Result<(), E>,
+            little: bool,
+            from_le: impl Fn(T) -> T,
+            from_be: impl Fn(T) -> T,
+        ) -> Result<Vec<T>, E> {
+            let mut v = vec![T::zeroed(); count];
+            fill(bytemuck::cast_slice_mut(&mut v))?;
+            for x in &mut v {
+                *x = if little { from_le(*x) } else { from_be(*x) };
+            }
+            Ok(v)
+        }
         let little = endian == Endian::Little;
+        let f = &mut fill;
         Ok(match ty {
-            SampleType::U8 => {
-                let mut v = vec![0u8; count];
-                fill(&mut v)?;
-                Self::U8(v)
-            }
-            SampleType::I16 => {
-                let mut v = vec![0i16; count];
-                fill(bytemuck::cast_slice_mut(&mut v))?;
-                for x in &mut v {
-                    *x = if little {
-                        i16::from_le(*x)
-                    } else {
-                        i16::from_be(*x)
-                    };
-                }
-                Self::I16(v)
-            }
-            SampleType::U16 => {
-                let mut v = vec![0u16; count];
-                fill(bytemuck::cast_slice_mut(&mut v))?;
-                for x in &mut v {
-                    *x = if little {
-                        u16::from_le(*x)
-                    } else {
-                        u16::from_be(*x)
-                    };
-                }
-                Self::U16(v)
-            }
-            SampleType::F32 => {
-                let mut v = vec![0u32; count];
-                fill(bytemuck::cast_slice_mut(&mut v))?;
-                Self::F32(
-                    v.into_iter()
-                        .map(|b| {
-                            f32::from_bits(if little {
-                                u32::from_le(b)
-                            } else {
-                                u32::from_be(b)
-                            })
-                        })
-                        .collect(),
-                )
-            }
+            SampleType::U8 => Self::U8(typed(count, f, little, |x: u8| x, |x: u8| x)?),
+            SampleType::I16 => Self::I16(typed(count, f, little, i16::from_le, i16::from_be)?),
+            SampleType::U16 => Self::U16(typed(count, f, little, u16::from_le, u16::from_be)?),
+            SampleType::F32 => Self::F32(
+                typed(count, f, little, u32::from_le, u32::from_be)?
+                    .into_iter()
+                    .map(f32::from_bits)
+                    .collect(),
+            ),
         })
     }
 
