@@ -18,9 +18,9 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use rrt_host::camera::Camera;
 use rrt_host::fit::{self, FitOptions, Source};
-use rrt_host::intersect::{Hit, Ray};
 use rrt_host::scene::{Material, Scene};
 use rrt_host::shade;
+use rrt_host::world::{Hit, Ray};
 use rrt_tests::shared_data;
 
 fn data(name: &str) -> PathBuf {

@@ -11,7 +11,7 @@ use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, Texture, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
-use rrt_host::fit::RasterFrame;
+use rrt_host::frame::RasterFrame;
 use rrt_host::texture::{
     Blend, Checker, ImageTexture, Mapping, Marble, TextureError, Wood, WorldTexture, Wrap,
 };

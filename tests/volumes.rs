@@ -10,7 +10,7 @@ use glam::DVec3;
 use rrt_core::raster::Extent;
 use rrt_core::store::Texture;
 use rrt_core::voxelize::{NORMAL_ONE, Separation, Surfel, VoxelSink};
-use rrt_host::fit::RasterFrame;
+use rrt_host::frame::RasterFrame;
 use rrt_host::volume::classify::gray_normal;
 use rrt_host::volume::computed::{self, Metaball, Metaballs, ScreenedSources};
 use rrt_host::volume::raw::{self, RawSpec};

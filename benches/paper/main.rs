@@ -33,10 +33,11 @@ use rrt_core::discrete_ray::{DiscreteRay, WalkEnd};
 use rrt_core::raster::{Raster, cell};
 use rrt_host::build::{BuildOptions, BuildReport, VoxelScene, build};
 use rrt_host::camera::Camera;
-use rrt_host::intersect::Ray;
 use rrt_host::render::{Image, RenderOptions, render};
-use rrt_host::scene::{Bounds, Scene, View};
+use rrt_host::scene::{Scene, View};
 use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+use rrt_host::world::Bounds;
+use rrt_host::world::Ray;
 
 use plot::Series;
 

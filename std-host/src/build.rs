@@ -55,14 +55,15 @@ use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::error::VoxelizeError;
 use rrt_core::voxelize::{Separation, VoxelSink, cone, sphere, triangle};
 
-use crate::fit::{self, Bytes, FitError, FitOptions, Fitted, RasterFrame, Source};
+use crate::fit::{self, Bytes, FitError, FitOptions, Fitted, Source};
+use crate::frame::RasterFrame;
+use crate::object_table::{WorldLight, WorldObject, WorldShape};
 use crate::plane::Plane;
 use crate::scene::{Material, Scene, SourceLoc, TextureKind, View};
 use crate::shade;
 use crate::texture::AnyTexture;
 use crate::texture::InRaster;
 use crate::voxel_objects::{self, Pass};
-use crate::world::{WorldLight, WorldObject, WorldShape};
 
 /// Records per run of the parallel light pass.
 const LIGHT_RUN: usize = 1 << 14;

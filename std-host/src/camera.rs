@@ -25,8 +25,8 @@
 
 use glam::DVec3;
 
-use crate::intersect::Ray;
 use crate::scene::View;
+use crate::world::Ray;
 
 /// Why a camera cannot be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

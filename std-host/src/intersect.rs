@@ -28,53 +28,7 @@
 
 use glam::DVec3;
 
-/// A ray `origin + t·dir`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ray {
-    /// Origin.
-    pub origin: DVec3,
-    /// Direction (any non-zero length).
-    pub dir: DVec3,
-}
-
-impl Ray {
-    /// The ray from `origin` along `dir`.
-    #[must_use]
-    pub const fn new(origin: DVec3, dir: DVec3) -> Self {
-        Self { origin, dir }
-    }
-
-    /// The point at parameter `t`.
-    #[must_use]
-    pub fn at(&self, t: f64) -> DVec3 {
-        self.origin + self.dir * t
-    }
-}
-
-/// A ray–surface intersection.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    /// Ray parameter.
-    pub t: f64,
-    /// Unit surface normal (see the module docs for its orientation).
-    pub normal: DVec3,
-    /// Surface parameters: barycentric `(u, v)` of vertices 1 and 2 for a
-    /// triangle, `(u, v)` for a patch, 0 otherwise.
-    pub u: f64,
-    /// See [`Hit::u`].
-    pub v: f64,
-}
-
-impl Hit {
-    fn new(t: f64, normal: DVec3) -> Self {
-        Self {
-            t,
-            normal,
-            u: 0.0,
-            v: 0.0,
-        }
-    }
-}
+use crate::world::{Hit, Ray};
 
 /// The nearest of `roots` in `(tmin, tmax)`.
 fn nearest(roots: impl IntoIterator<Item = f64>, tmin: f64, tmax: f64) -> Option<f64> {

@@ -56,10 +56,10 @@ use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
 use crate::build::{MAX_MATERIALS, VoxelScene, line_level};
-use crate::fit::RasterFrame;
+use crate::frame::RasterFrame;
+use crate::object_table::{WorldLight, WorldObject, WorldShape};
 use crate::plane::Plane;
 use crate::scene::{Material, SourceLoc, View};
-use crate::world::{WorldLight, WorldObject, WorldShape};
 
 /// The file's first bytes.
 pub const MAGIC: [u8; 8] = *b"RRTRASTR";

@@ -25,9 +25,9 @@ use glam::DVec3;
 use indicatif::ProgressBar;
 
 use crate::camera::{Camera, sample_offset};
-use crate::intersect::Ray;
 use crate::shade;
 use crate::trace::{BLOCK, BLOCK_H, BLOCK_W, RayStats, Tracer};
+use crate::world::Ray;
 
 /// Tile width in pixels (a multiple of the block width).
 pub const TILE_W: u32 = 32;

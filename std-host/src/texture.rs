@@ -16,7 +16,7 @@
 //! use rrt_core::raster::Extent;
 //! use rrt_core::store::Texture;
 //! use rrt_core::fixed::voxel_centre;
-//! use rrt_host::fit::RasterFrame;
+//! use rrt_host::frame::RasterFrame;
 //! use rrt_host::texture::{Blend, Checker, WorldTexture};
 //! let frame = RasterFrame { extent: Extent::cube(64).unwrap(),
 //!                           origin: DVec3::ZERO, voxel_size: 0.125 };
@@ -42,17 +42,10 @@ use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use rrt_core::fixed::VOXEL;
 use rrt_core::store::Texture;
 use rrt_core::voxelize::NORMAL_ONE;
 
-use crate::fit::RasterFrame;
-
-/// A fixed-point raster point (16 fractional bits) in the world.
-#[must_use]
-pub fn fixed_to_world(frame: &RasterFrame, p: [i64; 3]) -> DVec3 {
-    frame.raster_to_world(DVec3::from(p.map(|c| c as f64)) / VOXEL as f64)
-}
+use crate::frame::RasterFrame;
 
 /// Why a texture cannot be made.
 #[derive(Debug, thiserror::Error)]
@@ -141,7 +134,7 @@ pub struct InRaster<T> {
 
 impl<T: WorldTexture> Texture for InRaster<T> {
     fn color(&self, centre: [i64; 3], normal: [i32; 3], base: [u8; 3]) -> [u8; 3] {
-        let p = fixed_to_world(&self.frame, centre);
+        let p = self.frame.fixed_to_world(centre);
         let n = DVec3::from(normal.map(f64::from)) / f64::from(NORMAL_ONE);
         let t = self.texture.world_color(p, n, base);
         match self.blend {

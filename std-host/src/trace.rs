@@ -109,11 +109,11 @@ use rrt_core::voxel::{LightVisibility, VoxelRecord};
 use rrt_core::voxelize::NORMAL_ONE;
 
 use crate::build::VoxelScene;
-use crate::fit::{RasterFrame, unit_to_fixed};
-use crate::intersect::Ray;
+use crate::frame::{RasterFrame, round_to_i64, unit_to_fixed};
+use crate::object_table::{WorldLight, WorldObject};
 use crate::scene::Material;
 use crate::shade;
-use crate::world::{WorldLight, WorldObject};
+use crate::world::Ray;
 
 /// Rays per primary block: 4 × 2 pixels, the lanes of `RayPacket8`.
 pub const BLOCK: usize = 8;
@@ -268,7 +268,7 @@ fn slab(o: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64)> {
 /// gives: any deterministic rounding would do.)
 #[inline]
 fn round_to_int(x: f64) -> i64 {
-    crate::fit::round_to_i64(x)
+    round_to_i64(x)
 }
 
 /// The unit vector of a stored octahedral normal (unfolded in integers,
@@ -286,7 +286,7 @@ fn rgb(c: [u8; 3]) -> DVec3 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Verdict {
     /// The continuous ray meets the object near the voxel: the true hit.
-    Hit(crate::intersect::Hit),
+    Hit(crate::world::Hit),
     /// The continuous ray meets the object, but farther along than the
     /// voxel's neighbourhood (a ray grazing a surface's voxel layer): the
     /// walk goes on to the voxel that holds the intersection.

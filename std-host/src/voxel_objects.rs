@@ -10,7 +10,7 @@
 //! a `.vox` model's voxels take their palette colours; a CSG result's
 //! voxels take the material of the leaf that forms the surface there.
 //! None of them has exact geometry: their world object is
-//! [`crate::world::WorldShape::Voxels`], whose hits verification keeps.
+//! [`crate::object_table::WorldShape::Voxels`], whose hits verification keeps.
 
 #![deny(missing_docs)]
 
@@ -21,7 +21,8 @@ use rrt_core::store::{Counter, Filler, ObjectAttrs};
 use rrt_core::voxelize::Separation;
 
 use crate::build::BuildError;
-use crate::fit::{FitError, RasterFrame, unit_to_fixed};
+use crate::fit::FitError;
+use crate::frame::{RasterFrame, unit_to_fixed};
 use crate::scene::{Csg, SolidShape, SourceLoc, VolumeObject, VoxObject};
 use crate::texture::InRaster;
 use crate::texture::{AnyTexture, WorldTexture};

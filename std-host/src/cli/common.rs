@@ -13,7 +13,8 @@ use super::ray::ConnectivityArg;
 use crate::build::{BuildOptions, BuildReport, VoxelScene, build};
 use crate::fit::{FitOptions, default_max_memory};
 use crate::rasterfile;
-use crate::scene::{Bounds, Scene, View};
+use crate::scene::{Scene, View};
+use crate::world::Bounds;
 
 /// The built-in scene: SPD `balls2.nff`, the paper's 91-sphereflake.
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/balls2.nff");

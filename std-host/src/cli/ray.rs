@@ -166,7 +166,7 @@ fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Re
     let one = f64::from(1u32 << FRAC_BITS);
     let o = glam::DVec3::from(args.origin.map(|v| v as f64 / one));
     let d = glam::DVec3::from(args.dir.map(|v| f64::from(v) / one));
-    let world = crate::intersect::Ray::new(
+    let world = crate::world::Ray::new(
         scene.frame.raster_to_world(o),
         d.normalize_or(glam::DVec3::X),
     );

@@ -36,6 +36,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
+use crate::world::Bounds;
+
 pub use error::{Found, SceneError};
 pub use loc::SourceLoc;
 pub use nff::ParseOptions;
@@ -171,41 +173,6 @@ impl Polygon {
     #[must_use]
     pub fn range(&self) -> std::ops::Range<usize> {
         self.first..self.first.saturating_add(self.count)
-    }
-}
-
-/// An axis-aligned box in world coordinates.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Bounds {
-    /// Lowest corner.
-    pub min: DVec3,
-    /// Highest corner.
-    pub max: DVec3,
-}
-
-impl Bounds {
-    /// The empty box (`min = +∞`, `max = −∞`): [`Bounds::include`] grows it.
-    pub const EMPTY: Self = Self {
-        min: DVec3::INFINITY,
-        max: DVec3::NEG_INFINITY,
-    };
-
-    /// Grows the box to hold `lo..hi`.
-    pub fn include(&mut self, lo: DVec3, hi: DVec3) {
-        self.min = self.min.min(lo);
-        self.max = self.max.max(hi);
-    }
-
-    /// Whether the box holds at least one point.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        !(self.min.cmple(self.max).all())
-    }
-
-    /// `max − min`.
-    #[must_use]
-    pub fn size(&self) -> DVec3 {
-        self.max - self.min
     }
 }
 

@@ -14,10 +14,11 @@ use rrt_core::csg::MAX_NODES;
 
 #[cfg(any(test, feature = "check"))]
 use super::Scene;
-use super::{Bounds, SourceLoc};
+use super::SourceLoc;
 use crate::texture::{AnyTexture, Blend};
 use crate::volume::{Classifier, PlacedVolume, Placement, Volume};
 use crate::vox::VoxScene;
+use crate::world::Bounds;
 
 /// A classified volume placed in the world: the data, where it goes and
 /// which of its samples are non-transparent (and their colours).

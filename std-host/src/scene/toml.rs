@@ -848,7 +848,7 @@ impl Builder<'_> {
         let placement = match (&d.fit, d.translate, d.scale) {
             (Some(b), None, None) => Placement::fit_into(
                 &data,
-                super::Bounds {
+                crate::world::Bounds {
                     min: self.vec3(&s, &key("fit.min"), b.min)?,
                     max: self.vec3(&s, &key("fit.max"), b.max)?,
                 },

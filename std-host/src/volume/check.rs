@@ -7,7 +7,7 @@ use glam::DVec3;
 use rrt_core::raster::Extent;
 
 use super::{Classifier, Limits, Placement, Samples, nrrd};
-use crate::fit::RasterFrame;
+use crate::frame::RasterFrame;
 
 /// The limits the checker reads with: 1 MiB of samples, 64 KiB of header.
 pub const FUZZ_LIMITS: Limits = Limits {

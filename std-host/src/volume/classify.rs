@@ -41,7 +41,7 @@ use glam::DVec3;
 use rrt_core::store::Texture;
 
 use super::{PlacedVolume, Volume, VolumeError};
-use crate::fit::RasterFrame;
+use crate::frame::RasterFrame;
 
 fn invalid(what: &str, msg: String) -> VolumeError {
     VolumeError::Invalid {
@@ -327,7 +327,7 @@ impl<'a> VolumeColors<'a> {
 
 impl Texture for VolumeColors<'_> {
     fn color(&self, centre: [i64; 3], _normal: [i32; 3], base: [u8; 3]) -> [u8; 3] {
-        let p = crate::texture::fixed_to_world(&self.frame, centre);
+        let p = self.frame.fixed_to_world(centre);
         match self.placed.sample_world(p) {
             Some(v) => self.classifier.color(v, base),
             None => base,

@@ -41,7 +41,7 @@ use std::path::PathBuf;
 
 use glam::{DMat3, DVec3};
 
-use crate::scene::Bounds;
+use crate::world::Bounds;
 
 #[cfg(any(test, feature = "check"))]
 pub mod check;

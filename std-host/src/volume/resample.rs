@@ -17,7 +17,7 @@
 //! ```
 //! use glam::DVec3;
 //! use rrt_core::raster::Extent;
-//! use rrt_host::fit::RasterFrame;
+//! use rrt_host::frame::RasterFrame;
 //! use rrt_host::volume::{Classifier, Grid, Placement, Samples, Volume};
 //! // 2×2×2 samples 10 mm apart, sample (0,0,0) at the physical origin.
 //! let v = Volume::new([2, 2, 2], Grid::axis_aligned([10.0; 3], DVec3::ZERO),
@@ -44,8 +44,8 @@ use rrt_core::voxelize::volume::{self, Block};
 use rrt_core::voxelize::{Separation, Surfel, VoxelSink};
 
 use super::{Classifier, DimsFmt, Grid, Limits, SampleType, Samples, Volume, VolumeError};
-use crate::fit::RasterFrame;
-use crate::scene::Bounds;
+use crate::frame::RasterFrame;
+use crate::world::Bounds;
 
 /// A predicate on raster voxels: which to keep (see
 /// [`PlacedVolume::voxelize_where`]).

@@ -1,0 +1,178 @@
+//! The raster's frame: where the 3D raster lies in the world, and the
+//! conversions between world coordinates (`f64`), continuous raster
+//! coordinates (voxel units) and the core's fixed point (1/65536 voxel).
+//!
+//! [`RasterFrame`] is made once, by fitting ([`crate::fit`]), and read by
+//! every phase after it: the shape model's fixed-point geometry
+//! ([`crate::shape`]), voxelization, the tracer and the saved-raster file.
+
+use glam::DVec3;
+use rrt_core::fixed::VOXEL;
+use rrt_core::geometry::{NORMAL_ONE, Point, UnitVector};
+use rrt_core::raster::Extent;
+
+use crate::world::{Bounds, Ray};
+
+/// Farthest any fixed-point coordinate may lie from the raster's origin:
+/// 2^31 voxels (so products of coordinates stay far from `i64` limits).
+pub const MAX_FIXED: i64 = (1 << 31) * VOXEL;
+
+/// The raster's place in the world: voxel `(i, j, k)` spans
+/// `origin + [i, i+1) × [j, j+1) × [k, k+1) · voxel_size`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RasterFrame {
+    /// Voxels per axis.
+    pub extent: Extent,
+    /// World position of the raster's lowest corner.
+    pub origin: DVec3,
+    /// World length of a voxel's edge.
+    pub voxel_size: f64,
+}
+
+impl RasterFrame {
+    /// Voxels per axis.
+    #[must_use]
+    pub fn dims(&self) -> [u32; 3] {
+        self.extent.dims()
+    }
+
+    /// The raster's box in world coordinates.
+    #[must_use]
+    pub fn world_bounds(&self) -> Bounds {
+        let n = DVec3::from(self.dims().map(f64::from));
+        Bounds {
+            min: self.origin,
+            max: self.origin + n * self.voxel_size,
+        }
+    }
+
+    /// A world point in voxel units (continuous raster coordinates).
+    #[must_use]
+    pub fn world_to_raster(&self, p: DVec3) -> DVec3 {
+        (p - self.origin) / self.voxel_size
+    }
+
+    /// A point in voxel units back in the world.
+    #[must_use]
+    pub fn raster_to_world(&self, p: DVec3) -> DVec3 {
+        self.origin + p * self.voxel_size
+    }
+
+    /// A world point in fixed units (rounded to the nearest 1/65536
+    /// voxel); `None` if it lies more than [`MAX_FIXED`] away or is not
+    /// finite.
+    #[must_use]
+    pub fn to_fixed(&self, p: DVec3) -> Option<Point> {
+        let q = self.world_to_raster(p) * VOXEL as f64;
+        let c = |v: f64| {
+            let r = round(v);
+            // The range check makes the conversion exact.
+            (r.abs() <= MAX_FIXED as f64).then_some(r as i64)
+        };
+        Some([c(q.x)?, c(q.y)?, c(q.z)?])
+    }
+
+    /// A fixed-point point back in the world.
+    #[must_use]
+    pub fn fixed_to_world(&self, p: Point) -> DVec3 {
+        self.raster_to_world(DVec3::from(p.map(|v| v as f64)) / VOXEL as f64)
+    }
+
+    /// A world length in fixed units, rounded, at least `min`; `None` if
+    /// longer than [`MAX_FIXED`].
+    #[must_use]
+    pub fn length_to_fixed(&self, l: f64, min: i64) -> Option<i64> {
+        let v = round(l / self.voxel_size * VOXEL as f64);
+        (v.abs() <= MAX_FIXED as f64).then_some((v as i64).max(min))
+    }
+
+    /// A world ray in voxel units (same parameter `t`).
+    #[must_use]
+    pub fn ray_to_raster(&self, r: &Ray) -> Ray {
+        Ray::new(self.world_to_raster(r.origin), r.dir / self.voxel_size)
+    }
+}
+
+/// A unit vector scaled by 2^30 and rounded; `None` for a zero or
+/// non-finite vector.
+#[must_use]
+pub fn unit_to_fixed(n: DVec3) -> Option<UnitVector> {
+    let u = n.try_normalize()? * f64::from(NORMAL_ONE);
+    // |component| ≤ 2^30 after normalising: fits an i32.
+    Some([u.x, u.y, u.z].map(|c| round(c) as i32))
+}
+
+/// `x.round()` (halves away from zero), exactly, without the libm call
+/// that `f64::round` compiles to on the baseline x86-64 target (no SSE4.1),
+/// and without a data-dependent branch: it runs for every ray.
+#[inline]
+#[must_use]
+pub fn round(x: f64) -> f64 {
+    // From 2^52 up every f64 is an integer (and inf and NaN stay as they are).
+    if x.abs() < 4_503_599_627_370_496.0 {
+        // The sign of x keeps −0.0 for −0.5 < x ≤ −0.0, as f64::round does.
+        (round_to_i64(x) as f64).copysign(x)
+    } else {
+        x
+    }
+}
+
+/// `x.round() as i64` (halves away from zero, saturating, NaN → 0),
+/// exactly, branch-free: the truncation `t` is exact for `|x| < 2^63` and
+/// so is `x − t`, which decides the step away from zero.
+#[inline]
+#[must_use]
+pub fn round_to_i64(x: f64) -> i64 {
+    let t = x as i64;
+    let r = x - t as f64;
+    t.saturating_add(i64::from(r >= 0.5))
+        .saturating_sub(i64::from(r <= -0.5))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_is_f64_round() {
+        let mut vals = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            4503599627370495.5,
+            4503599627370497.0,
+            9.3e18,
+            -9.3e18,
+            1e300,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            1e-300,
+            -1e-300,
+        ];
+        let mut x = 0x9e37_79b9_7f4a_7c15_u64;
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            if v.is_finite() {
+                vals.push(v);
+                vals.push((x % 4_000_001) as f64 / 8.0 - 250_000.0);
+            }
+        }
+        for v in vals {
+            assert_eq!(round(v).to_bits(), v.round().to_bits(), "{v:e}");
+            assert_eq!(round_to_i64(v), v.round() as i64, "{v:e}");
+        }
+        assert_eq!(round_to_i64(f64::NAN), 0);
+        assert!(round(f64::NAN).is_nan());
+    }
+}
