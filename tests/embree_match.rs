@@ -2,7 +2,7 @@
 //! reproduce `embree_nff`'s images.
 //!
 //! A brute-force Whitted tracer (every ray against every object of the
-//! fitted object table, through [`Source::intersect`]) with `embree_nff`'s
+//! fitted object table, through [`Shape::intersect`]) with `embree_nff`'s
 //! conventions: rays through pixel centres, SPD intensities, two-sided
 //! normals, shadow rays only towards lights the surface faces, secondary
 //! rays from `hit + ε·N` with `ε = 1e-5 ×` the scene's diagonal, depth 3.
@@ -17,9 +17,10 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use rrt_host::camera::Camera;
-use rrt_host::fit::{self, FitOptions, Source};
+use rrt_host::fit::{self, FitOptions};
 use rrt_host::scene::{Material, Scene};
 use rrt_host::shade;
+use rrt_host::shape::Shape;
 use rrt_host::world::{Hit, Ray};
 use rrt_tests::shared_data;
 
@@ -39,7 +40,7 @@ struct Counts {
 
 struct Tracer<'a> {
     scene: &'a Scene,
-    objects: Vec<(Source, usize)>,
+    objects: Vec<(Shape, usize)>,
     eps: f64,
     intensity: f64,
     max_depth: u32,
@@ -62,7 +63,7 @@ impl<'a> Tracer<'a> {
             objects: fitted
                 .objects
                 .iter()
-                .map(|o| (o.source, o.material))
+                .map(|o| (o.shape, o.material))
                 .collect(),
             eps: 1e-5 * if diag > 0.0 { diag } else { 1.0 },
             intensity: shade::light_intensity(scene.lights.len()),
@@ -75,7 +76,7 @@ impl<'a> Tracer<'a> {
         let scene = self.scene;
         self.objects
             .iter()
-            .filter_map(|&(src, m)| src.intersect(scene, ray, 0.0, tmax).map(|h| (h, m)))
+            .filter_map(|&(shape, m)| shape.intersect(ray, 0.0, tmax).map(|h| (h, m)))
             .min_by(|a, b| a.0.t.total_cmp(&b.0.t))
             .map(|(h, m)| (h, &scene.materials[m]))
     }

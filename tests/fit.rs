@@ -7,9 +7,11 @@ use std::path::PathBuf;
 use glam::DVec3;
 use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::NORMAL_ONE;
+use rrt_core::object_table::Shape;
 use rrt_host::camera::Camera;
-use rrt_host::fit::{self, FitOptions, Fitted, Shape, Source};
+use rrt_host::fit::{self, FitOptions, Fitted};
 use rrt_host::scene::Scene;
+use rrt_host::shape::{self, Surface};
 use rrt_tests::shared_data;
 
 fn test_data(name: &str) -> PathBuf {
@@ -34,7 +36,7 @@ fn check_inside(f: &Fitted, margin: u32) {
     let m = i64::from(margin) * VOXEL - 1;
     let inside = |lo: [i64; 3], hi: [i64; 3]| (0..3).all(|k| lo[k] >= m && hi[k] <= size[k] - m);
     for o in &f.objects {
-        let ok = match o.shape {
+        let ok = match o.entry {
             Shape::Sphere(s) => inside(
                 s.centre.map(|c| c - s.radius),
                 s.centre.map(|c| c + s.radius),
@@ -55,6 +57,7 @@ fn check_inside(f: &Fitted, margin: u32) {
                 let hi = [0, 1, 2].map(|k| c.base[k].max(c.apex[k]) + r);
                 inside(lo, hi)
             }
+            other => panic!("an NFF scene made a {other:?} entry"),
         };
         assert!(ok, "{o:?} outside {:?}", f.frame.dims());
     }
@@ -91,22 +94,17 @@ fn balls1_fits_and_ray_casts() {
             let nearest = f
                 .objects
                 .iter()
-                .filter_map(|o| {
-                    o.source
-                        .intersect(&s, &ray, 0.0, f64::INFINITY)
-                        .map(|h| (h, o))
-                })
+                .filter_map(|o| o.shape.intersect(&ray, 0.0, f64::INFINITY).map(|h| (h, o)))
                 .min_by(|a, b| a.0.t.total_cmp(&b.0.t));
             let Some((h, o)) = nearest else { continue };
             hits += 1;
             let p = ray.at(h.t);
-            match o.source {
-                Source::Sphere(i) => {
-                    let sp = &s.spheres[i];
+            match o.shape {
+                shape::Shape::Sphere(sp) => {
                     assert!(((p - sp.centre).length() - sp.radius).abs() < 1e-9);
                 }
-                Source::Polygon { .. } => assert!((p.z + 0.5).abs() < 1e-9),
-                Source::Cone(_) => unreachable!("balls1 has no cones"),
+                shape::Shape::Triangle(_) => assert!((p.z + 0.5).abs() < 1e-9),
+                other => unreachable!("balls1 has no {}", other.kind()),
             }
         }
     }
@@ -114,8 +112,9 @@ fn balls1_fits_and_ray_casts() {
     assert!(hits > 33 * 33 / 2, "{hits}");
     // The centre pixel looks at the big sphere's centre: hits it first.
     let ray = cam.primary(16, 16);
-    let h = Source::Sphere(0)
-        .intersect(&s, &ray, 0.0, f64::INFINITY)
+    let h = s.spheres[0]
+        .shape
+        .intersect(&ray, 0.0, f64::INFINITY)
         .unwrap();
     assert!((h.t - (s.view.from.length() - 0.5)).abs() < 1e-9);
 }
@@ -129,7 +128,7 @@ fn tetra_fits() {
     assert!(
         f.objects
             .iter()
-            .all(|o| matches!(o.shape, Shape::Triangle(t) if t.normals.is_none()))
+            .all(|o| matches!(o.entry, Shape::Triangle(t) if t.normals.is_none()))
     );
     check_inside(&f, fit::DEFAULT_MARGIN);
 }
@@ -167,7 +166,7 @@ fn spd_scenes_fit_with_memory_estimates() {
     let patches = teapot
         .objects
         .iter()
-        .filter(|o| matches!(o.shape, Shape::Triangle(t) if t.normals.is_some()))
+        .filter(|o| matches!(o.entry, Shape::Triangle(t) if t.normals.is_some()))
         .count();
     assert_eq!(patches, 240);
     let rings = fit::fit(&Scene::load(spd.join("rings.nff")).unwrap(), &opts(256)).unwrap();
@@ -175,7 +174,7 @@ fn spd_scenes_fit_with_memory_estimates() {
         rings
             .objects
             .iter()
-            .any(|o| matches!(o.shape, Shape::Cone(c) if c.base_radius == c.apex_radius))
+            .any(|o| matches!(o.entry, Shape::Cone(c) if c.base_radius == c.apex_radius))
     );
 
     // balls4 at 2048: the estimate is an upper bound well below the

@@ -80,8 +80,8 @@ fn balls1_copy_parses_with_counts_and_values() {
     assert_eq!((floor.transmittance, floor.ior), (0.0, 1.0));
     assert_eq!(s.polygons[0].material, 0);
     assert!(s.spheres.iter().all(|sp| sp.material == 1));
-    assert_eq!(s.spheres[0].centre, DVec3::ZERO);
-    assert_eq!(s.spheres[0].radius, 0.5);
+    assert_eq!(s.spheres[0].shape.centre, DVec3::ZERO);
+    assert_eq!(s.spheres[0].shape.radius, 0.5);
     // Locations point at the directives.
     assert_eq!(
         s.spheres[0].loc.to_string(),
@@ -168,9 +168,12 @@ fn every_spd_scene_parses_with_counts() {
     assert_eq!(rings.cones.len(), 150);
     assert_eq!(rings.polygons.len(), 1);
     let c = &rings.cones[0];
-    assert_eq!(c.base, DVec3::new(0.930995, 2.61313, 0.0));
-    assert_eq!(c.apex, DVec3::new(0.287693, 1.7277, 0.0));
-    assert_eq!((c.base_radius, c.apex_radius), (0.07412, 0.07412));
+    assert_eq!(c.shape.base, DVec3::new(0.930995, 2.61313, 0.0));
+    assert_eq!(c.shape.apex, DVec3::new(0.287693, 1.7277, 0.0));
+    assert_eq!(
+        (c.shape.base_radius, c.shape.apex_radius),
+        (0.07412, 0.07412)
+    );
 
     let tetra = load("tetra.nff");
     assert_eq!(tetra.polygons.len(), 16);
@@ -181,10 +184,10 @@ fn cone_on_one_line_or_two() {
     let one = ok(&format!("{HEAD}c 0 0 0 1 0 0 2 0.5\n"));
     let two = ok(&format!("{HEAD}c\n0 0 0 1\n0 0 2 0.5\n"));
     let split = ok(&format!("{HEAD}c 0 0 0 1\n0 0 2 0.5\n"));
-    assert_eq!(one.cones[0].base, two.cones[0].base);
-    assert_eq!(one.cones[0].apex, two.cones[0].apex);
-    assert_eq!(one.cones[0].apex_radius, 0.5);
-    assert_eq!(split.cones[0].apex, DVec3::new(0.0, 0.0, 2.0));
+    assert_eq!(one.cones[0].shape.base, two.cones[0].shape.base);
+    assert_eq!(one.cones[0].shape.apex, two.cones[0].shape.apex);
+    assert_eq!(one.cones[0].shape.apex_radius, 0.5);
+    assert_eq!(split.cones[0].shape.apex, DVec3::new(0.0, 0.0, 2.0));
     // A cone with a point apex is fine.
     ok(&format!("{HEAD}c 0 0 0 1 0 0 2 0\n"));
 }

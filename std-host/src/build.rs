@@ -52,15 +52,16 @@ use rrt_core::store::{
     self, Counter, Limits, ObjectAttrs, RecordStore, StoreError, directory_len, write_rank_hints,
 };
 use rrt_core::voxel::VoxelRecord;
+use rrt_core::voxelize::Separation;
 use rrt_core::voxelize::error::VoxelizeError;
-use rrt_core::voxelize::{Separation, VoxelSink, cone, sphere, triangle};
 
-use crate::fit::{self, Bytes, FitError, FitOptions, Fitted, Source};
+use crate::fit::{self, Bytes, FitError, FitOptions, Fitted};
 use crate::frame::RasterFrame;
-use crate::object_table::{WorldLight, WorldObject, WorldShape};
+use crate::object_table::{WorldLight, WorldObject};
 use crate::plane::Plane;
 use crate::scene::{Material, Scene, SourceLoc, TextureKind, View};
 use crate::shade;
+use crate::shape::{self, Shape};
 use crate::texture::AnyTexture;
 use crate::texture::InRaster;
 use crate::voxel_objects::{self, Pass};
@@ -310,50 +311,6 @@ pub enum BuildError {
     Raster(String),
 }
 
-/// The location and kind of a fitted object's source.
-fn source_loc(scene: &Scene, source: Source) -> (SourceLoc, &'static str) {
-    let fallback = || SourceLoc::new(scene.file.clone(), 0, 0);
-    match source {
-        Source::Sphere(i) => (
-            scene
-                .spheres
-                .get(i)
-                .map_or_else(fallback, |s| s.loc.clone()),
-            "sphere",
-        ),
-        Source::Cone(i) => (
-            scene.cones.get(i).map_or_else(fallback, |c| c.loc.clone()),
-            "cone",
-        ),
-        Source::Polygon { polygon, .. } => (
-            scene
-                .polygons
-                .get(polygon)
-                .map_or_else(fallback, |p| p.loc.clone()),
-            "polygon",
-        ),
-    }
-}
-
-/// Voxelizes one fitted object into `sink` through the core voxelizers:
-/// sphere shells, triangles (flat or with interpolated normals) and open
-/// cones, as NFF defines them.
-///
-/// # Errors
-/// The voxelizer's refusal.
-pub fn voxelize_shape(
-    shape: &fit::Shape,
-    separation: Separation,
-    extent: Extent,
-    sink: &mut dyn VoxelSink,
-) -> Result<u64, VoxelizeError> {
-    match shape {
-        fit::Shape::Sphere(s) => sphere::surface(s, separation, extent, sink),
-        fit::Shape::Triangle(t) => triangle::triangle(t, separation, extent, sink),
-        fit::Shape::Cone(c) => cone::surface(c, separation, extent, sink),
-    }
-}
-
 /// A scalar in `[0, ∞)` as the core's 16.16 fixed point, saturating.
 fn scalar(v: f64) -> u32 {
     let s = (v * f64::from(SCALAR_ONE)).round();
@@ -421,16 +378,6 @@ fn distinct_materials(scene: &Scene) -> Result<(Vec<Material>, Vec<u16>), BuildE
         index.push(i);
     }
     Ok((list, index))
-}
-
-/// A fitted shape as an object of the core's table (the light pass reads
-/// only whether it is closed).
-fn core_shape(shape: &fit::Shape) -> object_table::Shape {
-    match *shape {
-        fit::Shape::Sphere(s) => object_table::Shape::Sphere(s),
-        fit::Shape::Triangle(t) => object_table::Shape::Triangle(t),
-        fit::Shape::Cone(c) => object_table::Shape::Cone(c),
-    }
 }
 
 /// The scene material of extra object `e` (volumes, then `.vox` models,
@@ -534,9 +481,12 @@ pub fn build(
         RasterMut::new(extent, &mut plane).map_err(|e| BuildError::Raster(e.to_string()))?;
     let mut counter = Counter::new(raster, &mut directory)?;
     for o in &fitted.objects {
-        voxelize_shape(&o.shape, separation, extent, &mut counter).map_err(|source| {
-            let (loc, what) = source_loc(scene, o.source);
-            BuildError::Voxelize { loc, what, source }
+        shape::voxelize(&o.entry, separation, extent, &mut counter).map_err(|source| {
+            BuildError::Voxelize {
+                loc: o.loc.clone(),
+                what: o.kind,
+                source,
+            }
         })?;
         progress.inc(1);
     }
@@ -580,12 +530,13 @@ pub fn build(
             color: colour,
         })?;
         let voxelized = match texture_of(o.material) {
-            Some(t) => voxelize_shape(&o.shape, separation, extent, &mut filler.textured(t)),
-            None => voxelize_shape(&o.shape, separation, extent, &mut filler),
+            Some(t) => shape::voxelize(&o.entry, separation, extent, &mut filler.textured(t)),
+            None => shape::voxelize(&o.entry, separation, extent, &mut filler),
         };
-        voxelized.map_err(|source| {
-            let (loc, what) = source_loc(scene, o.source);
-            BuildError::Voxelize { loc, what, source }
+        voxelized.map_err(|source| BuildError::Voxelize {
+            loc: o.loc.clone(),
+            what: o.kind,
+            source,
         })?;
         progress.inc(1);
     }
@@ -627,7 +578,7 @@ pub fn build(
     for o in &fitted.objects {
         // The storage holds exactly the n objects: no push can fail.
         let _ = table.push(Object {
-            shape: core_shape(&o.shape),
+            shape: o.entry,
             material: mat_of(o.material),
         });
     }
@@ -692,20 +643,18 @@ pub fn build(
     let lines = finish_plane(extent, &mut plane, &directory, &records);
     let voxelize = voxelize + t2.elapsed();
 
-    let objects = fitted
+    let objects: Vec<WorldObject> = fitted
         .objects
         .iter()
-        .map(|o| {
-            WorldObject::from_fitted(scene, o, mat_of(o.material))
-                .ok_or_else(|| BuildError::Raster("fitted object without its source".into()))
+        .map(|o| WorldObject {
+            shape: o.shape,
+            material: mat_of(o.material),
         })
-        .chain((0..extras).map(|e| {
-            Ok(WorldObject {
-                shape: WorldShape::Voxels,
-                material: mat_of(extra_material(scene, e)),
-            })
+        .chain((0..extras).map(|e| WorldObject {
+            shape: Shape::Voxels,
+            material: mat_of(extra_material(scene, e)),
         }))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect();
     let world_lights = scene
         .lights
         .iter()

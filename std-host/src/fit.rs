@@ -26,13 +26,14 @@ use std::f64::consts::PI;
 use std::fmt;
 
 use glam::DVec3;
-use rrt_core::geometry::{self, Point, UnitVector};
+use rrt_core::geometry::Point;
+use rrt_core::object_table as table;
 use rrt_core::raster::{Extent, LINE_CELLS, MAX_AXIS};
 
-use crate::frame::{RasterFrame, unit_to_fixed};
-use crate::intersect;
-use crate::scene::{Scene, SourceLoc};
-use crate::world::{Bounds, Hit, Ray};
+use crate::frame::RasterFrame;
+use crate::scene::{Object, Scene, SourceLoc};
+use crate::shape::{Shape, Surface, Unfit};
+use crate::world::Bounds;
 
 /// Bytes per voxel record, for the memory estimate.
 pub const RECORD_BYTES: u64 = 20;
@@ -210,81 +211,21 @@ impl fmt::Display for MemoryEstimate {
     }
 }
 
-/// A core object in fixed-point raster coordinates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Shape {
-    /// From an `s`.
-    Sphere(geometry::Sphere),
-    /// From a `p` or `pp` (one triangle of its fan).
-    Triangle(geometry::Triangle),
-    /// From a `c`.
-    Cone(geometry::Cone),
-}
-
-/// Which scene object a fitted object comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Source {
-    /// `Scene::spheres[i]`.
-    Sphere(usize),
-    /// `Scene::cones[i]`.
-    Cone(usize),
-    /// Triangle `triangle` (vertices 0, `triangle + 1`, `triangle + 2`) of
-    /// `Scene::polygons[polygon]`.
-    Polygon {
-        /// Index into `Scene::polygons`.
-        polygon: usize,
-        /// Index of the triangle in the polygon's fan.
-        triangle: usize,
-    },
-}
-
-impl Source {
-    /// Intersects a world ray with the exact world object this came from
-    /// (the NFF geometry, before fixed-point rounding): for intersection
-    /// verification. `None` if the source does not exist in `scene`.
-    #[must_use]
-    pub fn intersect(&self, scene: &Scene, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
-        match *self {
-            Self::Sphere(i) => {
-                let s = scene.spheres.get(i)?;
-                intersect::sphere(ray, s.centre, s.radius, tmin, tmax)
-            }
-            Self::Cone(i) => {
-                let c = scene.cones.get(i)?;
-                intersect::cone(
-                    ray,
-                    c.base,
-                    c.base_radius,
-                    c.apex,
-                    c.apex_radius,
-                    tmin,
-                    tmax,
-                )
-            }
-            Self::Polygon { polygon, triangle } => {
-                let p = scene.polygons.get(polygon)?;
-                let v = scene.polygon_vertices(p);
-                let idx = [0, triangle.checked_add(1)?, triangle.checked_add(2)?];
-                let tri = [*v.get(idx[0])?, *v.get(idx[1])?, *v.get(idx[2])?];
-                let normals = match scene.polygon_normals(p) {
-                    Some(n) => Some([*n.get(idx[0])?, *n.get(idx[1])?, *n.get(idx[2])?]),
-                    None => None,
-                };
-                intersect::triangle(ray, tri, normals, tmin, tmax)
-            }
-        }
-    }
-}
-
-/// One object of the object table.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// One object of the object table: its exact world geometry and, made of
+/// it, the core's fixed-point geometry in the raster.
+#[derive(Clone, Debug, PartialEq)]
 pub struct FittedObject {
-    /// The fixed-point geometry.
+    /// The world geometry (what intersection verification intersects).
     pub shape: Shape,
+    /// The core's object-table entry: the fixed-point geometry the
+    /// voxelizer draws and the light pass reads.
+    pub entry: table::Shape,
     /// Index into `Scene::materials`.
     pub material: usize,
-    /// The scene object it comes from.
-    pub source: Source,
+    /// What the scene calls it (`sphere`, `cone`, `polygon`), for messages.
+    pub kind: &'static str,
+    /// Where the scene object is defined.
+    pub loc: SourceLoc,
 }
 
 /// A light in fixed-point raster coordinates.
@@ -338,112 +279,23 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
             limit: opts.max_memory,
         });
     }
-    let world = frame.world_bounds();
-    let outside = |lo: DVec3, hi: DVec3| hi.cmplt(world.min).any() || lo.cmpgt(world.max).any();
-    let range = |loc: &SourceLoc, what| FitError::OutOfRange {
-        loc: loc.clone(),
-        what,
+    let mut table = Table {
+        frame: &frame,
+        world: frame.world_bounds(),
+        objects: Vec::with_capacity(
+            scene.spheres.len() + scene.cones.len() + scene.triangle_count(),
+        ),
+        dropped: Dropped::default(),
     };
-
-    let mut objects =
-        Vec::with_capacity(scene.spheres.len() + scene.cones.len() + scene.triangle_count());
-    let mut dropped = Dropped::default();
-    for (i, s) in scene.spheres.iter().enumerate() {
-        if outside(s.centre - s.radius, s.centre + s.radius) {
-            dropped.outside += 1;
+    table.add_all(&scene.spheres)?;
+    table.add_all(&scene.cones)?;
+    for p in &scene.polygons {
+        if table.outside(scene.polygon_bounds(p)) {
+            table.dropped.outside += p.count.saturating_sub(2);
             continue;
         }
-        let centre = frame
-            .to_fixed(s.centre)
-            .ok_or_else(|| range(&s.loc, "sphere"))?;
-        let radius = frame
-            .length_to_fixed(s.radius, 1)
-            .ok_or_else(|| range(&s.loc, "sphere"))?;
-        objects.push(FittedObject {
-            shape: Shape::Sphere(geometry::Sphere { centre, radius }),
-            material: s.material,
-            source: Source::Sphere(i),
-        });
-    }
-    for (i, c) in scene.cones.iter().enumerate() {
-        let r = c.base_radius.max(c.apex_radius);
-        if outside(c.base.min(c.apex) - r, c.base.max(c.apex) + r) {
-            dropped.outside += 1;
-            continue;
-        }
-        let err = || range(&c.loc, "cone");
-        let base = frame.to_fixed(c.base).ok_or_else(err)?;
-        let apex = frame.to_fixed(c.apex).ok_or_else(err)?;
-        let mut base_radius = frame.length_to_fixed(c.base_radius, 0).ok_or_else(err)?;
-        let mut apex_radius = frame.length_to_fixed(c.apex_radius, 0).ok_or_else(err)?;
-        if base == apex {
-            dropped.degenerate += 1;
-            continue;
-        }
-        if base_radius == 0 && apex_radius == 0 {
-            // Thinner than 1/65536 voxel: keep the wider end's 1.
-            if c.base_radius >= c.apex_radius {
-                base_radius = 1;
-            } else {
-                apex_radius = 1;
-            }
-        }
-        objects.push(FittedObject {
-            shape: Shape::Cone(geometry::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-            }),
-            material: c.material,
-            source: Source::Cone(i),
-        });
-    }
-    for (pi, p) in scene.polygons.iter().enumerate() {
-        let verts = scene.polygon_vertices(p);
-        let normals = scene.polygon_normals(p);
-        let mut lo = DVec3::INFINITY;
-        let mut hi = DVec3::NEG_INFINITY;
-        for &v in verts {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-        if outside(lo, hi) {
-            dropped.outside += p.count.saturating_sub(2);
-            continue;
-        }
-        let err = || range(&p.loc, "polygon");
-        let fixed: Vec<Point> = verts
-            .iter()
-            .map(|&v| frame.to_fixed(v))
-            .collect::<Option<_>>()
-            .ok_or_else(err)?;
-        let units: Option<Vec<UnitVector>> = normals.map(|ns| {
-            // The parser refuses zero normals; a normal that still fails
-            // (hand-built scene) becomes the face's own, below.
-            ns.iter()
-                .map(|&n| unit_to_fixed(n).unwrap_or([0; 3]))
-                .collect()
-        });
-        for t in 0..verts.len().saturating_sub(2) {
-            let idx = [0, t + 1, t + 2];
-            let vertices = idx.map(|k| fixed[k]);
-            if twice_area(vertices) == 0 {
-                dropped.degenerate += 1;
-                continue;
-            }
-            let normals = units.as_ref().and_then(|u| {
-                let n = idx.map(|k| u[k]);
-                (!n.contains(&[0; 3])).then_some(n)
-            });
-            objects.push(FittedObject {
-                shape: Shape::Triangle(geometry::Triangle { vertices, normals }),
-                material: p.material,
-                source: Source::Polygon {
-                    polygon: pi,
-                    triangle: t,
-                },
-            });
+        for t in scene.polygon_triangles(p) {
+            table.add(t, p.material, "polygon", &p.loc)?;
         }
     }
     let lights = scene
@@ -451,13 +303,17 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
         .iter()
         .map(|l| {
             Ok(FittedLight {
-                position: frame
-                    .to_fixed(l.position)
-                    .ok_or_else(|| range(&l.loc, "light"))?,
+                position: frame.to_fixed(l.position).ok_or(FitError::OutOfRange {
+                    loc: l.loc.clone(),
+                    what: "light",
+                })?,
                 colour: l.rgb(),
             })
         })
         .collect::<Result<_, FitError>>()?;
+    let Table {
+        objects, dropped, ..
+    } = table;
     Ok(Fitted {
         frame,
         objects,
@@ -467,17 +323,60 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
     })
 }
 
-/// `|(v1 − v0) × (v2 − v0)|²`-free test: the squared length of the cross
-/// product is 0 exactly when the triangle has no area; computed in i128.
-fn twice_area(v: [Point; 3]) -> i128 {
-    let d = |a: Point, b: Point| [0, 1, 2].map(|k| i128::from(b[k]) - i128::from(a[k]));
-    let (e1, e2) = (d(v[0], v[1]), d(v[0], v[2]));
-    let c = [
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ];
-    c[0].abs() + c[1].abs() + c[2].abs()
+/// The object table as [`fit`] fills it.
+struct Table<'f> {
+    frame: &'f RasterFrame,
+    /// The raster's world box.
+    world: Bounds,
+    objects: Vec<FittedObject>,
+    dropped: Dropped,
+}
+
+impl Table<'_> {
+    /// Whether world box `b` lies entirely outside the raster.
+    fn outside(&self, b: Bounds) -> bool {
+        b.max.cmplt(self.world.min).any() || b.min.cmpgt(self.world.max).any()
+    }
+
+    /// Adds `shape` of a scene object (`kind` at `loc`), or counts it as
+    /// dropped when nothing of it is left in fixed point.
+    fn add<S: Surface>(
+        &mut self,
+        shape: S,
+        material: usize,
+        kind: &'static str,
+        loc: &SourceLoc,
+    ) -> Result<(), FitError> {
+        match shape.to_fixed(self.frame) {
+            Ok(fixed) => self.objects.push(FittedObject {
+                shape: shape.into(),
+                entry: S::entry(fixed),
+                material,
+                kind,
+                loc: loc.clone(),
+            }),
+            Err(Unfit::Degenerate) => self.dropped.degenerate += 1,
+            Err(Unfit::OutOfRange) => {
+                return Err(FitError::OutOfRange {
+                    loc: loc.clone(),
+                    what: kind,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds every object of `list` that does not lie outside the raster.
+    fn add_all<S: Surface>(&mut self, list: &[Object<S>]) -> Result<(), FitError> {
+        for o in list {
+            if self.outside(o.shape.bounds()) {
+                self.dropped.outside += 1;
+                continue;
+            }
+            self.add(o.shape, o.material, S::KIND, &o.loc)?;
+        }
+        Ok(())
+    }
 }
 
 /// The raster's frame for `scene` (no allocation, no conversion).
@@ -560,7 +459,7 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
     };
     let mut count = 0.0;
     for sp in &scene.spheres {
-        let r = sp.radius;
+        let r = sp.shape.radius;
         count += surface(4.0 * PI * r * r, 0.0);
         if solid_spheres {
             let rv = r / s + 1.0;
@@ -568,11 +467,11 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
         }
     }
     for c in &scene.cones {
-        let slant = (c.apex - c.base)
+        let slant = (c.shape.apex - c.shape.base)
             .length()
-            .hypot(c.apex_radius - c.base_radius);
-        let area = PI * (c.base_radius + c.apex_radius) * slant;
-        count += surface(area, 2.0 * PI * (c.base_radius + c.apex_radius));
+            .hypot(c.shape.apex_radius - c.shape.base_radius);
+        let area = PI * (c.shape.base_radius + c.shape.apex_radius) * slant;
+        count += surface(area, 2.0 * PI * (c.shape.base_radius + c.shape.apex_radius));
     }
     for p in &scene.polygons {
         let v = scene.polygon_vertices(p);
@@ -639,6 +538,9 @@ mod tests {
     use super::*;
     use rrt_core::fixed::VOXEL;
     use rrt_core::geometry::NORMAL_ONE;
+
+    use crate::shape::{Sphere, Triangle};
+    use crate::world::Ray;
 
     fn scene(body: &str) -> Scene {
         let head = "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 45\nhither 0\nresolution 8 8\n";
@@ -749,31 +651,35 @@ mod tests {
         let fitted = fit(&s, &opts(36)).unwrap();
         let f = fitted.frame;
         assert_eq!(fitted.objects.len(), 1 + 1 + 2 + 1);
-        let Shape::Sphere(sp) = fitted.objects[0].shape else {
+        let table::Shape::Sphere(sp) = fitted.objects[0].entry else {
             panic!()
         };
         assert_eq!(sp.centre, f.to_fixed(DVec3::ZERO).unwrap());
         assert_eq!(sp.radius, 16 * VOXEL);
-        let Shape::Cone(c) = fitted.objects[1].shape else {
+        let table::Shape::Cone(c) = fitted.objects[1].entry else {
             panic!()
         };
         assert_eq!((c.base_radius, c.apex_radius), (8 * VOXEL, 4 * VOXEL));
         // The quad's fan: (0, 1, 2) and (0, 2, 3), winding kept.
-        let Shape::Triangle(t1) = fitted.objects[3].shape else {
+        let table::Shape::Triangle(t1) = fitted.objects[3].entry else {
             panic!()
         };
         let expect = [0, 2, 3].map(|k| f.to_fixed(s.vertices[k]).unwrap());
         assert_eq!(t1.vertices, expect);
         assert_eq!(t1.normals, None);
         assert_eq!(
-            fitted.objects[3].source,
-            Source::Polygon {
-                polygon: 0,
-                triangle: 1
-            }
+            fitted.objects[3].shape,
+            Shape::Triangle(Triangle {
+                vertices: [0, 2, 3].map(|k| s.vertices[k]),
+                normals: None,
+            })
+        );
+        assert_eq!(
+            (fitted.objects[3].kind, fitted.objects[3].loc.line),
+            ("polygon", 13)
         );
         // Patch normals normalised and scaled by 2^30.
-        let Shape::Triangle(pt) = fitted.objects[4].shape else {
+        let table::Shape::Triangle(pt) = fitted.objects[4].entry else {
             panic!()
         };
         let n = pt.normals.unwrap();
@@ -927,13 +833,13 @@ mod tests {
     }
 
     #[test]
-    fn source_intersects_the_exact_object() {
+    fn objects_keep_the_exact_world_geometry() {
         let s = scene("s 0 0 0 1\npp 3\n0 0 2 0 0 1\n1 0 2 1 0 1\n0 1 2 0 1 1\n");
         let fitted = fit(&s, &opts(36)).unwrap();
         let down = Ray::new(DVec3::new(0.2, 0.2, 5.0), -DVec3::Z);
         let h = fitted.objects[1]
-            .source
-            .intersect(&s, &down, 0.0, f64::INFINITY)
+            .shape
+            .intersect(&down, 0.0, f64::INFINITY)
             .unwrap();
         assert!((h.t - 3.0).abs() < 1e-12);
         let expect =
@@ -941,16 +847,17 @@ mod tests {
                 .normalize();
         assert!((h.normal - expect).length() < 1e-12);
         let h = fitted.objects[0]
-            .source
-            .intersect(&s, &down, 0.0, f64::INFINITY)
+            .shape
+            .intersect(&down, 0.0, f64::INFINITY)
             .unwrap();
         assert!((h.t - (5.0 - (1.0f64 - 0.08).sqrt())).abs() < 1e-12);
-        assert!(Source::Sphere(9).intersect(&s, &down, 0.0, 1.0).is_none());
         // The same ray in raster units meets the sphere at the same t.
         let r = fitted.frame.ray_to_raster(&down);
-        let c = fitted.frame.world_to_raster(DVec3::ZERO);
-        let h2 =
-            intersect::sphere(&r, c, 1.0 / fitted.frame.voxel_size, 0.0, f64::INFINITY).unwrap();
+        let ball = Sphere {
+            centre: fitted.frame.world_to_raster(DVec3::ZERO),
+            radius: 1.0 / fitted.frame.voxel_size,
+        };
+        let h2 = ball.intersect(&r, 0.0, f64::INFINITY).unwrap();
         assert!((h2.t - h.t).abs() < 1e-9);
     }
 }

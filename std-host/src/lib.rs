@@ -49,6 +49,7 @@ pub mod rasterfile;
 pub mod render;
 pub mod scene;
 pub mod shade;
+pub mod shape;
 pub mod texture;
 pub mod trace;
 pub mod volume;

@@ -57,9 +57,10 @@ use rrt_core::voxelize::Separation;
 
 use crate::build::{MAX_MATERIALS, VoxelScene, line_level};
 use crate::frame::RasterFrame;
-use crate::object_table::{WorldLight, WorldObject, WorldShape};
+use crate::object_table::{WorldLight, WorldObject};
 use crate::plane::Plane;
 use crate::scene::{Material, SourceLoc, View};
+use crate::shape::{SLOTS, Shape, Slots};
 
 /// The file's first bytes.
 pub const MAGIC: [u8; 8] = *b"RRTRASTR";
@@ -68,7 +69,8 @@ pub const VERSION: u32 = 1;
 const SECTIONS: usize = 7;
 const HEADER_LEN: u64 = 192;
 const META_LEN: u64 = 192;
-const OBJECT_LEN: u64 = 168;
+/// Kind, material and the shape's saved numbers.
+const OBJECT_LEN: u64 = 8 + 8 * SLOTS as u64;
 const MATERIAL_LEN: u64 = 64;
 const LIGHT_LEN: u64 = 48;
 const RECORD_LEN: u64 = 20;
@@ -224,46 +226,7 @@ fn meta_bytes(s: &VoxelScene) -> Vec<u8> {
 fn objects_bytes(s: &VoxelScene) -> Vec<u8> {
     let mut b = Buf::default();
     for o in &s.objects {
-        let mut slots = [0f64; 20];
-        fn put(slots: &mut [f64; 20], at: usize, v: DVec3) {
-            slots[at] = v.x;
-            slots[at + 1] = v.y;
-            slots[at + 2] = v.z;
-        }
-        let kind = match o.shape {
-            WorldShape::Sphere { centre, radius } => {
-                put(&mut slots, 0, centre);
-                slots[3] = radius;
-                1
-            }
-            WorldShape::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-            } => {
-                put(&mut slots, 0, base);
-                slots[3] = base_radius;
-                put(&mut slots, 4, apex);
-                slots[7] = apex_radius;
-                2
-            }
-            WorldShape::Triangle { vertices, normals } => {
-                for (k, v) in vertices.iter().enumerate() {
-                    put(&mut slots, 3 * k, *v);
-                }
-                match normals {
-                    Some(n) => {
-                        for (k, v) in n.iter().enumerate() {
-                            put(&mut slots, 9 + 3 * k, *v);
-                        }
-                        4
-                    }
-                    None => 3,
-                }
-            }
-            WorldShape::Voxels => 5,
-        };
+        let (kind, slots) = o.shape.save();
         b.u32(kind);
         b.u32(u32::from(o.material));
         for v in slots {
@@ -791,25 +754,9 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         let mut c = Cursor::new(chunk);
         let kind = c.u32();
         let material = c.u32();
-        let s: Vec<f64> = (0..20).map(|_| c.f64()).collect();
-        let v = |k: usize| DVec3::new(s[k], s[k + 1], s[k + 2]);
-        let shape = match kind {
-            1 => WorldShape::Sphere {
-                centre: v(0),
-                radius: s[3],
-            },
-            2 => WorldShape::Cone {
-                base: v(0),
-                base_radius: s[3],
-                apex: v(4),
-                apex_radius: s[7],
-            },
-            3 | 4 => WorldShape::Triangle {
-                vertices: [v(0), v(3), v(6)],
-                normals: (kind == 4).then(|| [v(9), v(12), v(15)]),
-            },
-            5 => WorldShape::Voxels,
-            k => return Err(invalid(format!("object {i} has unknown kind {k}"))),
+        let slots: Slots = std::array::from_fn(|_| c.f64());
+        let Some(shape) = Shape::load(kind, &slots) else {
+            return Err(invalid(format!("object {i} has unknown kind {kind}")));
         };
         let material = u16::try_from(material)
             .ok()
@@ -819,8 +766,8 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
                     "object {i} names material {material}, beyond the table"
                 ))
             })?;
-        if !shape.is_valid() {
-            return Err(invalid(format!("object {i} has non-finite geometry")));
+        if let Err(e) = shape.validate() {
+            return Err(invalid(format!("object {i}: {}: {e}", shape.kind())));
         }
         objects.push(WorldObject { shape, material });
     }

@@ -10,20 +10,19 @@
 //! a `.vox` model's voxels take their palette colours; a CSG result's
 //! voxels take the material of the leaf that forms the surface there.
 //! None of them has exact geometry: their world object is
-//! [`crate::object_table::WorldShape::Voxels`], whose hits verification keeps.
+//! [`crate::shape::Shape::Voxels`], whose hits verification keeps.
 
 #![deny(missing_docs)]
 
-use rrt_core::csg::{self, CsgNode, CsgTree, IgnoreLeaf, LeafFill, Solid};
+use rrt_core::csg::{self, CsgNode, CsgTree, IgnoreLeaf, LeafFill};
 use rrt_core::fixed::voxel_centre;
-use rrt_core::geometry;
 use rrt_core::store::{Counter, Filler, ObjectAttrs};
 use rrt_core::voxelize::Separation;
 
 use crate::build::BuildError;
 use crate::fit::FitError;
-use crate::frame::{RasterFrame, unit_to_fixed};
-use crate::scene::{Csg, SolidShape, SourceLoc, VolumeObject, VoxObject};
+use crate::frame::RasterFrame;
+use crate::scene::{Csg, Solid, SourceLoc, VolumeObject, VoxObject};
 use crate::texture::InRaster;
 use crate::texture::{AnyTexture, WorldTexture};
 use crate::volume::VolumeColors;
@@ -34,61 +33,6 @@ pub const MAX_BLOCK_BYTES: u64 = 256 << 20;
 
 /// Most raster voxels per `.vox` cell edge.
 pub const MAX_VOX_SCALE: u32 = 4096;
-
-/// A core solid in raster fixed point.
-enum CoreSolid {
-    Sphere(geometry::Sphere),
-    Cuboid(geometry::Cuboid),
-    Cone(geometry::Cone),
-    Torus(geometry::Torus),
-}
-
-impl CoreSolid {
-    fn as_dyn(&self) -> &dyn Solid {
-        match self {
-            Self::Sphere(s) => s,
-            Self::Cuboid(s) => s,
-            Self::Cone(s) => s,
-            Self::Torus(s) => s,
-        }
-    }
-
-    fn from_shape(s: &SolidShape, frame: &RasterFrame) -> Option<Self> {
-        Some(match *s {
-            SolidShape::Sphere { centre, radius } => Self::Sphere(geometry::Sphere {
-                centre: frame.to_fixed(centre)?,
-                radius: frame.length_to_fixed(radius, 1)?,
-            }),
-            SolidShape::Cuboid { min, max } => Self::Cuboid(geometry::Cuboid {
-                min: frame.to_fixed(min)?,
-                max: frame.to_fixed(max)?,
-            }),
-            SolidShape::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-            } => Self::Cone(geometry::Cone {
-                base: frame.to_fixed(base)?,
-                base_radius: frame.length_to_fixed(base_radius, 0)?,
-                apex: frame.to_fixed(apex)?,
-                apex_radius: frame.length_to_fixed(apex_radius, 0)?,
-            }),
-            SolidShape::Torus {
-                centre,
-                axis,
-                major,
-                minor,
-            } => Self::Torus(geometry::Torus {
-                centre: frame.to_fixed(centre)?,
-                axis: unit_to_fixed(axis)?,
-                major: frame.length_to_fixed(major, 1)?,
-                minor: frame.length_to_fixed(minor, 1)?,
-            }),
-            SolidShape::Volume(_) => return None,
-        })
-    }
-}
 
 fn out_of_range(loc: &SourceLoc, what: &'static str) -> BuildError {
     BuildError::Fit(FitError::OutOfRange {
@@ -106,15 +50,15 @@ fn csg_error(loc: &SourceLoc, e: &csg::CsgError) -> BuildError {
 /// rest of the tree, re-indexed, and the top operation.
 struct Prepared {
     nodes: Vec<CsgNode>,
-    solids: Vec<CoreSolid>,
+    solids: Vec<Box<dyn csg::Solid>>,
     /// `Some(true)` for `volume − rest`, `Some(false)` for `volume ∩ rest`.
     volume_cut: Option<bool>,
 }
 
 fn prepare(c: &Csg, frame: &RasterFrame) -> Result<Prepared, BuildError> {
     let volume_cut = match (c.leaves.first().map(|l| &l.shape), c.nodes.last()) {
-        (Some(SolidShape::Volume(_)), Some(CsgNode::Difference(..))) => Some(true),
-        (Some(SolidShape::Volume(_)), Some(CsgNode::Intersection(..))) => Some(false),
+        (Some(Solid::Volume(_)), Some(CsgNode::Difference(..))) => Some(true),
+        (Some(Solid::Volume(_)), Some(CsgNode::Intersection(..))) => Some(false),
         _ => None,
     };
     let (nodes, leaves) = match volume_cut {
@@ -142,7 +86,10 @@ fn prepare(c: &Csg, frame: &RasterFrame) -> Result<Prepared, BuildError> {
     let solids = leaves
         .iter()
         .map(|l| {
-            CoreSolid::from_shape(&l.shape, frame).ok_or_else(|| out_of_range(&l.loc, "CSG solid"))
+            l.shape
+                .primitive()
+                .and_then(|p| p.solid(frame))
+                .ok_or_else(|| out_of_range(&l.loc, "CSG solid"))
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(Prepared {
@@ -343,12 +290,12 @@ pub fn csg(
     pass: Pass<'_, '_, '_, '_>,
 ) -> Result<(), BuildError> {
     let p = prepare(c, frame)?;
-    let leaves: Vec<&dyn Solid> = p.solids.iter().map(CoreSolid::as_dyn).collect();
+    let leaves: Vec<&dyn csg::Solid> = p.solids.iter().map(AsRef::as_ref).collect();
     let tree = CsgTree::new(&p.nodes, &leaves).map_err(|e| csg_error(&c.loc, &e))?;
     let extent = frame.extent;
     let volume_leaf = match c.leaves.first() {
         Some(l) => match &l.shape {
-            SolidShape::Volume(data) => Some(VolumeObject {
+            Solid::Volume(data) => Some(VolumeObject {
                 data: data.clone(),
                 material: l.material,
                 loc: l.loc.clone(),

@@ -4,6 +4,39 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::*;
+use crate::shape::{Cone, Sphere, Surface, Triangle};
+
+fn sphere(r: &Ray, centre: DVec3, radius: f64, tmin: f64, tmax: f64) -> Option<Hit> {
+    Sphere { centre, radius }.intersect(r, tmin, tmax)
+}
+
+fn triangle(
+    r: &Ray,
+    vertices: [DVec3; 3],
+    normals: Option<[DVec3; 3]>,
+    tmin: f64,
+    tmax: f64,
+) -> Option<Hit> {
+    Triangle { vertices, normals }.intersect(r, tmin, tmax)
+}
+
+fn cone(
+    r: &Ray,
+    base: DVec3,
+    base_radius: f64,
+    apex: DVec3,
+    apex_radius: f64,
+    tmin: f64,
+    tmax: f64,
+) -> Option<Hit> {
+    Cone {
+        base,
+        base_radius,
+        apex,
+        apex_radius,
+    }
+    .intersect(r, tmin, tmax)
+}
 
 const INF: f64 = f64::INFINITY;
 

@@ -36,13 +36,14 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
+use crate::shape::{Cone, Primitive, Sphere, Triangle};
 use crate::world::Bounds;
 
 pub use error::{Found, SceneError};
 pub use loc::SourceLoc;
 pub use nff::ParseOptions;
 pub use objects::{
-    Csg, CsgLeaf, SceneTexture, SceneVolume, SolidShape, TextureKind, VolumeObject, VoxObject,
+    Csg, CsgLeaf, SceneTexture, SceneVolume, Solid, TextureKind, VolumeObject, VoxObject,
 };
 
 /// The NFF viewpoint (`v` block). The parser guarantees `from ≠ at`, `up`
@@ -121,33 +122,15 @@ impl Material {
     };
 }
 
-/// A sphere (`s`).
+/// An object of the scene: a primitive of the shape model
+/// ([`crate::shape`]), its material and where it is defined.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Sphere {
-    /// Centre.
-    pub centre: DVec3,
-    /// Radius (> 0).
-    pub radius: f64,
+pub struct Object<S> {
+    /// The primitive, in world coordinates.
+    pub shape: S,
     /// Index into [`Scene::materials`].
     pub material: usize,
-    /// Where the `s` is.
-    pub loc: SourceLoc,
-}
-
-/// A cone or cylinder (`c`), open at both ends as NFF defines it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Cone {
-    /// Centre of the base disc.
-    pub base: DVec3,
-    /// Radius at the base (≥ 0).
-    pub base_radius: f64,
-    /// Centre of the apex disc (≠ `base`).
-    pub apex: DVec3,
-    /// Radius at the apex (≥ 0; not both radii 0).
-    pub apex_radius: f64,
-    /// Index into [`Scene::materials`].
-    pub material: usize,
-    /// Where the `c` is.
+    /// Where the object is defined.
     pub loc: SourceLoc,
 }
 
@@ -200,10 +183,10 @@ pub struct Scene {
     /// Materials, in file order; [`Material::DEFAULT`] alone if the file
     /// has no `f`.
     pub materials: Vec<Material>,
-    /// Spheres.
-    pub spheres: Vec<Sphere>,
-    /// Cones and cylinders.
-    pub cones: Vec<Cone>,
+    /// Spheres (NFF `s`).
+    pub spheres: Vec<Object<Sphere>>,
+    /// Open cones and cylinders (NFF `c`).
+    pub cones: Vec<Object<Cone>>,
     /// Polygons and patches.
     pub polygons: Vec<Polygon>,
     /// All polygon vertices.
@@ -297,6 +280,30 @@ impl Scene {
         }
     }
 
+    /// The box around the vertices of `polygon`.
+    #[must_use]
+    pub fn polygon_bounds(&self, polygon: &Polygon) -> Bounds {
+        let mut b = Bounds::EMPTY;
+        for &v in self.polygon_vertices(polygon) {
+            b.include(v, v);
+        }
+        b
+    }
+
+    /// The triangles of `polygon`'s fan: vertices 0, `t + 1`, `t + 2` for
+    /// each `t`, with the patch's vertex normals (as written) for a `pp`.
+    pub fn polygon_triangles(&self, polygon: &Polygon) -> impl Iterator<Item = Triangle> + '_ {
+        let v = self.polygon_vertices(polygon);
+        let n = self.polygon_normals(polygon);
+        (0..v.len().saturating_sub(2)).map(move |t| {
+            let idx = [0, t + 1, t + 2];
+            Triangle {
+                vertices: idx.map(|k| v[k]),
+                normals: n.and_then(|n| Some([*n.get(idx[0])?, *n.get(idx[1])?, *n.get(idx[2])?])),
+            }
+        })
+    }
+
     /// Number of `pp` patches.
     #[must_use]
     pub fn patch_count(&self) -> usize {
@@ -337,11 +344,12 @@ impl Scene {
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::EMPTY;
         for s in &self.spheres {
-            b.include(s.centre - s.radius, s.centre + s.radius);
+            let w = s.shape.bounds();
+            b.include(w.min, w.max);
         }
         for c in &self.cones {
-            b.include(c.base - c.base_radius, c.base + c.base_radius);
-            b.include(c.apex - c.apex_radius, c.apex + c.apex_radius);
+            let w = c.shape.disc_bounds();
+            b.include(w.min, w.max);
         }
         for p in &self.polygons {
             for &v in self.polygon_vertices(p) {
@@ -414,21 +422,10 @@ pub fn check_scene(s: &Scene) -> Result<(), String> {
     }
     let nm = s.materials.len();
     for o in &s.spheres {
-        finite(o.centre, "sphere")?;
-        if o.material >= nm || !(o.radius > 0.0 && o.radius.is_finite()) {
-            return Err(format!("bad sphere {o:?}"));
-        }
+        objects::check_object(o, nm)?;
     }
-    for c in &s.cones {
-        finite(c.base, "cone")?;
-        finite(c.apex, "cone")?;
-        if c.material >= nm
-            || c.base == c.apex
-            || !(c.base_radius >= 0.0 && c.apex_radius >= 0.0)
-            || c.base_radius + c.apex_radius <= 0.0
-        {
-            return Err(format!("bad cone {c:?}"));
-        }
+    for o in &s.cones {
+        objects::check_object(o, nm)?;
     }
     for p in &s.polygons {
         if p.material >= nm || p.count < 3 || s.vertices.get(p.range()).is_none() {

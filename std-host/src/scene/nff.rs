@@ -63,7 +63,8 @@ use glam::DVec3;
 
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
-use super::{Cone, Light, Material, Polygon, Scene, Sphere, View};
+use super::{Light, Material, Object, Polygon, Scene, View};
+use crate::shape::{Cone, Sphere};
 
 /// Largest image width or height a `resolution` line may ask for.
 pub const MAX_RESOLUTION: u32 = 65_536;
@@ -224,8 +225,8 @@ struct Parser<'a> {
 struct Builder {
     lights: Vec<Light>,
     materials: Vec<Material>,
-    spheres: Vec<Sphere>,
-    cones: Vec<Cone>,
+    spheres: Vec<Object<Sphere>>,
+    cones: Vec<Object<Cone>>,
     polygons: Vec<Polygon>,
     vertices: Vec<DVec3>,
     normals: Vec<DVec3>,
@@ -637,9 +638,8 @@ impl<'a> Parser<'a> {
         let radius = self.number_where("sphere radius", "a positive number", |r| r > 0.0)?;
         self.expect_eol("sphere")?;
         let material = self.current_material();
-        self.scene.spheres.push(Sphere {
-            centre,
-            radius,
+        self.scene.spheres.push(Object {
+            shape: Sphere { centre, radius },
             material,
             loc,
         });
@@ -677,11 +677,13 @@ impl<'a> Parser<'a> {
             });
         }
         let material = self.current_material();
-        self.scene.cones.push(Cone {
-            base,
-            base_radius,
-            apex,
-            apex_radius,
+        self.scene.cones.push(Object {
+            shape: Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+            },
             material,
             loc,
         });

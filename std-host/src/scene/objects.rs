@@ -15,6 +15,7 @@ use rrt_core::csg::MAX_NODES;
 #[cfg(any(test, feature = "check"))]
 use super::Scene;
 use super::SourceLoc;
+use crate::shape::{Cone, Cuboid, Primitive, SolidPrimitive, Sphere, Torus};
 use crate::texture::{AnyTexture, Blend};
 use crate::volume::{Classifier, PlacedVolume, Placement, Volume};
 use crate::vox::VoxScene;
@@ -93,83 +94,43 @@ impl VoxObject {
     }
 }
 
-/// A solid a CSG tree combines.
+/// A solid a CSG tree combines: a primitive of the shape model
+/// ([`crate::shape`]) or a classified volume.
 #[derive(Clone, Debug, PartialEq)]
-pub enum SolidShape {
+pub enum Solid {
     /// A ball.
-    Sphere {
-        /// Centre.
-        centre: DVec3,
-        /// Radius (> 0).
-        radius: f64,
-    },
+    Sphere(Sphere),
     /// An axis-aligned box.
-    Cuboid {
-        /// Lowest corner.
-        min: DVec3,
-        /// Highest corner.
-        max: DVec3,
-    },
+    Cuboid(Cuboid),
     /// A cone or cylinder closed by its end discs.
-    Cone {
-        /// Centre of the base disc.
-        base: DVec3,
-        /// Radius at the base (≥ 0).
-        base_radius: f64,
-        /// Centre of the apex disc.
-        apex: DVec3,
-        /// Radius at the apex (≥ 0, not both 0).
-        apex_radius: f64,
-    },
+    Cone(Cone),
     /// A solid torus.
-    Torus {
-        /// Centre.
-        centre: DVec3,
-        /// Unit axis.
-        axis: DVec3,
-        /// Radius of the centre circle (> 0).
-        major: f64,
-        /// Radius of the tube (> 0).
-        minor: f64,
-    },
+    Torus(Torus),
     /// The non-transparent samples of a classified volume.
     Volume(SceneVolume),
 }
 
-impl SolidShape {
+impl Solid {
+    /// The primitive, `None` for a volume.
+    #[must_use]
+    pub fn primitive(&self) -> Option<&dyn SolidPrimitive> {
+        match self {
+            Self::Sphere(s) => Some(s),
+            Self::Cuboid(s) => Some(s),
+            Self::Cone(s) => Some(s),
+            Self::Torus(s) => Some(s),
+            Self::Volume(_) => None,
+        }
+    }
+
     /// The world box holding the solid.
     #[must_use]
     pub fn world_bounds(&self) -> Bounds {
         match self {
-            Self::Sphere { centre, radius } => Bounds {
-                min: *centre - *radius,
-                max: *centre + *radius,
-            },
-            Self::Cuboid { min, max } => Bounds {
-                min: *min,
-                max: *max,
-            },
-            Self::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-            } => {
-                let r = base_radius.max(*apex_radius);
-                Bounds {
-                    min: base.min(*apex) - r,
-                    max: base.max(*apex) + r,
-                }
-            }
-            Self::Torus {
-                centre,
-                major,
-                minor,
-                ..
-            } => Bounds {
-                min: *centre - (major + minor),
-                max: *centre + (major + minor),
-            },
+            Self::Sphere(s) => s.bounds(),
+            Self::Cuboid(s) => s.bounds(),
+            Self::Cone(s) => s.bounds(),
+            Self::Torus(s) => s.bounds(),
             Self::Volume(v) => v.world_bounds(),
         }
     }
@@ -178,11 +139,26 @@ impl SolidShape {
     #[must_use]
     pub const fn kind(&self) -> &'static str {
         match self {
-            Self::Sphere { .. } => "sphere",
-            Self::Cuboid { .. } => "box",
-            Self::Cone { .. } => "cone",
-            Self::Torus { .. } => "torus",
+            Self::Sphere(_) => Sphere::KIND,
+            Self::Cuboid(_) => Cuboid::KIND,
+            Self::Cone(_) => Cone::KIND,
+            Self::Torus(_) => Torus::KIND,
             Self::Volume(_) => "volume",
+        }
+    }
+
+    /// Checks the world-space invariants of the primitive, or the
+    /// classifier of the volume.
+    ///
+    /// # Errors
+    /// What is wrong, for a message.
+    pub fn validate(&self) -> Result<(), String> {
+        match self {
+            Self::Sphere(s) => s.validate().map_err(String::from),
+            Self::Cuboid(s) => s.validate().map_err(String::from),
+            Self::Cone(s) => s.validate().map_err(String::from),
+            Self::Torus(s) => s.validate().map_err(String::from),
+            Self::Volume(v) => v.classifier.validate().map_err(|e| e.to_string()),
         }
     }
 }
@@ -192,7 +168,7 @@ impl SolidShape {
 #[derive(Clone, Debug, PartialEq)]
 pub struct CsgLeaf {
     /// The solid.
-    pub shape: SolidShape,
+    pub shape: Solid,
     /// Index into [`Scene::materials`](super::Scene::materials).
     pub material: usize,
     /// Where the solid is defined.
@@ -284,39 +260,23 @@ fn positive(x: f64) -> bool {
     x > 0.0 && x.is_finite()
 }
 
+/// An object's material index and its primitive's invariants (part of
+/// [`super::check_scene`]).
 #[cfg(any(test, feature = "check"))]
-fn check_solid(s: &SolidShape) -> Result<(), String> {
-    let ok = match s {
-        SolidShape::Sphere { centre, radius } => centre.is_finite() && positive(*radius),
-        SolidShape::Cuboid { min, max } => {
-            min.is_finite() && max.is_finite() && min.cmplt(*max).all()
-        }
-        SolidShape::Cone {
-            base,
-            base_radius,
-            apex,
-            apex_radius,
-        } => {
-            base.is_finite()
-                && apex.is_finite()
-                && base != apex
-                && *base_radius >= 0.0
-                && *apex_radius >= 0.0
-                && positive(base_radius + apex_radius)
-        }
-        SolidShape::Torus {
-            centre,
-            axis,
-            major,
-            minor,
-        } => centre.is_finite() && axis.is_normalized() && positive(*major) && positive(*minor),
-        SolidShape::Volume(v) => v.classifier.validate().is_ok(),
-    };
-    if ok {
-        Ok(())
-    } else {
-        Err(format!("bad solid {s:?}"))
+pub(crate) fn check_object<S: Primitive + std::fmt::Debug>(
+    o: &super::Object<S>,
+    materials: usize,
+) -> Result<(), String> {
+    if o.material >= materials {
+        return Err(format!(
+            "{}: material {} of {materials}",
+            S::KIND,
+            o.material
+        ));
     }
+    o.shape
+        .validate()
+        .map_err(|e| format!("bad {} {:?}: {e}", S::KIND, o.shape))
 }
 
 /// The guarantees of [`Scene`] about the objects of this module (part of
@@ -359,7 +319,9 @@ pub(crate) fn check(s: &Scene) -> Result<(), String> {
         }
         for l in &c.leaves {
             mat(l.material, "CSG leaf")?;
-            check_solid(&l.shape)?;
+            l.shape
+                .validate()
+                .map_err(|e| format!("bad solid {:?}: {e}", l.shape))?;
         }
     }
     for (&m, &t) in &s.material_textures {

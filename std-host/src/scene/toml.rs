@@ -50,10 +50,11 @@ use serde::Deserialize;
 
 use super::error::SceneError;
 use super::loc::SourceLoc;
-use super::objects::{Csg, CsgLeaf, SceneTexture, SceneVolume, SolidShape, TextureKind};
+use super::objects::{Csg, CsgLeaf, SceneTexture, SceneVolume, Solid, TextureKind};
 use super::objects::{VolumeObject, VoxObject};
 use super::text::{byte_loc, read_text};
-use super::{Light, Material, Polygon, Scene, Sphere, View, bpt, nff, obj};
+use super::{Light, Material, Object, Polygon, Scene, View, bpt, nff, obj};
+use crate::shape::{Cone, Cuboid, Sphere, Torus};
 use crate::texture::{AnyTexture, Blend, Checker, ImageTexture, Mapping, Marble, Wood, Wrap};
 use crate::volume::computed::{self, Metaball, Metaballs};
 use crate::volume::raw::{self, RawSpec};
@@ -997,28 +998,23 @@ impl Builder<'_> {
             if !(sp.radius.is_finite() && sp.radius > 0.0) {
                 return Err(self.err(s, "object.sphere.radius", "expected a number > 0"));
             }
-            scene.spheres.push(Sphere {
-                centre,
-                radius: sp.radius,
+            scene.spheres.push(Object {
+                shape: Sphere {
+                    centre,
+                    radius: sp.radius,
+                },
                 material,
                 loc,
             });
         } else if let Some(c) = &d.cone {
             let shape = self.cone(c, &s, "object.cone")?;
             if c.capped {
-                scene.csgs.push(single_leaf(shape, material, loc));
-            } else if let SolidShape::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-            } = shape
-            {
-                scene.cones.push(super::Cone {
-                    base,
-                    base_radius,
-                    apex,
-                    apex_radius,
+                scene
+                    .csgs
+                    .push(single_leaf(Solid::Cone(shape), material, loc));
+            } else {
+                scene.cones.push(Object {
+                    shape,
                     material,
                     loc,
                 });
@@ -1046,7 +1042,9 @@ impl Builder<'_> {
             }
         } else if let Some(t) = &d.torus {
             let shape = self.torus(t, &s, "object.torus")?;
-            scene.csgs.push(single_leaf(shape, material, loc));
+            scene
+                .csgs
+                .push(single_leaf(Solid::Torus(shape), material, loc));
         } else if let Some(b) = &d.bezier {
             if b.steps == 0 || b.steps > self.opts.max_patch_steps {
                 return Err(self.err(
@@ -1169,12 +1167,7 @@ impl Builder<'_> {
         Ok(())
     }
 
-    fn cone(
-        &self,
-        c: &ConeDef,
-        s: &std::ops::Range<usize>,
-        key: &str,
-    ) -> Result<SolidShape, SceneError> {
+    fn cone(&self, c: &ConeDef, s: &std::ops::Range<usize>, key: &str) -> Result<Cone, SceneError> {
         let base = self.vec3(s, key, c.base)?;
         let apex = self.vec3(s, key, c.apex)?;
         let ok = base != apex
@@ -1190,7 +1183,7 @@ impl Builder<'_> {
                 "expected base ≠ apex and radii ≥ 0, not both 0",
             ));
         }
-        Ok(SolidShape::Cone {
+        Ok(Cone {
             base,
             base_radius: c.base_radius,
             apex,
@@ -1203,7 +1196,7 @@ impl Builder<'_> {
         t: &TorusDef,
         s: &std::ops::Range<usize>,
         key: &str,
-    ) -> Result<SolidShape, SceneError> {
+    ) -> Result<Torus, SceneError> {
         let centre = self.vec3(s, key, t.centre)?;
         let axis = self
             .vec3(s, key, t.axis)?
@@ -1212,7 +1205,7 @@ impl Builder<'_> {
         if !(t.major.is_finite() && t.minor.is_finite() && t.major > 0.0 && t.minor > 0.0) {
             return Err(self.err(s.clone(), key, "expected major > 0 and minor > 0"));
         }
-        Ok(SolidShape::Torus {
+        Ok(Torus {
             centre,
             axis,
             major: t.major,
@@ -1265,23 +1258,23 @@ impl Builder<'_> {
             if !(sp.radius.is_finite() && sp.radius > 0.0) {
                 return Err(self.err(s, &format!("{key}.sphere.radius"), "expected a number > 0"));
             }
-            SolidShape::Sphere {
+            Solid::Sphere(Sphere {
                 centre,
                 radius: sp.radius,
-            }
+            })
         } else if let Some(b) = &d.cuboid {
             let min = self.vec3(&s, &key, b.min)?;
             let max = self.vec3(&s, &key, b.max)?;
             if !min.cmplt(max).all() {
                 return Err(self.err(s, &format!("{key}.box"), "expected min < max on every axis"));
             }
-            SolidShape::Cuboid { min, max }
+            Solid::Cuboid(Cuboid { min, max })
         } else if let Some(c) = &d.cone {
-            self.cone(c, &s, &format!("{key}.cone"))?
+            Solid::Cone(self.cone(c, &s, &format!("{key}.cone"))?)
         } else if let Some(t) = &d.torus {
-            self.torus(t, &s, &format!("{key}.torus"))?
+            Solid::Torus(self.torus(t, &s, &format!("{key}.torus"))?)
         } else if let Some(v) = &d.volume {
-            SolidShape::Volume(self.volumes.get(v.get_ref()).cloned().ok_or_else(|| {
+            Solid::Volume(self.volumes.get(v.get_ref()).cloned().ok_or_else(|| {
                 self.err(
                     v.span(),
                     &format!("{key}.volume"),
@@ -1327,13 +1320,13 @@ impl Builder<'_> {
         let leaf_has_volume = |l: u16| {
             matches!(
                 csg.leaves.get(usize::from(l)).map(|l| &l.shape),
-                Some(SolidShape::Volume(_))
+                Some(Solid::Volume(_))
             )
         };
         let volumes = csg
             .leaves
             .iter()
-            .filter(|l| matches!(l.shape, SolidShape::Volume(_)))
+            .filter(|l| matches!(l.shape, Solid::Volume(_)))
             .count();
         if volumes > 0 {
             let ok = volumes == 1
@@ -1475,7 +1468,7 @@ fn key_before(text: &str, at: usize) -> String {
 }
 
 /// A CSG tree of one solid: a closed primitive (torus, capped cone).
-fn single_leaf(shape: SolidShape, material: usize, loc: SourceLoc) -> Csg {
+fn single_leaf(shape: Solid, material: usize, loc: SourceLoc) -> Csg {
     Csg {
         nodes: vec![CsgNode::Leaf(0)],
         leaves: vec![CsgLeaf {

@@ -1,0 +1,269 @@
+//! The one shape model: each primitive described once, in world
+//! coordinates, with every role the pipeline asks of it.
+//!
+//! A primitive is a world-space struct in its own file: [`Sphere`],
+//! [`Cone`], [`Triangle`], [`Cuboid`], [`Torus`]. Its roles are traits:
+//!
+//! * [`Primitive`], every primitive: its name in messages, its world-space
+//!   validation (what the parsers guarantee and a loaded raster file must
+//!   satisfy) and its world box;
+//! * [`Surface`], an object of the object table: its fixed-point geometry
+//!   in the raster and the core object-table entry made of it
+//!   ([`rrt_core::object_table::Shape`]), its core voxelizer call, its
+//!   exact intersection for *intersection verification*, and its saved
+//!   form in a raster file;
+//! * [`SolidPrimitive`], a leaf of a CSG tree: its core solid
+//!   ([`rrt_core::csg::Solid`]) in the raster.
+//!
+//! [`Shape`] is what the world object table holds: one surface primitive,
+//! or [`Shape::Voxels`] for the objects whose voxels are the object
+//! (volumes, `.vox` models, CSG results).
+//!
+//! # Exact intersections
+//! [`Surface::intersect`] takes a [`Ray`] (the direction need not be unit
+//! length; `t` is in units of it) and an open interval `(tmin, tmax)`, and
+//! returns the nearest intersection with `tmin < t < tmax` and the
+//! surface's true unit normal there:
+//! * closed surfaces (spheres) give the outward normal, also for a ray that
+//!   starts inside;
+//! * triangles give the normal of their winding, `(v1 − v0) × (v2 − v0)`,
+//!   or the barycentric interpolation of their vertex normals;
+//! * open cones give the outward normal of the lateral surface.
+//!
+//! None of them flips the normal towards the ray: shading does that
+//! ([`crate::shade::face_forward`]). Tangent (grazing) rays count as hits.
+//! No input makes them panic; non-finite input gives `None`.
+
+// `!(x >= 0.0)` is deliberate throughout: it is true for NaN, which must
+// be refused like any other out-of-range value.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod cone;
+pub mod cuboid;
+pub mod sphere;
+pub mod torus;
+pub mod triangle;
+
+use glam::DVec3;
+use rrt_core::csg;
+use rrt_core::object_table as table;
+use rrt_core::raster::Extent;
+use rrt_core::voxelize::error::VoxelizeError;
+use rrt_core::voxelize::{Separation, VoxelSink};
+
+pub use cone::Cone;
+pub use cuboid::Cuboid;
+pub use sphere::Sphere;
+pub use torus::Torus;
+pub use triangle::Triangle;
+
+use crate::frame::RasterFrame;
+use crate::world::{Bounds, Hit, Ray};
+
+/// Numbers in a primitive's saved form (a raster file's object slots).
+pub const SLOTS: usize = 20;
+
+/// A primitive's saved form: its numbers, unused ones 0.
+pub type Slots = [f64; SLOTS];
+
+/// The saved kind of [`Shape::Voxels`].
+pub const VOXELS_KIND: u32 = 5;
+
+/// Why a primitive has no place in the raster.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unfit {
+    /// A coordinate or length lies beyond the fixed-point range
+    /// ([`crate::frame::MAX_FIXED`]).
+    OutOfRange,
+    /// Nothing is left of it in fixed point: a triangle without area, a
+    /// cone whose end discs meet.
+    Degenerate,
+}
+
+/// What every primitive has.
+pub trait Primitive {
+    /// What it is called in messages.
+    const KIND: &'static str;
+
+    /// Checks the world-space invariants: finite coordinates, radii in
+    /// range, and the like.
+    ///
+    /// # Errors
+    /// What is wrong, for a message.
+    fn validate(&self) -> Result<(), &'static str>;
+
+    /// A world box holding the primitive.
+    fn bounds(&self) -> Bounds;
+}
+
+/// A primitive that is an object of the object table: a surface the
+/// voxelizer draws and intersection verification intersects.
+pub trait Surface: Primitive + Copy + Into<Shape> {
+    /// The core's fixed-point geometry of it.
+    type Fixed: Copy;
+
+    /// The primitive in the raster `frame`.
+    ///
+    /// # Errors
+    /// [`Unfit`]: beyond the fixed-point range, or nothing left of it.
+    fn to_fixed(&self, frame: &RasterFrame) -> Result<Self::Fixed, Unfit>;
+
+    /// Its entry in the core's object table (what the light pass reads).
+    fn entry(fixed: Self::Fixed) -> table::Shape;
+
+    /// Voxelizes it through its core voxelizer; returns the voxels offered.
+    ///
+    /// # Errors
+    /// The voxelizer's refusal.
+    fn voxelize(
+        fixed: &Self::Fixed,
+        separation: Separation,
+        extent: Extent,
+        sink: &mut dyn VoxelSink,
+    ) -> Result<u64, VoxelizeError>;
+
+    /// The exact intersection of `ray` in `(tmin, tmax)` (module docs).
+    fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit>;
+
+    /// Writes its saved form into `slots` (all 0 on entry) and returns its
+    /// saved kind.
+    fn save(&self, slots: &mut Slots) -> u32;
+
+    /// The primitive a saved form describes, if `kind` is one of its own.
+    fn load(kind: u32, slots: &Slots) -> Option<Self>;
+}
+
+/// A primitive that can be a leaf of a CSG tree.
+pub trait SolidPrimitive {
+    /// Its core solid in the raster `frame`; `None` beyond the fixed-point
+    /// range.
+    fn solid(&self, frame: &RasterFrame) -> Option<Box<dyn csg::Solid>>;
+}
+
+/// An object's exact geometry in world coordinates: an entry of the world
+/// object table, indexed by the voxel records' object id as the paper's
+/// object table is. Primitives are the scene's own geometry, before any
+/// fixed-point rounding, so that verification intersects the true surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A sphere.
+    Sphere(Sphere),
+    /// An open cone or cylinder.
+    Cone(Cone),
+    /// A triangle of a polygon's fan.
+    Triangle(Triangle),
+    /// No continuous definition: the voxels are the object (volumes,
+    /// `.vox` models, CSG results). It has no exact intersection, so
+    /// intersection verification keeps the discrete hit with the stored
+    /// normal.
+    Voxels,
+}
+
+/// `$body` with `$s` bound to the surface primitive in `$shape`, or
+/// `$voxels` for [`Shape::Voxels`].
+macro_rules! each_surface {
+    ($shape:expr, $s:ident => $body:expr, voxels => $voxels:expr) => {
+        match $shape {
+            Shape::Sphere($s) => $body,
+            Shape::Cone($s) => $body,
+            Shape::Triangle($s) => $body,
+            Shape::Voxels => $voxels,
+        }
+    };
+}
+
+impl Shape {
+    /// What it is called in messages.
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        fn kind<S: Primitive>(_: &S) -> &'static str {
+            S::KIND
+        }
+        each_surface!(self, s => kind(s), voxels => "voxels")
+    }
+
+    /// The exact intersection of `ray` with the shape in `(tmin, tmax)`,
+    /// with the true normal there (module docs); `None` for
+    /// [`Shape::Voxels`].
+    #[must_use]
+    pub fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
+        each_surface!(self, s => s.intersect(ray, tmin, tmax), voxels => None)
+    }
+
+    /// Whether the shape has exact geometry to verify hits against (all
+    /// but [`Shape::Voxels`]).
+    #[must_use]
+    pub const fn is_exact(&self) -> bool {
+        !matches!(self, Self::Voxels)
+    }
+
+    /// Checks the world-space invariants of its primitive.
+    ///
+    /// # Errors
+    /// What is wrong, for a message.
+    pub fn validate(&self) -> Result<(), &'static str> {
+        each_surface!(self, s => s.validate(), voxels => Ok(()))
+    }
+
+    /// Its saved form: the kind and the numbers.
+    #[must_use]
+    pub fn save(&self) -> (u32, Slots) {
+        let mut slots = [0.0; SLOTS];
+        let kind = each_surface!(self, s => s.save(&mut slots), voxels => VOXELS_KIND);
+        (kind, slots)
+    }
+
+    /// The shape a saved form describes; `None` for an unknown kind.
+    #[must_use]
+    pub fn load(kind: u32, slots: &Slots) -> Option<Self> {
+        if kind == VOXELS_KIND {
+            return Some(Self::Voxels);
+        }
+        Sphere::load(kind, slots)
+            .map(Self::Sphere)
+            .or_else(|| Cone::load(kind, slots).map(Self::Cone))
+            .or_else(|| Triangle::load(kind, slots).map(Self::Triangle))
+    }
+}
+
+/// Voxelizes an object-table entry made by [`Surface::entry`] through its
+/// primitive's core voxelizer; entries without a surface of their own
+/// (voxel objects voxelize themselves) offer nothing.
+///
+/// # Errors
+/// The voxelizer's refusal.
+pub fn voxelize(
+    entry: &table::Shape,
+    separation: Separation,
+    extent: Extent,
+    sink: &mut dyn VoxelSink,
+) -> Result<u64, VoxelizeError> {
+    match entry {
+        table::Shape::Sphere(s) => Sphere::voxelize(s, separation, extent, sink),
+        table::Shape::Cone(c) => Cone::voxelize(c, separation, extent, sink),
+        table::Shape::Triangle(t) => Triangle::voxelize(t, separation, extent, sink),
+        _ => Ok(0),
+    }
+}
+
+/// Writes `v` into `slots[at..at + 3]`.
+fn put(slots: &mut Slots, at: usize, v: DVec3) {
+    slots[at] = v.x;
+    slots[at + 1] = v.y;
+    slots[at + 2] = v.z;
+}
+
+/// The vector in `slots[at..at + 3]`.
+fn get(slots: &Slots, at: usize) -> DVec3 {
+    DVec3::new(slots[at], slots[at + 1], slots[at + 2])
+}
+
+/// Whether `x` is a finite number ≥ 0.
+fn non_negative(x: f64) -> bool {
+    x >= 0.0 && x.is_finite()
+}
+
+/// Whether `x` is a finite number > 0.
+fn positive(x: f64) -> bool {
+    x > 0.0 && x.is_finite()
+}
