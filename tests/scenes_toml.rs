@@ -7,7 +7,11 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use indicatif::ProgressBar;
 use rrt_host::build::{BuildOptions, VoxelScene, build};
+use rrt_host::rasterfile;
 use rrt_host::scene::Scene;
+use rrt_host::shape::Shape;
+use rrt_host::trace::{Verdict, verify};
+use rrt_host::world::Ray;
 
 fn scenes_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes")
@@ -154,17 +158,20 @@ fn every_object_kind_reaches_the_raster() {
     // Box: 6 polygons; Bézier: 4 × 4 patch quads; mesh: 1 triangle.
     assert_eq!(scene.polygons.len(), 6 + 16 + 1);
     assert!(scene.polygons[6..22].iter().all(|p| p.patch));
-    // Torus and capped cone as one-solid CSG trees, plus the cut ball.
-    assert_eq!(scene.csgs.len(), 3);
+    // The torus is a primitive; the capped cone a one-solid CSG tree,
+    // beside the cut ball.
+    assert_eq!(scene.tori.len(), 1);
+    assert_eq!(scene.csgs.len(), 2);
     assert_eq!(scene.volumes.len(), 1);
     rrt_host::check::check_scene(&scene).unwrap();
     let vs = built(&scene, 96);
     let recs = records(&vs);
     let n_objects = vs.objects.len();
-    // Volumes, then CSG trees come last, in scene order: torus, cone, ball.
-    let volume_id = u32::try_from(n_objects - 4).unwrap();
-    let torus_id = volume_id + 1;
-    let ball_id = volume_id + 3;
+    // The torus is the last primitive; then the volume, then the CSG trees
+    // in scene order: cone, ball.
+    let volume_id = u32::try_from(n_objects - 3).unwrap();
+    let torus_id = volume_id - 1;
+    let ball_id = volume_id + 2;
     let of = |id: u32| recs.iter().filter(|r| r.1 == id).collect::<Vec<_>>();
     let blob = of(volume_id);
     assert!(blob.len() > 50, "volume voxels {}", blob.len());
@@ -435,4 +442,49 @@ volume = "blob"
             "exact {exact}: no volume shadow ({a}, {b})"
         );
     }
+}
+
+#[test]
+fn a_torus_is_verified_against_the_exact_torus_and_saved_as_one() {
+    const TORUS: &str = r#"
+[camera]
+from = [0, -6, 4]
+at = [0, 0, 0]
+angle = 40
+resolution = [8, 8]
+
+[material.m]
+
+[[object]]
+material = "m"
+torus = { centre = [0, 0, 0], axis = [0, 0, 1], major = 1.5, minor = 0.5 }
+"#;
+    let d = temp_dir("torus");
+    std::fs::write(d.join("torus.toml"), TORUS).unwrap();
+    let scene = Scene::load(d.join("torus.toml")).unwrap();
+    let vs = built(&scene, 64);
+    let Shape::Torus(t) = vs.objects[0].shape else {
+        panic!("torus object {:?}", vs.objects[0])
+    };
+    // Every voxel of the torus: the continuous ray from above through its
+    // centre verifies on the exact surface, (|p_xy| − R)² + z² = r².
+    let mut hits = 0;
+    for (v, rec) in vs.store().unwrap().iter() {
+        assert_eq!(rec.object, 0);
+        let centre = vs
+            .frame
+            .raster_to_world(DVec3::from(v.map(f64::from)) + 0.5);
+        let ray = Ray::new(centre + DVec3::Z * (2.0 * vs.frame.voxel_size), -DVec3::Z);
+        if let Verdict::Hit(h) = verify(&vs.frame, &vs.objects[0], &ray, v, 0.0) {
+            let p = ray.at(h.t);
+            let ring = DVec3::new(p.x, p.y, 0.0).length() - t.major;
+            assert!((ring.hypot(p.z) - t.minor).abs() < 1e-9, "{p}");
+            hits += 1;
+        }
+    }
+    assert!(hits > 100, "{hits} verified hits");
+    // Saved and loaded, the world object is the same torus.
+    let rrt = d.join("torus.rrt");
+    rasterfile::save(&vs, &rrt).unwrap();
+    assert_eq!(rasterfile::load(&rrt).unwrap().objects, vs.objects);
 }

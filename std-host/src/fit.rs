@@ -283,7 +283,7 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
         frame: &frame,
         world: frame.world_bounds(),
         objects: Vec::with_capacity(
-            scene.spheres.len() + scene.cones.len() + scene.triangle_count(),
+            scene.spheres.len() + scene.cones.len() + scene.triangle_count() + scene.tori.len(),
         ),
         dropped: Dropped::default(),
     };
@@ -298,6 +298,7 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
             table.add(t, p.material, "polygon", &p.loc)?;
         }
     }
+    table.add_all(&scene.tori)?;
     let lights = scene
         .lights
         .iter()
@@ -481,6 +482,10 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
             let perimeter = (w[0] - v0).length() + (w[1] - w[0]).length() + (v0 - w[1]).length();
             count += surface(area, perimeter);
         }
+    }
+    for t in &scene.tori {
+        let (big, small) = (t.shape.major, t.shape.minor);
+        count += surface(4.0 * PI * PI * big * small, 0.0);
     }
     let record_voxels = if count.is_finite() && count < voxels as f64 {
         count.ceil() as u64

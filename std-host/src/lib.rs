@@ -10,10 +10,10 @@
 //!   coordinates, once; the memory estimate and limit.
 //! * [`shade`]: shading maths (SPD intensities, Phong, Whitted secondary
 //!   rays, refraction), matching `embree_nff`.
-//! * [`intersect`]: exact `f64` ray intersections for intersection
-//!   verification and tests.
-//! * [`world`]: the world object table (each object's exact geometry),
-//!   materials and lights, indexed by the voxel records.
+//! * [`shape`]: the shape model: each primitive's validation, fixed-point
+//!   geometry, voxelizer call and exact intersection for verification.
+//! * [`object_table`]: the world object table (each object's exact
+//!   geometry) and lights, indexed by the voxel records.
 //! * [`build`]: the preprocessing pipeline, scene → fitted raster →
 //!   count and fill passes → proximity flags → light visibility, giving a
 //!   [`build::VoxelScene`]; [`plane`]: the plane's huge-page memory.
@@ -41,7 +41,6 @@ pub mod check;
 pub mod cli;
 pub mod fit;
 pub mod frame;
-pub mod intersect;
 pub mod object_table;
 pub mod output;
 pub mod plane;

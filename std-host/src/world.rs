@@ -74,7 +74,7 @@ pub struct Hit {
     /// Unit surface normal (see the module docs for its orientation).
     pub normal: DVec3,
     /// Surface parameters: barycentric `(u, v)` of vertices 1 and 2 for a
-    /// triangle, `(u, v)` for a patch, 0 otherwise.
+    /// triangle, 0 otherwise.
     pub u: f64,
     /// See [`Hit::u`].
     pub v: f64,

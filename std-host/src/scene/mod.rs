@@ -9,7 +9,7 @@
 //!   the Standard Procedural Databases): spheres, open cones and
 //!   cylinders, polygons and polygonal patches;
 //! * [`toml`]: a TOML scene file, for what NFF cannot say: everything NFF
-//!   has plus boxes (as polygons), tori and capped cones (as one-solid CSG
+//!   has plus tori, boxes (as polygons), capped cones (as one-solid CSG
 //!   trees), Bézier patches (`.bpt` files, tessellated into `pp`
 //!   patches), OBJ meshes, included NFF files, sampled and computed
 //!   volumes, MagicaVoxel models, CSG trees and textured materials.
@@ -36,7 +36,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::shape::{Cone, Primitive, Sphere, Triangle};
+use crate::shape::{Cone, Primitive, Sphere, Torus, Triangle};
 use crate::world::Bounds;
 
 pub use error::{Found, SceneError};
@@ -189,6 +189,8 @@ pub struct Scene {
     pub cones: Vec<Object<Cone>>,
     /// Polygons and patches.
     pub polygons: Vec<Polygon>,
+    /// Tori.
+    pub tori: Vec<Object<Torus>>,
     /// All polygon vertices.
     pub vertices: Vec<DVec3>,
     /// Per-vertex normals as written (not normalised), parallel to
@@ -223,6 +225,7 @@ impl Scene {
             spheres: Vec::new(),
             cones: Vec::new(),
             polygons: Vec::new(),
+            tori: Vec::new(),
             vertices: Vec::new(),
             normals: Vec::new(),
             volumes: Vec::new(),
@@ -322,6 +325,7 @@ impl Scene {
         self.spheres.is_empty()
             && self.cones.is_empty()
             && self.polygons.is_empty()
+            && self.tori.is_empty()
             && self.volumes.is_empty()
             && self.voxes.is_empty()
             && self.csgs.is_empty()
@@ -338,7 +342,7 @@ impl Scene {
 
     /// The box around all geometry: spheres ± radius, polygon vertices,
     /// cone end discs ± their radius (the same box as `embree_nff`'s for
-    /// NFF scenes); the cells of volumes and `.vox` models, and CSG trees
+    /// NFF scenes); tori; the cells of volumes and `.vox` models, and CSG trees
     /// ([`Csg::world_bounds`]).
     #[must_use]
     pub fn bounds(&self) -> Bounds {
@@ -355,6 +359,10 @@ impl Scene {
             for &v in self.polygon_vertices(p) {
                 b.include(v, v);
             }
+        }
+        for t in &self.tori {
+            let w = t.shape.bounds();
+            b.include(w.min, w.max);
         }
         for v in &self.volumes {
             let w = v.data.world_bounds();
@@ -425,6 +433,9 @@ pub fn check_scene(s: &Scene) -> Result<(), String> {
         objects::check_object(o, nm)?;
     }
     for o in &s.cones {
+        objects::check_object(o, nm)?;
+    }
+    for o in &s.tori {
         objects::check_object(o, nm)?;
     }
     for p in &s.polygons {

@@ -11,7 +11,7 @@
 //! | `cone = { base, base_radius, apex, apex_radius, capped }` | NFF `c` (open); `capped = true` makes it a closed solid |
 //! | `polygon = [[x, y, z], …]` | NFF `p` |
 //! | `box = { min, max }` | an axis-aligned box (six polygons) |
-//! | `torus = { centre, axis, major, minor }` | a solid torus |
+//! | `torus = { centre, axis, major, minor }` | a torus |
 //! | `bezier = { file, steps }` | the bicubic patches of a `.bpt` file, each tessellated into `steps × steps` quads with the patch's exact normals (NFF `pp`) |
 //! | `mesh = { file, smooth }` | an OBJ triangle mesh (`tobj`); `smooth` interpolates the file's (or averaged) vertex normals |
 //! | `nff = "file.nff"` | every object, light and material of an NFF file (its view is ignored) |
@@ -1041,10 +1041,11 @@ impl Builder<'_> {
                 self.push_polygon(scene, &face, None, material, &loc, &s)?;
             }
         } else if let Some(t) = &d.torus {
-            let shape = self.torus(t, &s, "object.torus")?;
-            scene
-                .csgs
-                .push(single_leaf(Solid::Torus(shape), material, loc));
+            scene.tori.push(Object {
+                shape: self.torus(t, &s, "object.torus")?,
+                material,
+                loc,
+            });
         } else if let Some(b) = &d.bezier {
             if b.steps == 0 || b.steps > self.opts.max_patch_steps {
                 return Err(self.err(
@@ -1467,7 +1468,7 @@ fn key_before(text: &str, at: usize) -> String {
     lhs.get(start..).unwrap_or("").to_owned()
 }
 
-/// A CSG tree of one solid: a closed primitive (torus, capped cone).
+/// A CSG tree of one solid: a capped cone.
 fn single_leaf(shape: Solid, material: usize, loc: SourceLoc) -> Csg {
     Csg {
         nodes: vec![CsgNode::Leaf(0)],

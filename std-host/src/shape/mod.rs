@@ -24,8 +24,8 @@
 //! length; `t` is in units of it) and an open interval `(tmin, tmax)`, and
 //! returns the nearest intersection with `tmin < t < tmax` and the
 //! surface's true unit normal there:
-//! * closed surfaces (spheres) give the outward normal, also for a ray that
-//!   starts inside;
+//! * closed surfaces (spheres, tori) give the outward normal, also for a
+//!   ray that starts inside;
 //! * triangles give the normal of their winding, `(v1 − v0) × (v2 − v0)`,
 //!   or the barycentric interpolation of their vertex normals;
 //! * open cones give the outward normal of the lateral surface.
@@ -40,9 +40,13 @@
 
 pub mod cone;
 pub mod cuboid;
+mod roots;
 pub mod sphere;
 pub mod torus;
 pub mod triangle;
+
+#[cfg(test)]
+mod tests;
 
 use glam::DVec3;
 use rrt_core::csg;
@@ -152,6 +156,8 @@ pub enum Shape {
     Cone(Cone),
     /// A triangle of a polygon's fan.
     Triangle(Triangle),
+    /// A torus.
+    Torus(Torus),
     /// No continuous definition: the voxels are the object (volumes,
     /// `.vox` models, CSG results). It has no exact intersection, so
     /// intersection verification keeps the discrete hit with the stored
@@ -167,6 +173,7 @@ macro_rules! each_surface {
             Shape::Sphere($s) => $body,
             Shape::Cone($s) => $body,
             Shape::Triangle($s) => $body,
+            Shape::Torus($s) => $body,
             Shape::Voxels => $voxels,
         }
     };
@@ -223,6 +230,7 @@ impl Shape {
             .map(Self::Sphere)
             .or_else(|| Cone::load(kind, slots).map(Self::Cone))
             .or_else(|| Triangle::load(kind, slots).map(Self::Triangle))
+            .or_else(|| Torus::load(kind, slots).map(Self::Torus))
     }
 }
 
@@ -242,6 +250,7 @@ pub fn voxelize(
         table::Shape::Sphere(s) => Sphere::voxelize(s, separation, extent, sink),
         table::Shape::Cone(c) => Cone::voxelize(c, separation, extent, sink),
         table::Shape::Triangle(t) => Triangle::voxelize(t, separation, extent, sink),
+        table::Shape::Torus(t) => Torus::voxelize(t, separation, extent, sink),
         _ => Ok(0),
     }
 }

@@ -1,10 +1,13 @@
-//! Known values, grazing and inside-start rays for every primitive, plus
+//! Exact intersections: known values, grazing and inside-start rays for
+//! every surface primitive, plus
 //! seeded random rays checked against the implicit surface equations.
 
 #![allow(clippy::needless_range_loop)]
 
-use super::*;
-use crate::shape::{Cone, Sphere, Surface, Triangle};
+use glam::DVec3;
+
+use super::{Cone, Sphere, Surface, Torus, Triangle};
+use crate::world::{Hit, Ray};
 
 fn sphere(r: &Ray, centre: DVec3, radius: f64, tmin: f64, tmax: f64) -> Option<Hit> {
     Sphere { centre, radius }.intersect(r, tmin, tmax)
@@ -34,6 +37,24 @@ fn cone(
         base_radius,
         apex,
         apex_radius,
+    }
+    .intersect(r, tmin, tmax)
+}
+
+fn torus(
+    r: &Ray,
+    centre: DVec3,
+    axis: DVec3,
+    major: f64,
+    minor: f64,
+    tmin: f64,
+    tmax: f64,
+) -> Option<Hit> {
+    Torus {
+        centre,
+        axis,
+        major,
+        minor,
     }
     .intersect(r, tmin, tmax)
 }
@@ -523,45 +544,6 @@ fn cone_random_rays_land_on_surface() {
     }
 }
 
-// --------------------------------------------------------------------- box
-
-#[test]
-fn box_known_values_inside_start_and_edges() {
-    let (lo, hi) = (DVec3::ZERO, DVec3::ONE);
-    let h = aabb(&ray([-5.0, 0.5, 0.5], [1.0, 0.0, 0.0]), lo, hi, 0.0, INF).unwrap();
-    assert_eq!((h.t, h.normal), (5.0, -DVec3::X));
-    let h = aabb(&ray([0.5, 0.5, 0.5], [0.0, 1.0, 0.0]), lo, hi, 0.0, INF).unwrap();
-    assert_eq!((h.t, h.normal), (0.5, DVec3::Y));
-    let h = aabb(&ray([0.5, 0.5, 3.0], [0.0, 0.0, -2.0]), lo, hi, 0.0, INF).unwrap();
-    assert_eq!((h.t, h.normal), (1.0, DVec3::Z));
-    // Through an edge into the box.
-    let h = aabb(&ray([-1.0, -1.0, 0.5], [1.0, 1.0, 0.0]), lo, hi, 0.0, INF).unwrap();
-    assert_eq!(h.t, 1.0);
-    // Grazing an edge from outside: touches it at one point.
-    let h = aabb(&ray([0.0, -1.0, 0.5], [1.0, 1.0, 0.0]), lo, hi, 0.0, INF).unwrap();
-    assert_eq!((h.t, h.normal), (1.0, -DVec3::Y));
-    // Past the edge by a hair: misses.
-    assert!(
-        aabb(
-            &ray([0.0, -1.0 - 1e-12, 0.5], [1.0, 1.0, 0.0]),
-            lo,
-            hi,
-            0.0,
-            INF
-        )
-        .is_none()
-    );
-    // In a face's plane: enters the face at its edge.
-    let h = aabb(&ray([-1.0, 0.0, 0.5], [1.0, 0.0, 0.0]), lo, hi, 0.0, INF).unwrap();
-    assert_eq!((h.t, h.normal), (1.0, -DVec3::X));
-    // Misses and the interval.
-    assert!(aabb(&ray([-1.0, 2.0, 0.5], [1.0, 0.0, 0.0]), lo, hi, 0.0, INF).is_none());
-    assert!(aabb(&ray([-5.0, 0.5, 0.5], [-1.0, 0.0, 0.0]), lo, hi, 0.0, INF).is_none());
-    let r = ray([-5.0, 0.5, 0.5], [1.0, 0.0, 0.0]);
-    assert_eq!(aabb(&r, lo, hi, 5.5, INF).unwrap().t, 6.0);
-    assert!(aabb(&r, lo, hi, 0.0, 5.0).is_none());
-}
-
 // ------------------------------------------------------------------- torus
 
 /// R = 2, r = 0.5 about z through the origin.
@@ -674,145 +656,6 @@ fn torus_far_away_keeps_precision() {
     close(h.t, 1.0, 1e-12);
 }
 
-// ------------------------------------------------------------ Bézier patch
-
-/// Control points on a 3 × 3 square with evenly spaced x and y, so that
-/// `x = 3u`, `y = 3v`, and heights `z[i][j]`.
-fn height_patch(z: [[f64; 4]; 4]) -> PatchControl {
-    let mut c = [[DVec3::ZERO; 4]; 4];
-    for i in 0..4 {
-        for j in 0..4 {
-            c[i][j] = DVec3::new(i as f64, j as f64, z[i][j]);
-        }
-    }
-    c
-}
-
-/// Interior control points at height 1: `z = 9·u(1−u)·v(1−v)`, top
-/// 0.5625 at the centre.
-fn bump() -> PatchControl {
-    let mut z = [[0.0; 4]; 4];
-    for row in z.iter_mut().take(3).skip(1) {
-        for h in row.iter_mut().take(3).skip(1) {
-            *h = 1.0;
-        }
-    }
-    height_patch(z)
-}
-
-fn bump_height(x: f64, y: f64) -> f64 {
-    let (u, v) = (x / 3.0, y / 3.0);
-    9.0 * u * (1.0 - u) * v * (1.0 - v)
-}
-
-#[test]
-fn flat_patch_known_values() {
-    let flat = height_patch([[0.0; 4]; 4]);
-    let h = bezier_patch(&ray([1.0, 2.0, 5.0], [0.0, 0.0, -1.0]), &flat, 0.0, INF).unwrap();
-    close(h.t, 5.0, 1e-12);
-    close(h.u, 1.0 / 3.0, 1e-12);
-    close(h.v, 2.0 / 3.0, 1e-12);
-    close3(h.normal, DVec3::Z, 1e-12);
-    // Outside the patch's square: a miss.
-    assert!(bezier_patch(&ray([3.5, 2.0, 5.0], [0.0, 0.0, -1.0]), &flat, 0.0, INF).is_none());
-}
-
-#[test]
-fn bump_patch_known_values() {
-    let p = bump();
-    let h = bezier_patch(&ray([1.5, 1.5, 5.0], [0.0, 0.0, -1.0]), &p, 0.0, INF).unwrap();
-    close(h.t, 5.0 - 0.5625, 1e-12);
-    close(h.u, 0.5, 1e-9);
-    close(h.v, 0.5, 1e-9);
-    close3(h.normal, DVec3::Z, 1e-9);
-    // From below (a ray starting "inside" the bump), up through it.
-    let h = bezier_patch(&ray([1.0, 2.0, -1.0], [0.0, 0.0, 1.0]), &p, 0.0, INF).unwrap();
-    close(h.t, 1.0 + bump_height(1.0, 2.0), 1e-12);
-    // Starting on the surface and leaving it: no re-hit.
-    let on = DVec3::new(1.0, 2.0, bump_height(1.0, 2.0));
-    assert!(bezier_patch(&Ray::new(on, DVec3::Z), &p, 1e-9, INF).is_none());
-    // A ray through the bump twice: the nearer hit.
-    let r = ray([-1.0, 1.5, 0.3], [1.0, 0.0, 0.0]);
-    let h = bezier_patch(&r, &p, 0.0, INF).unwrap();
-    // 2.25·u(1−u) = 0.3 → u = (1 − √(1 − 4·0.3/2.25))/2.
-    let u = (1.0 - (1.0 - 4.0 * 0.3 / 2.25f64).sqrt()) / 2.0;
-    close(h.t, 3.0 * u + 1.0, 1e-9);
-}
-
-#[test]
-fn bump_patch_grazing() {
-    // Tangent to the top: touches at (1.5, 1.5, 0.5625) only.
-    let h = bezier_patch(
-        &ray([-1.0, 1.5, 0.5625], [1.0, 0.0, 0.0]),
-        &bump(),
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 2.5, 1e-4);
-    close3(h.normal, DVec3::Z, 1e-3);
-    // Slightly above: a miss.
-    assert!(
-        bezier_patch(
-            &ray([-1.0, 1.5, 0.5626], [1.0, 0.0, 0.0]),
-            &bump(),
-            0.0,
-            INF
-        )
-        .is_none()
-    );
-    // Slightly below: two close roots, the nearer one.
-    for eps in [1e-4, 1e-6] {
-        let z = 0.5625 - eps;
-        let h = bezier_patch(&ray([-1.0, 1.5, z], [1.0, 0.0, 0.0]), &bump(), 0.0, INF).unwrap();
-        let u = 0.5 - (eps / 2.25f64).sqrt();
-        close(h.t, 3.0 * u + 1.0, 1e-6);
-    }
-}
-
-#[test]
-fn bump_patch_random_rays_against_height_field() {
-    let p = bump();
-    for seed in 0..300 {
-        let mut g = Rng(seed);
-        let o = DVec3::new(g.range(-2.0, 5.0), g.range(-2.0, 5.0), g.range(0.7, 3.0));
-        let target = DVec3::new(g.range(-0.5, 3.5), g.range(-0.5, 3.5), g.range(-0.2, 0.6));
-        let r = Ray::new(o, target - o);
-        // The height field, marched over the part of the ray above the
-        // patch's square.
-        let f = |q: DVec3| q.z - bump_height(q.x, q.y);
-        let square = slabs(&r, DVec3::new(0.0, 0.0, -1e9), DVec3::new(3.0, 3.0, 1e9));
-        let expect = square.and_then(|(t0, _, t1, _)| {
-            (t1 > 0.0)
-                .then(|| march(&r, f, t0.max(0.0), t1, 30_000))
-                .flatten()
-        });
-        match (bezier_patch(&r, &p, 0.0, INF), expect) {
-            (Some(h), Some(t)) => {
-                close(h.t, t, 1e-6);
-                let (q, _, _) = patch_eval(&p, h.u, h.v);
-                close3(q, r.at(h.t), 1e-9);
-            }
-            (None, None) => {}
-            (got, expect) => panic!("seed {seed}: {got:?} vs {expect:?}"),
-        }
-    }
-}
-
-#[test]
-fn collapsed_patch_edge_has_a_normal() {
-    // Row u = 0 collapsed to one point (a pole, as in the teapot's lid).
-    let mut c = height_patch([[0.0; 4]; 4]);
-    for j in 0..4 {
-        c[0][j] = DVec3::new(0.0, 1.5, 0.0);
-    }
-    let n = patch_normal(&c, 0.0, 0.5);
-    assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-12);
-    close3(n, DVec3::Z, 1e-9);
-    let h = bezier_patch(&ray([1.5, 1.5, 1.0], [0.0, 0.0, -1.0]), &c, 0.0, INF).unwrap();
-    close(h.t, 1.0, 1e-12);
-}
-
 #[test]
 fn non_finite_input_is_a_miss() {
     let nan = ray([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0]);
@@ -821,8 +664,6 @@ fn non_finite_input_is_a_miss() {
         assert!(sphere(&r, DVec3::ZERO, 1.0, 0.0, INF).is_none());
         assert!(triangle(&r, [DVec3::ZERO, DVec3::X, DVec3::Y], None, 0.0, INF).is_none());
         assert!(cone(&r, DVec3::ZERO, 1.0, DVec3::Z, 1.0, 0.0, INF).is_none());
-        assert!(aabb(&r, -DVec3::ONE, DVec3::ONE, 0.0, INF).is_none());
         assert!(ring(&r).is_none());
-        assert!(bezier_patch(&r, &bump(), 0.0, INF).is_none());
     }
 }
