@@ -123,7 +123,7 @@ pub fn build(
         shape: Shape::Voxels,
         material: 0,
     }];
-    let table = ObjectTable::new(&mut storage, &mut []);
+    let table = ObjectTable::new(&mut storage);
     let mut mats: Box<Materials<MAX_MATERIALS>> = Box::default();
     let _ = mats.push(core_mat);
     let intensity = scalar(shade::light_intensity(1));

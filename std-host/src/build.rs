@@ -574,7 +574,7 @@ pub fn build(
     let t1 = Instant::now();
     progress.set_message("light visibility");
     let mut storage = vec![Object::UNUSED; n];
-    let mut table = ObjectTable::new(&mut storage, &mut []);
+    let mut table = ObjectTable::new(&mut storage);
     for o in &fitted.objects {
         // The storage holds exactly the n objects: no push can fail.
         let _ = table.push(Object {

@@ -251,7 +251,7 @@ pub fn voxelize(
         table::Shape::Cone(c) => Cone::voxelize(c, separation, extent, sink),
         table::Shape::Triangle(t) => Triangle::voxelize(t, separation, extent, sink),
         table::Shape::Torus(t) => Torus::voxelize(t, separation, extent, sink),
-        _ => Ok(0),
+        table::Shape::Voxels => Ok(0),
     }
 }
 
