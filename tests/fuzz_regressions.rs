@@ -62,7 +62,7 @@ fn voxelize_inputs_replay() {
 #[test]
 fn nrrd_inputs_replay() {
     for (name, bytes) in inputs("nrrd") {
-        if let Err(broken) = rrt_host::volume::check::nrrd_input(&bytes) {
+        if let Err(broken) = rrt_host::check::nrrd_input(&bytes) {
             panic!("{name}: {broken}");
         }
     }

@@ -7,13 +7,13 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use indicatif::ProgressBar;
 use rrt_core::Connectivity;
-use rrt_host::build::{BuildOptions, VoxelScene, build};
 use rrt_host::camera::Camera;
 use rrt_host::output::png_bytes;
 use rrt_host::rasterfile;
 use rrt_host::render::{Image, RenderOptions, render};
 use rrt_host::scene::Scene;
 use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

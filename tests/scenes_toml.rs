@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
-use rrt_host::build::{BuildOptions, VoxelScene, build};
 use rrt_host::rasterfile;
 use rrt_host::scene::Scene;
 use rrt_host::shape::Shape;
 use rrt_host::trace::{Verdict, verify};
+use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
 use rrt_host::world::Ray;
 
 fn scenes_dir() -> PathBuf {

@@ -15,6 +15,7 @@ use rrt_host::frame::RasterFrame;
 use rrt_host::texture::{
     Blend, Checker, ImageTexture, Mapping, Marble, TextureError, Wood, WorldTexture, Wrap,
 };
+use rrt_host::voxelize::texture::InRaster;
 
 fn tmp(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("textures");
@@ -54,7 +55,7 @@ fn planar_mapping_through_the_raster_frame() {
         origin: DVec3::ZERO,
         voxel_size: 1.0,
     };
-    let t = tex.clone().in_raster(frame, Blend::Replace);
+    let t = InRaster::new(tex.clone(), frame, Blend::Replace);
     let n = [0, 0, NORMAL_ONE];
     // Voxel (i, j) has centre (i + ½, j + ½): pixel column i, and row 1 − j
     // (v points up the image).
@@ -106,7 +107,7 @@ fn planar_mapping_through_the_raster_frame() {
         pixel(0, 0)
     );
     // Modulate: texel × base / 255.
-    let m = tex.in_raster(frame, Blend::Modulate);
+    let m = InRaster::new(tex, frame, Blend::Modulate);
     let c = [voxel_centre(3), voxel_centre(0), 0];
     assert_eq!(m.color(c, n, [255, 128, 0]), [180, 50, 0]);
 }
@@ -337,9 +338,11 @@ fn texture_colours_land_in_voxel_records() {
         voxel_size: 0.5,
     };
     let (a, b) = ([250, 250, 250], [10, 10, 200]);
-    let checker = Checker::new(DVec3::ZERO, 1.0, [a, b])
-        .unwrap()
-        .in_raster(frame, Blend::Replace);
+    let checker = InRaster::new(
+        Checker::new(DVec3::ZERO, 1.0, [a, b]).unwrap(),
+        frame,
+        Blend::Replace,
+    );
     let mut plane = vec![0u8; extent.len()];
     let mut dir = vec![0u32; directory_len(extent).unwrap()];
     let mut counter = Counter::new(RasterMut::new(extent, &mut plane).unwrap(), &mut dir).unwrap();

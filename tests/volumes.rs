@@ -17,8 +17,9 @@ use rrt_host::volume::raw::{self, RawSpec};
 use rrt_host::volume::resample::{Quantizer, resample_cubic};
 use rrt_host::volume::{
     Classifier, ColorRamp, Endian, Grid, Limits, Placement, Ramp, SampleType, Samples, Volume,
-    VolumeColors, VolumeError, nrrd,
+    VolumeError, nrrd,
 };
+use rrt_host::voxelize::volume::VolumeColors;
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

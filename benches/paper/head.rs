@@ -21,13 +21,13 @@ use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
-use rrt_host::build::{MAX_MATERIALS, VoxelScene, finish_plane};
 use rrt_host::frame::RasterFrame;
 use rrt_host::object_table::WorldLight;
-use rrt_host::plane::Plane;
 use rrt_host::scene::{Material, View};
 use rrt_host::shade;
 use rrt_host::volume::{Classifier, Limits as VolumeLimits, Placement, nrrd};
+use rrt_host::voxelize::plane::Plane;
+use rrt_host::voxelize::{MAX_MATERIALS, VoxelScene, finish_plane};
 
 /// The iso-value separating head from air (data README).
 pub const ISO: f64 = 20.0;

@@ -31,11 +31,11 @@ use indicatif::ProgressBar;
 use rrt_core::Connectivity;
 use rrt_core::discrete_ray::{DiscreteRay, WalkEnd};
 use rrt_core::raster::{Raster, cell};
-use rrt_host::build::{BuildOptions, BuildReport, VoxelScene, build};
 use rrt_host::camera::Camera;
 use rrt_host::render::{Image, RenderOptions, render};
 use rrt_host::scene::{Scene, View};
 use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+use rrt_host::voxelize::{BuildOptions, BuildReport, VoxelScene, build};
 use rrt_host::world::Bounds;
 use rrt_host::world::Ray;
 

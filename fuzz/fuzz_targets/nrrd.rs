@@ -1,4 +1,4 @@
-//! Arbitrary bytes into the NRRD reader (`rrt_host::volume::check::nrrd_input`
+//! Arbitrary bytes into the NRRD reader (`rrt_host::check::nrrd_input`
 //! holds the checks, shared with `tests/fuzz_regressions.rs`): nothing may
 //! panic, hang or allocate past the size limits; an error names the file
 //! (and line or byte offset); a volume keeps its invariants, samples within
@@ -9,7 +9,7 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    if let Err(broken) = rrt_host::volume::check::nrrd_input(data) {
+    if let Err(broken) = rrt_host::check::nrrd_input(data) {
         panic!("{broken}");
     }
 });

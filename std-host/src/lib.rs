@@ -34,7 +34,6 @@
 
 #![forbid(unsafe_code)]
 
-pub mod build;
 pub mod camera;
 #[cfg(any(test, feature = "check"))]
 pub mod check;
@@ -43,7 +42,6 @@ pub mod fit;
 pub mod frame;
 pub mod object_table;
 pub mod output;
-pub mod plane;
 pub mod rasterfile;
 pub mod render;
 pub mod scene;
@@ -53,5 +51,5 @@ pub mod texture;
 pub mod trace;
 pub mod volume;
 pub mod vox;
-pub mod voxel_objects;
+pub mod voxelize;
 pub mod world;

@@ -6,27 +6,21 @@
 //! voxel: "since the texture mapping is view-independent, it is
 //! precomputed during the voxelization algorithm from a 2D texture/photo
 //! map or a 3D texture". Here each texture is a [`WorldTexture`], a colour
-//! as a function of the world position (and normal) of a voxel centre;
-//! [`InRaster`] pairs it with the raster's [`RasterFrame`] and implements
-//! the core's [`Texture`] hook, which the scene builder's fill pass calls
-//! once per voxel (`Filler::textured`). Nothing is recomputed per view.
+//! as a function of the world position (and normal) of a voxel centre; in
+//! the raster ([`crate::voxelize::texture::InRaster`]) it becomes the
+//! core's [`Texture`](rrt_core::store::Texture) hook, which the scene
+//! builder's fill pass calls once per voxel (`Filler::textured`). Nothing
+//! is recomputed per view. Nothing here knows the raster.
 //!
 //! ```
 //! use glam::DVec3;
-//! use rrt_core::raster::Extent;
-//! use rrt_core::store::Texture;
-//! use rrt_core::fixed::voxel_centre;
-//! use rrt_host::frame::RasterFrame;
 //! use rrt_host::texture::{Blend, Checker, WorldTexture};
-//! let frame = RasterFrame { extent: Extent::cube(64).unwrap(),
-//!                           origin: DVec3::ZERO, voxel_size: 0.125 };
-//! let checker = Checker::new(DVec3::ZERO, 1.0, [[255, 255, 255], [200, 0, 0]]).unwrap()
-//!     .in_raster(frame, Blend::Replace);
-//! // Voxel (3, 3, 3): world (0.4375, …): the white cell; voxel 11: red.
-//! let c = |i| [voxel_centre(i); 3];
-//! assert_eq!(checker.color(c(3), [0, 0, 1 << 30], [9; 3]), [255, 255, 255]);
-//! assert_eq!(checker.color([voxel_centre(11), voxel_centre(3), voxel_centre(3)],
-//!                          [0, 0, 1 << 30], [9; 3]), [200, 0, 0]);
+//! let checker = Checker::new(DVec3::ZERO, 1.0, [[255, 255, 255], [200, 0, 0]]).unwrap();
+//! // (0.4375, 0.4375, 0.4375) lies in the white cell, x = 1.4375 in the red one.
+//! let white = checker.world_color(DVec3::splat(0.4375), DVec3::Z, [9; 3]);
+//! assert_eq!(white, [255, 255, 255]);
+//! let red = checker.world_color(DVec3::new(1.4375, 0.4375, 0.4375), DVec3::Z, [9; 3]);
+//! assert_eq!(Blend::Modulate.apply(red, [255, 128, 0]), [200, 0, 0]);
 //! ```
 //!
 //! # Conventions
@@ -42,10 +36,6 @@ use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use rrt_core::store::Texture;
-use rrt_core::voxelize::NORMAL_ONE;
-
-use crate::frame::RasterFrame;
 
 /// Why a texture cannot be made.
 #[derive(Debug, thiserror::Error)]
@@ -97,18 +87,6 @@ pub trait WorldTexture: Sync {
     /// The colour at world point `p` with unit normal `n`, given the
     /// object's base colour.
     fn world_color(&self, p: DVec3, n: DVec3, base: [u8; 3]) -> [u8; 3];
-
-    /// This texture in the raster `frame`, as a core [`Texture`].
-    fn in_raster(self, frame: RasterFrame, blend: Blend) -> InRaster<Self>
-    where
-        Self: Sized,
-    {
-        InRaster {
-            texture: self,
-            frame,
-            blend,
-        }
-    }
 }
 
 /// How a texture's colour combines with the object's base colour.
@@ -121,25 +99,13 @@ pub enum Blend {
     Modulate,
 }
 
-/// A [`WorldTexture`] in a raster: the core's [`Texture`].
-#[derive(Clone, Debug)]
-pub struct InRaster<T> {
-    /// The texture.
-    pub texture: T,
-    /// The raster's place in the world.
-    pub frame: RasterFrame,
-    /// How the texture meets the base colour.
-    pub blend: Blend,
-}
-
-impl<T: WorldTexture> Texture for InRaster<T> {
-    fn color(&self, centre: [i64; 3], normal: [i32; 3], base: [u8; 3]) -> [u8; 3] {
-        let p = self.frame.fixed_to_world(centre);
-        let n = DVec3::from(normal.map(f64::from)) / f64::from(NORMAL_ONE);
-        let t = self.texture.world_color(p, n, base);
-        match self.blend {
-            Blend::Replace => t,
-            Blend::Modulate => {
+impl Blend {
+    /// The colour of texel `t` on an object of base colour `base`.
+    #[must_use]
+    pub fn apply(self, t: [u8; 3], base: [u8; 3]) -> [u8; 3] {
+        match self {
+            Self::Replace => t,
+            Self::Modulate => {
                 let mut out = [0u8; 3];
                 for ((o, a), b) in out.iter_mut().zip(t).zip(base) {
                     // (a·b + 127) / 255 ≤ 255.

@@ -61,13 +61,10 @@
 
 #![deny(missing_docs)]
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use rrt_core::fixed::FRAC_BITS;
-use rrt_core::store::Texture;
-use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
+use rrt_core::voxelize::NORMAL_ONE;
 
 /// Largest model edge MagicaVoxel writes (voxel coordinates are bytes).
 pub const MAX_MODEL_EDGE: u32 = 256;
@@ -523,16 +520,6 @@ fn walk_scene(
     Ok(out)
 }
 
-/// Where a scene's world cells go in the raster: cell `c` covers raster
-/// voxels `offset + c·scale + [0, scale)³`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct VoxPlacement {
-    /// Raster voxel of world cell (0, 0, 0).
-    pub offset: [i64; 3],
-    /// Raster voxels per cell edge (at least 1).
-    pub scale: u32,
-}
-
 impl VoxScene {
     /// The models.
     #[must_use]
@@ -686,78 +673,6 @@ impl VoxScene {
             }
         }
         b
-    }
-
-    /// Offers every voxel of the scene to `sink` at `placement` (each
-    /// world cell as `scale³` raster voxels, all with the cell's normal,
-    /// distance 0); voxels at negative or too large raster coordinates are
-    /// skipped. Returns the offers made. Colour them through
-    /// [`VoxScene::colors`] with the same placement (the builder's
-    /// `Filler::textured`).
-    pub fn voxelize<S: VoxelSink + ?Sized>(&self, placement: VoxPlacement, sink: &mut S) -> u64 {
-        let s = i64::from(placement.scale.max(1));
-        let mut n = 0u64;
-        for v in self.world_voxels() {
-            let base: [i64; 3] = std::array::from_fn(|a| {
-                placement.offset[a].saturating_add(v.cell[a].saturating_mul(s))
-            });
-            for dz in 0..s {
-                for dy in 0..s {
-                    for dx in 0..s {
-                        let r = [base[0] + dx, base[1] + dy, base[2] + dz];
-                        let (Ok(x), Ok(y), Ok(z)) = (
-                            u32::try_from(r[0]),
-                            u32::try_from(r[1]),
-                            u32::try_from(r[2]),
-                        ) else {
-                            continue;
-                        };
-                        sink.offer(
-                            [x, y, z],
-                            Surfel {
-                                normal: v.normal,
-                                distance: 0,
-                            },
-                        );
-                        n += 1;
-                    }
-                }
-            }
-        }
-        n
-    }
-
-    /// The per-voxel colours at `placement`, as a core [`Texture`].
-    #[must_use]
-    pub fn colors(&self, placement: VoxPlacement) -> VoxColors {
-        VoxColors {
-            placement,
-            cells: self
-                .world_voxels()
-                .into_iter()
-                .map(|v| (v.cell, v.color))
-                .collect(),
-        }
-    }
-}
-
-/// The palette colour of each placed world cell, looked up from a raster
-/// voxel centre (a core [`Texture`]); the base colour elsewhere.
-#[derive(Clone, Debug)]
-pub struct VoxColors {
-    placement: VoxPlacement,
-    cells: HashMap<[i64; 3], [u8; 3]>,
-}
-
-impl Texture for VoxColors {
-    fn color(&self, centre: [i64; 3], _normal: [i32; 3], base: [u8; 3]) -> [u8; 3] {
-        let s = i64::from(self.placement.scale.max(1));
-        let cell: [i64; 3] = std::array::from_fn(|a| {
-            (centre[a] >> FRAC_BITS)
-                .saturating_sub(self.placement.offset[a])
-                .div_euclid(s)
-        });
-        self.cells.get(&cell).copied().unwrap_or(base)
     }
 }
 

@@ -10,10 +10,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::CliError;
 use super::ray::ConnectivityArg;
-use crate::build::{BuildOptions, BuildReport, VoxelScene, build};
 use crate::fit::{FitOptions, default_max_memory};
 use crate::rasterfile;
 use crate::scene::{Scene, View};
+use crate::voxelize::{BuildOptions, BuildReport, VoxelScene, build};
 use crate::world::Bounds;
 
 /// The built-in scene: SPD `balls2.nff`, the paper's 91-sphereflake.

@@ -62,7 +62,7 @@ pub enum CliError {
     Scene(#[from] crate::scene::SceneError),
     /// Voxelizing the scene.
     #[error(transparent)]
-    Build(#[from] crate::build::BuildError),
+    Build(#[from] crate::voxelize::BuildError),
     /// The view.
     #[error(transparent)]
     Camera(#[from] crate::camera::CameraError),

@@ -38,10 +38,8 @@
 #![deny(missing_docs)]
 
 use glam::DVec3;
-use rrt_core::store::Texture;
 
-use super::{PlacedVolume, Volume, VolumeError};
-use crate::frame::RasterFrame;
+use super::{Volume, VolumeError};
 
 fn invalid(what: &str, msg: String) -> VolumeError {
     VolumeError::Invalid {
@@ -295,44 +293,6 @@ pub fn gray_gradient(f: impl Fn(i64, i64, i64) -> f64, i: i64, j: i64, k: i64) -
 /// the gradient vanishes.
 pub fn gray_normal(f: impl Fn(i64, i64, i64) -> f64, i: i64, j: i64, k: i64) -> Option<DVec3> {
     (-gray_gradient(f, i, j, k)).try_normalize()
-}
-
-/// The per-voxel colour of a classified volume, as a core [`Texture`]:
-/// the voxel centre goes to the world through the raster frame, the
-/// volume is sampled there (trilinear), and the classifier's colour ramp
-/// gives the colour (the base colour where there is no ramp or no value).
-/// Computed once per voxel while the raster is filled.
-#[derive(Clone, Debug)]
-pub struct VolumeColors<'a> {
-    placed: PlacedVolume<'a>,
-    frame: RasterFrame,
-    classifier: &'a Classifier,
-}
-
-impl<'a> VolumeColors<'a> {
-    /// The colours of `placed` under `classifier`, for the raster `frame`.
-    #[must_use]
-    pub const fn new(
-        placed: PlacedVolume<'a>,
-        frame: RasterFrame,
-        classifier: &'a Classifier,
-    ) -> Self {
-        Self {
-            placed,
-            frame,
-            classifier,
-        }
-    }
-}
-
-impl Texture for VolumeColors<'_> {
-    fn color(&self, centre: [i64; 3], _normal: [i32; 3], base: [u8; 3]) -> [u8; 3] {
-        let p = self.frame.fixed_to_world(centre);
-        match self.placed.sample_world(p) {
-            Some(v) => self.classifier.color(v, base),
-            None => base,
-        }
-    }
 }
 
 #[cfg(test)]

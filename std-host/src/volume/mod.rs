@@ -1,6 +1,8 @@
 //! Sampled and computed volumes: scalar grids read from NRRD or headerless
 //! raw files, or sampled from a formula, placed in the world next to
-//! geometry.
+//! geometry. Nothing here knows the raster: the raster side of volumes
+//! (sampling at the raster's voxel centres, the core's volume voxelizer,
+//! per-voxel colours) is [`crate::voxelize::volume`].
 //!
 //! The paper ray traces "3D sampled datasets (e.g. 3D MRI imaging) and
 //! computed datasets" in the same 3D raster as geometric objects: a voxel
@@ -15,13 +17,10 @@
 //! * [`nrrd`] and [`raw`]: the readers, with errors that name the file and
 //!   the header line or byte offset at fault, and size limits checked
 //!   before anything is allocated ([`Limits`]);
-//! * [`resample`]: resampling an anisotropic grid to cubic voxels, placing
-//!   a volume in the world ([`Placement`], [`PlacedVolume`]) and producing
-//!   the scalar grid over the raster voxels it covers, in the sample type
-//!   of the core's volume voxelizer ([`RasterBlock`]);
+//! * [`resample`]: resampling an anisotropic grid to cubic voxels, and
+//!   placing a volume in the world ([`Placement`], [`PlacedVolume`]);
 //! * [`classify`]: the iso-value, the optional opacity and colour ramps,
-//!   the float gray-level gradient used to check the core's, and the
-//!   per-voxel colour as a core [`Texture`](rrt_core::store::Texture);
+//!   and the float gray-level gradient used to check the core's;
 //! * [`computed`]: computed datasets (metaballs) as the same [`Volume`].
 //!
 //! # Conventions
@@ -43,16 +42,14 @@ use glam::{DMat3, DVec3};
 
 use crate::world::Bounds;
 
-#[cfg(any(test, feature = "check"))]
-pub mod check;
 pub mod classify;
 pub mod computed;
 pub mod nrrd;
 pub mod raw;
 pub mod resample;
 
-pub use classify::{Classifier, ColorRamp, Ramp, VolumeColors};
-pub use resample::{PlacedVolume, Placement, RasterBlock, SAMPLE_MAX};
+pub use classify::{Classifier, ColorRamp, Ramp};
+pub use resample::{PlacedVolume, Placement, SAMPLE_MAX};
 
 /// Default limit on the bytes of samples one volume may take (4 GiB).
 pub const DEFAULT_MAX_BYTES: u64 = 4 << 30;

@@ -25,7 +25,7 @@
 //! renderer ([`crate::trace`]) and the saved-raster file
 //! ([`crate::rasterfile`]) both start from it.
 //!
-//! Volumes, `.vox` models and CSG trees ([`crate::voxel_objects`]) go
+//! Volumes, `.vox` models and CSG trees ([`objects`]) go
 //! through both passes after the fitted primitives, with object ids after
 //! theirs. Textured materials colour each voxel once, in the fill pass.
 //!
@@ -34,6 +34,12 @@
 //! most [`MAX_MATERIALS`] distinct ones are accepted.
 
 #![deny(missing_docs)]
+
+pub mod objects;
+pub mod plane;
+pub mod texture;
+pub mod volume;
+pub mod vox;
 
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
@@ -55,16 +61,16 @@ use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 use rrt_core::voxelize::error::VoxelizeError;
 
+use self::objects::Pass;
+use self::plane::Plane;
+use self::texture::InRaster;
 use crate::fit::{self, Bytes, FitError, FitOptions, Fitted};
 use crate::frame::RasterFrame;
 use crate::object_table::{WorldLight, WorldObject};
-use crate::plane::Plane;
 use crate::scene::{Material, Scene, SourceLoc, TextureKind, View};
 use crate::shade;
 use crate::shape::{self, Shape};
 use crate::texture::AnyTexture;
-use crate::texture::InRaster;
-use crate::voxel_objects::{self, Pass};
 
 /// Records per run of the parallel light pass.
 const LIGHT_RUN: usize = 1 << 14;
@@ -409,11 +415,11 @@ fn extra(
     let nv = scene.volumes.len();
     let nx = scene.voxes.len();
     if let Some(v) = scene.volumes.get(e) {
-        voxel_objects::volume(v, frame, separation, pass)
+        objects::volume(v, frame, separation, pass)
     } else if let Some(v) = scene.voxes.get(e.wrapping_sub(nv)) {
-        voxel_objects::vox(v, frame, pass)
+        objects::vox(v, frame, pass)
     } else if let Some(c) = scene.csgs.get(e.wrapping_sub(nv + nx)) {
-        voxel_objects::csg(c, frame, separation, pass)
+        objects::csg(c, frame, separation, pass)
     } else {
         Ok(())
     }
@@ -467,7 +473,7 @@ pub fn build(
         .textures
         .iter()
         .map(|t| match &t.kind {
-            TextureKind::World(w) => voxel_objects::in_raster(w, frame, t.blend),
+            TextureKind::World(w) => objects::in_raster(w, frame, t.blend),
         })
         .collect();
     let texture_of = |m: usize| {

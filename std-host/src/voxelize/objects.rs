@@ -1,6 +1,6 @@
 //! Objects whose voxels are the object: sampled and computed volumes,
 //! MagicaVoxel models and CSG trees (the paper's voxel Booleans), as the
-//! build pipeline ([`crate::build`]) voxelizes them next to the fitted
+//! build pipeline ([`super::build`]) voxelizes them next to the fitted
 //! primitives, in the same raster and the same two passes.
 //!
 //! Each is offered to the count pass and to the fill pass through the same
@@ -19,14 +19,14 @@ use rrt_core::fixed::voxel_centre;
 use rrt_core::store::{Counter, Filler, ObjectAttrs};
 use rrt_core::voxelize::Separation;
 
-use crate::build::BuildError;
+use super::BuildError;
+use super::texture::InRaster;
+use super::volume::{Keep, VolumeColors};
+use super::vox::VoxPlacement;
 use crate::fit::FitError;
 use crate::frame::RasterFrame;
 use crate::scene::{Csg, Solid, SourceLoc, VolumeObject, VoxObject};
-use crate::texture::InRaster;
-use crate::texture::{AnyTexture, WorldTexture};
-use crate::volume::VolumeColors;
-use crate::vox::VoxPlacement;
+use crate::texture::AnyTexture;
 
 /// Most bytes of the resampled block a volume is voxelized through at once.
 pub const MAX_BLOCK_BYTES: u64 = 256 << 20;
@@ -181,7 +181,7 @@ fn volume_into(
     v: &VolumeObject,
     frame: &RasterFrame,
     separation: Separation,
-    keep: Option<crate::volume::resample::Keep<'_>>,
+    keep: Option<Keep<'_>>,
     pass: Pass<'_, '_, '_, '_>,
 ) -> Result<(), BuildError> {
     let placed = v.data.placed();
@@ -328,5 +328,5 @@ pub fn in_raster(
     frame: RasterFrame,
     blend: crate::texture::Blend,
 ) -> InRaster<AnyTexture> {
-    t.clone().in_raster(frame, blend)
+    InRaster::new(t.clone(), frame, blend)
 }
