@@ -66,7 +66,7 @@ impl<'a> Tracer<'a> {
                 .map(|o| (o.shape, o.material))
                 .collect(),
             eps: 1e-5 * if diag > 0.0 { diag } else { 1.0 },
-            intensity: shade::light_intensity(scene.lights.len()),
+            intensity: rrt_host::scene::light_intensity(scene.lights.len()),
             max_depth: 3,
             counts: Counts::default(),
         }

@@ -22,10 +22,9 @@ use rrt_core::store::{Counter, Limits, ObjectAttrs, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 use rrt_host::frame::RasterFrame;
-use rrt_host::object_table::WorldLight;
-use rrt_host::scene::{Material, View};
-use rrt_host::shade;
+use rrt_host::scene::{Material, View, light_intensity};
 use rrt_host::volume::{Classifier, Limits as VolumeLimits, Placement, nrrd};
+use rrt_host::voxelize::WorldLight;
 use rrt_host::voxelize::plane::Plane;
 use rrt_host::voxelize::{MAX_MATERIALS, VoxelScene, finish_plane};
 
@@ -126,7 +125,7 @@ pub fn build(
     let table = ObjectTable::new(&mut storage);
     let mut mats: Box<Materials<MAX_MATERIALS>> = Box::default();
     let _ = mats.push(core_mat);
-    let intensity = scalar(shade::light_intensity(1));
+    let intensity = scalar(light_intensity(1));
     let mut lights = Lights::new(intensity);
     let position = frame.to_fixed(light_pos).ok_or("light out of range")?;
     let _ = lights.push(Light {

@@ -40,7 +40,6 @@ pub mod check;
 pub mod cli;
 pub mod fit;
 pub mod frame;
-pub mod object_table;
 pub mod output;
 pub mod rasterfile;
 pub mod render;

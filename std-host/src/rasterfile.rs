@@ -56,11 +56,11 @@ use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
 use crate::frame::RasterFrame;
-use crate::object_table::{WorldLight, WorldObject};
 use crate::scene::{Material, SourceLoc, View};
 use crate::shape::{SLOTS, Shape, Slots};
 use crate::voxelize::plane::Plane;
 use crate::voxelize::{MAX_MATERIALS, VoxelScene, line_level};
+use crate::voxelize::{WorldLight, WorldObject};
 
 /// The file's first bytes.
 pub const MAGIC: [u8; 8] = *b"RRTRASTR";

@@ -2,7 +2,7 @@
 //!
 //! The SPD readme leaves intensities open and suggests, for `nl` lights,
 //! `I = sqrt(nl) / (2·nl)` per light, with the same `I` for the ambient
-//! term ([`light_intensity`]). A hit on a surface of colour `C` is shaded
+//! term ([`crate::scene::light_intensity`]). A hit on a surface of colour `C` is shaded
 //! (Phong highlights, Whitted secondary rays) as
 //!
 //! ```text
@@ -33,20 +33,6 @@
 use glam::DVec3;
 
 use crate::scene::Material;
-
-/// The SPD light intensity for `n_lights` lights: `sqrt(nl) / (2·nl)`,
-/// with `nl` at least 1. The ambient intensity is the same.
-///
-/// ```
-/// use rrt_host::shade::light_intensity;
-/// assert_eq!(light_intensity(1), 0.5);
-/// assert_eq!(light_intensity(4), 0.25);
-/// ```
-#[must_use]
-pub fn light_intensity(n_lights: usize) -> f64 {
-    let nl = n_lights.max(1) as f64;
-    nl.sqrt() / (2.0 * nl)
-}
 
 /// `normal`, negated if it points along `dir` (the incoming ray's
 /// direction), so that it faces the viewer: two-sided shading.
@@ -212,6 +198,7 @@ pub fn to_rgb8(c: DVec3) -> [u8; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::light_intensity;
 
     #[track_caller]
     fn close3(a: DVec3, b: DVec3) {

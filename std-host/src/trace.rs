@@ -109,10 +109,10 @@ use rrt_core::voxel::{LightVisibility, VoxelRecord};
 use rrt_core::voxelize::NORMAL_ONE;
 
 use crate::frame::{RasterFrame, round_to_i64, unit_to_fixed};
-use crate::object_table::{WorldLight, WorldObject};
 use crate::scene::Material;
 use crate::shade;
 use crate::voxelize::VoxelScene;
+use crate::voxelize::{WorldLight, WorldObject};
 use crate::world::Ray;
 
 /// Rays per primary block: 4 × 2 pixels, the lanes of `RayPacket8`.

@@ -88,6 +88,20 @@ impl Light {
     }
 }
 
+/// The SPD light intensity for `n_lights` lights: `sqrt(nl) / (2·nl)`,
+/// with `nl` at least 1. The ambient intensity is the same.
+///
+/// ```
+/// use rrt_host::scene::light_intensity;
+/// assert_eq!(light_intensity(1), 0.5);
+/// assert_eq!(light_intensity(4), 0.25);
+/// ```
+#[must_use]
+pub fn light_intensity(n_lights: usize) -> f64 {
+    let nl = n_lights.max(1) as f64;
+    nl.sqrt() / (2.0 * nl)
+}
+
 /// Fill colour and shading parameters (`f r g b Kd Ks Shine T
 /// index_of_refraction`).
 #[derive(Clone, Debug, PartialEq)]

@@ -35,7 +35,10 @@ use rrt_core::store::Texture;
 use rrt_core::voxelize::volume::{self, Block};
 use rrt_core::voxelize::{Separation, Surfel, VoxelSink};
 
+use super::BuildError;
+use super::objects::Pass;
 use crate::frame::RasterFrame;
+use crate::scene::VolumeObject;
 use crate::volume::resample::Quantizer;
 use crate::volume::{Classifier, DimsFmt, PlacedVolume, SampleType, VolumeError, sample_count};
 
@@ -422,6 +425,56 @@ impl Texture for VolumeColors<'_> {
             None => base,
         }
     }
+}
+
+/// Most bytes of the resampled block a volume is voxelized through at once.
+pub const MAX_BLOCK_BYTES: u64 = 256 << 20;
+
+/// Voxelizes a volume object into `pass`, with `keep` choosing voxels (a
+/// CSG cut). In the fill pass its voxels take the colour of the material's
+/// texture if it has one, else the classifier's colour ramp (else the
+/// material colour).
+///
+/// # Errors
+/// The volume's refusal (a block beyond the limits), the store's.
+pub(super) fn voxelize_object(
+    v: &VolumeObject,
+    frame: &RasterFrame,
+    separation: Separation,
+    keep: Option<Keep<'_>>,
+    pass: Pass<'_, '_, '_, '_>,
+) -> Result<(), BuildError> {
+    let placed = v.data.placed();
+    let classifier = &v.data.classifier;
+    let err = |e: VolumeError| BuildError::Raster(format!("{}: volume: {e}", v.loc));
+    match pass {
+        Pass::Count(c) => {
+            placed
+                .voxelize_where(frame, classifier, separation, MAX_BLOCK_BYTES, keep, c)
+                .map_err(err)?;
+        }
+        Pass::Fill {
+            filler,
+            attrs,
+            texture,
+            ..
+        } => {
+            filler.begin_object(attrs)?;
+            if let Some(t) = texture {
+                let mut s = filler.textured(t);
+                placed
+                    .voxelize_where(frame, classifier, separation, MAX_BLOCK_BYTES, keep, &mut s)
+                    .map_err(err)?;
+            } else {
+                let colors = VolumeColors::new(placed, *frame, classifier);
+                let mut s = filler.textured(&colors);
+                placed
+                    .voxelize_where(frame, classifier, separation, MAX_BLOCK_BYTES, keep, &mut s)
+                    .map_err(err)?;
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -7,6 +7,10 @@ use rrt_core::fixed::FRAC_BITS;
 use rrt_core::store::Texture;
 use rrt_core::voxelize::{Surfel, VoxelSink};
 
+use super::BuildError;
+use super::objects::Pass;
+use crate::frame::RasterFrame;
+use crate::scene::VoxObject;
 use crate::vox::VoxScene;
 
 /// Where a scene's world cells go in the raster: cell `c` covers raster
@@ -91,4 +95,52 @@ impl Texture for VoxColors {
         });
         self.cells.get(&cell).copied().unwrap_or(base)
     }
+}
+
+/// Most raster voxels per `.vox` cell edge.
+pub const MAX_VOX_SCALE: u32 = 4096;
+
+/// The raster placement of a `.vox` model: its origin's voxel, and
+/// `cell / voxel size` voxels (rounded, at least 1) per cell.
+///
+/// # Errors
+/// [`FitError::OutOfRange`](crate::fit::FitError::OutOfRange) for a model
+/// too far out or cells too large.
+pub fn placement(v: &VoxObject, frame: &RasterFrame) -> Result<VoxPlacement, BuildError> {
+    let scale = (v.cell / frame.voxel_size).round().max(1.0);
+    if scale.is_nan() || scale > f64::from(MAX_VOX_SCALE) {
+        return Err(BuildError::out_of_range(&v.loc, "vox cell"));
+    }
+    let o = frame.world_to_raster(v.position).floor();
+    if !(o.is_finite() && o.abs().max_element() < f64::from(1u32 << 30)) {
+        return Err(BuildError::out_of_range(&v.loc, "vox position"));
+    }
+    Ok(VoxPlacement {
+        offset: [o.x as i64, o.y as i64, o.z as i64],
+        scale: scale as u32,
+    })
+}
+
+/// Voxelizes a `.vox` model into `pass`, with its palette colours.
+///
+/// # Errors
+/// As [`placement`]; the store's.
+pub(super) fn voxelize_object(
+    v: &VoxObject,
+    frame: &RasterFrame,
+    pass: Pass<'_, '_, '_, '_>,
+) -> Result<(), BuildError> {
+    let placement = placement(v, frame)?;
+    match pass {
+        Pass::Count(c) => {
+            v.vox.voxelize(placement, c);
+        }
+        Pass::Fill { filler, attrs, .. } => {
+            filler.begin_object(attrs)?;
+            let colors = v.vox.colors(placement);
+            let mut s = filler.textured(&colors);
+            v.vox.voxelize(placement, &mut s);
+        }
+    }
+    Ok(())
 }

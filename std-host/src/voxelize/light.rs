@@ -1,0 +1,114 @@
+//! The light pass: light visibility and precomputed illumination for every
+//! record ([`rrt_core::light::illuminate_run`]), in runs of records on
+//! rayon's threads.
+//!
+//! One discrete shadow ray per record and light gives the record's two
+//! visibility bits per light and its ambient + diffuse illumination (SPD
+//! intensities `I = sqrt(nl)/(2·nl)`, ambient the same). Each record's
+//! bits and illumination depend only on the (unchanged) store, so the
+//! result is the serial pass's whatever the thread count. The runs write
+//! into a copy of the records (one more record array while the pass
+//! runs), since the store they read must stay whole.
+
+use rayon::prelude::*;
+use rrt_core::light::{LightError, LightParams, LightReport, illuminate_run};
+use rrt_core::object_table::{Light, Lights, Materials, Object, ObjectTable};
+use rrt_core::raster::Raster;
+use rrt_core::store::RecordStore;
+use rrt_core::voxel::VoxelRecord;
+
+use super::BuildError;
+use super::materials::{MAX_MATERIALS, MaterialTable, scalar};
+use super::objects::TableObject;
+use crate::fit::FittedLight;
+use crate::scene::light_intensity;
+
+/// Records per run of the parallel light pass.
+const LIGHT_RUN: usize = 1 << 14;
+
+/// What the light pass reads besides the raster: the core's object-table
+/// entries, material table and lights.
+pub(super) struct LightScene {
+    entries: Vec<Object>,
+    materials: Box<Materials<MAX_MATERIALS>>,
+    lights: Lights,
+}
+
+impl LightScene {
+    /// The core's tables for `objects` (in id order) and `lights`.
+    pub fn new(
+        objects: &[TableObject<'_>],
+        materials: &MaterialTable,
+        lights: &[FittedLight],
+    ) -> Self {
+        let intensity = scalar(light_intensity(lights.len()));
+        let mut core_lights = Lights::new(intensity);
+        for l in lights {
+            let c = l.colour;
+            // The builder refuses more than MAX_LIGHTS: no push fails.
+            let _ = core_lights.push(Light {
+                position: l.position,
+                color: [c.x, c.y, c.z].map(scalar),
+                intensity,
+            });
+        }
+        Self {
+            entries: objects
+                .iter()
+                .map(|o| Object {
+                    shape: o.entry(),
+                    material: materials.of(o.material()),
+                })
+                .collect(),
+            materials: materials.core(),
+            lights: core_lights,
+        }
+    }
+
+    /// The lit copy of `store`'s records, computed on `threads` threads (0:
+    /// one per core), and the pass's counts.
+    ///
+    /// # Errors
+    /// The core's [`LightError`]; threads that cannot be started.
+    pub fn illuminate(
+        &self,
+        raster: &Raster<'_>,
+        store: &RecordStore<'_>,
+        params: &LightParams,
+        threads: usize,
+    ) -> Result<(Vec<VoxelRecord>, LightReport), BuildError> {
+        let mut storage = vec![Object::UNUSED; self.entries.len()];
+        let mut table = ObjectTable::new(&mut storage);
+        for o in &self.entries {
+            // The storage holds exactly these objects: no push fails.
+            let _ = table.push(*o);
+        }
+        let mut out = store.records().to_vec();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| BuildError::Raster(format!("cannot start threads: {e}")))?;
+        let reports: Vec<Result<LightReport, LightError>> = pool.install(|| {
+            out.par_chunks_mut(LIGHT_RUN)
+                .enumerate()
+                .map(|(i, run)| {
+                    illuminate_run(
+                        raster,
+                        store,
+                        i * LIGHT_RUN,
+                        run,
+                        &table,
+                        &self.materials,
+                        &self.lights,
+                        params,
+                    )
+                })
+                .collect()
+        });
+        let mut report = LightReport::default();
+        for r in reports {
+            report.add(&r?);
+        }
+        Ok((out, report))
+    }
+}

@@ -1,0 +1,154 @@
+//! The voxelized scene: what voxelization hands to the tracer and to the
+//! saved-raster file. The raster (plane, line level, brick directory and
+//! records) and the world side: each object's exact geometry (the world
+//! object table, indexed by the records' object id as the paper's object
+//! table is, for intersection verification), the distinct materials and
+//! the lights in `f64` for shading.
+
+use glam::DVec3;
+use rrt_core::proximity::{distance_field, line_distances};
+use rrt_core::raster::{Extent, Raster, RasterMut, line_count};
+use rrt_core::store::{RecordStore, StoreError, write_rank_hints};
+use rrt_core::voxel::VoxelRecord;
+use rrt_core::voxelize::Separation;
+
+use super::plane::Plane;
+use crate::frame::RasterFrame;
+use crate::scene::{Material, View, light_intensity};
+use crate::shape::Shape;
+
+/// A voxelized scene: the raster, its records and everything the renderer
+/// needs besides the view.
+#[derive(Debug)]
+pub struct VoxelScene {
+    /// World ↔ raster mapping and the raster's dimensions.
+    pub frame: RasterFrame,
+    /// The separation the surfaces were voxelized with: rays of a
+    /// connectivity that needs more (26-connected rays need
+    /// [`Separation::TwentySix`]) could pass through them.
+    pub separation: Separation,
+    /// One cell per voxel ([`rrt_core::raster::cell`]).
+    pub plane: Plane,
+    /// The plane's line level ([`Raster::with_lines`], from [`line_level`]):
+    /// computed from the plane, never saved.
+    pub lines: Vec<u8>,
+    /// The brick directory of the record store.
+    pub directory: Vec<u32>,
+    /// The voxel records, sorted by brick and position.
+    pub records: Vec<VoxelRecord>,
+    /// The world object table, indexed by [`VoxelRecord::object`].
+    pub objects: Vec<WorldObject>,
+    /// Distinct materials, indexed by [`VoxelRecord::material`].
+    pub materials: Vec<Material>,
+    /// Lights, in file order (light `i` is bit pair `i` of the records).
+    pub lights: Vec<WorldLight>,
+    /// Background colour.
+    pub background: DVec3,
+    /// The scene's view (the renderer may override it).
+    pub view: View,
+}
+
+impl VoxelScene {
+    /// The raster's dimensions.
+    #[must_use]
+    pub fn extent(&self) -> Extent {
+        self.frame.extent
+    }
+
+    /// The raster (the plane over the extent, with its line level when
+    /// the scene has one).
+    ///
+    /// # Errors
+    /// Only if the plane or the line level does not match the extent, which
+    /// the constructors rule out.
+    pub fn raster(&self) -> Result<Raster<'_>, rrt_core::RasterError> {
+        let r = Raster::new(self.frame.extent, &self.plane)?;
+        if self.lines.is_empty() {
+            Ok(r)
+        } else {
+            r.with_lines(&self.lines)
+        }
+    }
+
+    /// The record store, validated (O(bricks + records)).
+    ///
+    /// # Errors
+    /// The first broken store invariant.
+    pub fn store(&self) -> Result<RecordStore<'_>, StoreError> {
+        RecordStore::new(self.frame.extent, &self.directory, &self.records)
+    }
+
+    /// The SPD intensity of each light and of the ambient term.
+    #[must_use]
+    pub fn intensity(&self) -> f64 {
+        light_intensity(self.lights.len())
+    }
+
+    /// Bytes held by the plane, its line level, directory and records.
+    #[must_use]
+    pub fn memory(&self) -> u64 {
+        let dir = self.directory.len().saturating_mul(4);
+        let rec = self
+            .records
+            .len()
+            .saturating_mul(std::mem::size_of::<VoxelRecord>());
+        let bytes = self
+            .plane
+            .len()
+            .saturating_add(self.lines.len())
+            .saturating_add(dir)
+            .saturating_add(rec);
+        u64::try_from(bytes).unwrap_or(u64::MAX)
+    }
+}
+
+/// The last pass over a voxelized plane, once its records are final: the
+/// proximity distance field (empty-space skipping for 26-runs; it sets the
+/// same PROXIMITY flags the builder set), the records' rank hints in their
+/// opaque cells (which the field clears), and the line level, returned.
+/// A plane, directory or record array that does not match `extent` is left
+/// as it is, with no line level.
+pub fn finish_plane(
+    extent: Extent,
+    plane: &mut [u8],
+    directory: &[u32],
+    records: &[VoxelRecord],
+) -> Vec<u8> {
+    if let Ok(mut raster) = RasterMut::new(extent, plane) {
+        distance_field(&mut raster);
+        if let Ok(store) = RecordStore::new(extent, directory, records) {
+            write_rank_hints(&mut raster, &store);
+        }
+    }
+    line_level(extent, plane)
+}
+
+/// The line level of a plane over `extent` ([`line_distances`]): one
+/// stand-in cell per 64 cells, which lets skipping walks stay off the plane
+/// far from surfaces. Empty if the plane does not match the extent.
+#[must_use]
+pub fn line_level(extent: Extent, plane: &[u8]) -> Vec<u8> {
+    let mut lines = vec![0u8; line_count(plane.len())];
+    match Raster::new(extent, plane).map(|r| line_distances(&r, &mut lines)) {
+        Ok(Ok(())) => lines,
+        _ => Vec::new(),
+    }
+}
+
+/// One entry of the world object table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldObject {
+    /// Exact geometry.
+    pub shape: Shape,
+    /// Index into the scene's material list.
+    pub material: u16,
+}
+
+/// A point light in world coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldLight {
+    /// Position.
+    pub position: DVec3,
+    /// Colour (white unless the file gives one).
+    pub colour: DVec3,
+}
