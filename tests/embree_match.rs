@@ -19,8 +19,8 @@ use glam::DVec3;
 use rrt_host::camera::Camera;
 use rrt_host::fit::{self, FitOptions};
 use rrt_host::scene::{Material, Scene};
-use rrt_host::shade;
 use rrt_host::shape::Shape;
+use rrt_host::trace::shading;
 use rrt_host::world::{Hit, Ray};
 use rrt_tests::shared_data;
 
@@ -88,14 +88,14 @@ impl<'a> Tracer<'a> {
         self.counts.hits += 1;
         let d = ray.dir;
         let p = ray.at(hit.t);
-        let n = shade::face_forward(hit.normal, d);
+        let n = shading::face_forward(hit.normal, d);
         let po = p + n * self.eps;
         let mut visible = Vec::new();
         for light in &self.scene.lights {
             let to = light.position - p;
             let dist = to.length();
             let l = to / dist;
-            if !shade::faces_light(n, l) {
+            if !shading::faces_light(n, l) {
                 continue;
             }
             self.counts.shadow += 1;
@@ -106,14 +106,14 @@ impl<'a> Tracer<'a> {
                 visible.push((l, light.rgb()));
             }
         }
-        let local = shade::local(m, n, d, visible, self.intensity);
+        let local = shading::local(m, n, d, visible, self.intensity);
         let mut reflected = DVec3::ZERO;
         if m.ks > 0.0 && depth < self.max_depth {
             self.counts.reflect += 1;
-            reflected = self.trace(Ray::new(po, shade::reflect(d, n)), depth + 1);
+            reflected = self.trace(Ray::new(po, shading::reflect(d, n)), depth + 1);
         }
         // The SPD scenes have T = 0: no refracted ray, as in embree_nff.
-        shade::combine(m, local, reflected, DVec3::ZERO)
+        shading::combine(m, local, reflected, DVec3::ZERO)
     }
 
     fn render(&mut self, w: u32, h: u32) -> Vec<u8> {
@@ -123,7 +123,7 @@ impl<'a> Tracer<'a> {
             for x in 0..w {
                 self.counts.primary += 1;
                 let c = self.trace(cam.primary(x, y), 1);
-                rgb.extend(shade::to_rgb8(c));
+                rgb.extend(shading::to_rgb8(c));
             }
         }
         rgb

@@ -44,7 +44,6 @@ pub mod output;
 pub mod rasterfile;
 pub mod render;
 pub mod scene;
-pub mod shade;
 pub mod shape;
 pub mod texture;
 pub mod trace;

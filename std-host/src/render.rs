@@ -25,7 +25,7 @@ use glam::DVec3;
 use indicatif::ProgressBar;
 
 use crate::camera::{Camera, sample_offset};
-use crate::shade;
+use crate::trace::shading;
 use crate::trace::{BLOCK, BLOCK_H, BLOCK_W, RayStats, Tracer};
 use crate::world::Ray;
 
@@ -229,5 +229,8 @@ fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, x0: u32, y0: u32) -
         }
     }
     let n = f64::from(k * k);
-    (sums.iter().map(|s| shade::to_rgb8(*s / n)).collect(), stats)
+    (
+        sums.iter().map(|s| shading::to_rgb8(*s / n)).collect(),
+        stats,
+    )
 }

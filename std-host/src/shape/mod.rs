@@ -31,7 +31,7 @@
 //! * open cones give the outward normal of the lateral surface.
 //!
 //! None of them flips the normal towards the ray: shading does that
-//! ([`crate::shade::face_forward`]). Tangent (grazing) rays count as hits.
+//! ([`crate::trace::shading::face_forward`]). Tangent (grazing) rays count as hits.
 //! No input makes them panic; non-finite input gives `None`.
 
 // `!(x >= 0.0)` is deliberate throughout: it is true for NaN, which must

@@ -176,7 +176,7 @@ pub fn refract(dir: DVec3, normal: DVec3, ior: f64) -> Refraction {
 /// truncated (round to nearest); NaN gives 0.
 ///
 /// ```
-/// use rrt_host::shade::channel_to_u8;
+/// use rrt_host::trace::shading::channel_to_u8;
 /// assert_eq!([0.0, 0.5, 1.0, 7.0, -1.0, f64::NAN].map(channel_to_u8), [0, 128, 255, 255, 0, 0]);
 /// ```
 #[must_use]

@@ -1,0 +1,216 @@
+//! Shading a hit: the precomputed illumination or the local light of the
+//! lights its bits say are visible, render-time shadow rays through
+//! translucent objects (or exact shadow rays), and the reflected and
+//! refracted rays, which leave the surface by the acne rule (module docs
+//! of [`crate::trace`]).
+
+use glam::DVec3;
+use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
+use rrt_core::light::LeavingSurface;
+use rrt_core::voxel::LightVisibility;
+use rrt_core::voxelize::NORMAL_ONE;
+
+use super::walk::surface_voxel;
+use super::{RayStats, SurfaceHit, Tracer, shading};
+use crate::frame::unit_to_fixed;
+use crate::scene::Material;
+use crate::world::Ray;
+
+fn rgb(c: [u8; 3]) -> DVec3 {
+    DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])) / 255.0
+}
+
+impl Tracer<'_> {
+    /// The smallest ray parameter at which an exact intersection counts
+    /// for a ray leaving a surface (a thousandth of a voxel): it must not
+    /// verify onto, or be shadowed by, the point it leaves.
+    pub(super) fn leaving_tmin(&self) -> f64 {
+        1e-3 * self.frame.voxel_size
+    }
+
+    /// The acne rule for a ray leaving hit `h` towards the side `side`.
+    pub(super) fn leaving(&self, h: &SurfaceHit, side: DVec3) -> LeavingSurface {
+        let side = unit_to_fixed(side).unwrap_or([0, 0, NORMAL_ONE]);
+        LeavingSurface::new(self.extent, h.voxel, side, &h.rec, &self.opts.light)
+    }
+
+    /// The colour of hit `h` of `ray` at `depth` (module docs).
+    pub(super) fn shade(
+        &self,
+        ray: &Ray,
+        h: &SurfaceHit,
+        depth: u32,
+        stats: &mut RayStats,
+    ) -> DVec3 {
+        let m = self
+            .materials
+            .get(usize::from(h.rec.material))
+            .unwrap_or(&Material::DEFAULT);
+        let d = ray.dir;
+        let front = h.normal.dot(d) <= 0.0;
+        let n = if front { h.normal } else { -h.normal };
+        let c = rgb(h.rec.color);
+        let i = self.intensity;
+        // The precomputed illumination is the stored normal's side, at the
+        // voxel centre: used as it is for the basic algorithm on that side.
+        let use_illum = front && !h.verified;
+        let mut local = if use_illum {
+            rgb(h.rec.illum)
+        } else {
+            c * (i * m.kd)
+        };
+        let p = h.point;
+        for (k, light) in self.lights.iter().enumerate() {
+            let to = light.position - p;
+            let dist = to.length();
+            if !(dist > 0.0) {
+                continue;
+            }
+            let l = to / dist;
+            let ndl = n.dot(l);
+            if ndl <= 0.0 {
+                continue;
+            }
+            let vis = h.rec.light(k);
+            let exact = self.opts.exact_shadows && h.verified;
+            let att = match vis {
+                _ if exact => {
+                    stats.shadow += 1;
+                    self.shadow(h, n, k, Some((l, dist)), stats)
+                }
+                LightVisibility::Visible => 1.0,
+                LightVisibility::Translucent => {
+                    stats.shadow += 1;
+                    self.shadow(h, n, k, None, stats)
+                }
+                LightVisibility::Occluded | LightVisibility::Reserved => 0.0,
+            };
+            if att <= 0.0 {
+                continue;
+            }
+            let lc = light.colour * (i * att);
+            if !use_illum || vis == LightVisibility::Translucent {
+                local += lc * c * (m.kd * ndl);
+            }
+            if m.ks > 0.0 {
+                let r = n * (2.0 * ndl) - l;
+                let rv = -r.dot(d);
+                if rv > 0.0 {
+                    local += lc * (m.ks * rv.powf(m.shine));
+                }
+            }
+        }
+        let mut reflected = DVec3::ZERO;
+        let mut refracted = DVec3::ZERO;
+        if depth < self.opts.depth {
+            if m.ks > 0.0 {
+                stats.reflected += 1;
+                let dir = shading::reflect(d, n).normalize_or(n);
+                let rule = self.leaving(h, n);
+                reflected = self.trace(&Ray::new(p, dir), depth + 1, Some(&rule), stats);
+            }
+            if m.transmittance > 0.0 {
+                stats.refracted += 1;
+                let dir = shading::refract(d, h.normal, m.ior).dir();
+                let side = if dir.dot(n) > 0.0 { n } else { -n };
+                let rule = self.leaving(h, side);
+                refracted = self.trace(&Ray::new(p, dir), depth + 1, Some(&rule), stats);
+            }
+        }
+        shading::combine(m, local, reflected, refracted)
+    }
+
+    /// A render-time shadow ray from hit `h` (seen side `n`) to light `k`:
+    /// the product of the transmittances of the translucent objects in
+    /// between (each object once), 0 if an opaque voxel blocks.
+    ///
+    /// `exact` (unit direction and distance to the light) makes it an
+    /// exact shadow ray ([`TraceOptions::exact_shadows`]): a 6-connected
+    /// walk, which meets every voxel the continuous segment passes
+    /// through, and a voxel counts only if the continuous segment
+    /// intersects its object (each object tested once); voxels of objects
+    /// without exact geometry (volumes, voxel models) count as they are.
+    pub(super) fn shadow(
+        &self,
+        h: &SurfaceHit,
+        n: DVec3,
+        k: usize,
+        exact: Option<(DVec3, f64)>,
+        stats: &mut RayStats,
+    ) -> f64 {
+        let (Some(Some(light)), Some(p)) = (self.lights_fx.get(k), self.frame.to_fixed(h.point))
+        else {
+            return 0.0;
+        };
+        let delta = [0, 1, 2].map(|a| i128::from(light[a]) - i128::from(p[a]));
+        let span = delta.iter().map(|v| v.unsigned_abs()).max().unwrap_or(0);
+        let ray = if span <= u128::from(i32::MAX.unsigned_abs()) {
+            DiscreteRay::segment(self.extent, p, *light)
+        } else {
+            // Scale the direction into i32; the walk ends where the ray
+            // leaves the raster (a light inside a raster wider than 2^15
+            // voxels is treated as if it were outside).
+            let shift = 128u32
+                .saturating_sub(span.leading_zeros())
+                .saturating_sub(31);
+            let dir = delta.map(|v| i32::try_from(v >> shift).unwrap_or(0));
+            DiscreteRay::new(self.extent, p, dir)
+        };
+        let Ok(Some(mut dray)) = ray else {
+            return 1.0;
+        };
+        let rule = self.leaving(h, n);
+        let store = self.store;
+        let extent = self.extent;
+        let materials = self.materials;
+        let mut att = 1.0;
+        let mut seen: Vec<u32> = Vec::new();
+        // Objects the exact segment was found not to intersect.
+        let mut clear: Vec<u32> = Vec::new();
+        let segment = exact.map(|(l, dist)| (Ray::new(h.point, l), dist));
+        let tmin = self.leaving_tmin();
+        let objects = self.objects;
+        let mode = if exact.is_some() {
+            Connectivity::Six
+        } else {
+            self.opts.light.mode
+        };
+        let mut missing = 0u64;
+        let end = dray
+            .walk_skipping(&self.raster, mode, u32::MAX, |index, c| {
+                let Some(b) = surface_voxel(&store, extent, Some(&rule), index, c, &mut missing)
+                else {
+                    return false;
+                };
+                if let Some((ray, dist)) = &segment
+                    && let Some(obj) = usize::try_from(b.object)
+                        .ok()
+                        .and_then(|i| objects.get(i))
+                        .filter(|o| o.shape.is_exact())
+                {
+                    if seen.contains(&b.object) || clear.contains(&b.object) {
+                        return false;
+                    }
+                    if obj.shape.intersect(ray, tmin, *dist).is_none() {
+                        clear.push(b.object);
+                        return false;
+                    }
+                }
+                let t = materials
+                    .get(usize::from(b.material))
+                    .map_or(0.0, |m| m.transmittance);
+                if t > 0.0 {
+                    if !seen.contains(&b.object) {
+                        seen.push(b.object);
+                        att *= t;
+                    }
+                    return false;
+                }
+                true
+            })
+            .unwrap_or(WalkEnd::Exit);
+        stats.steps += u64::from(dray.steps());
+        stats.missing += missing;
+        if end == WalkEnd::Hit { 0.0 } else { att }
+    }
+}
