@@ -16,8 +16,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use rrt_host::camera::Camera;
 use rrt_host::fit::{self, FitOptions};
+use rrt_host::render::camera::Camera;
 use rrt_host::scene::{Material, Scene};
 use rrt_host::shape::Shape;
 use rrt_host::trace::shading;

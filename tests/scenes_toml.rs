@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
-use rrt_host::rasterfile;
+use rrt_host::output::rasterfile;
 use rrt_host::scene::Scene;
 use rrt_host::shape::Shape;
 use rrt_host::trace::{Verdict, verify};
@@ -367,7 +367,7 @@ fn scene_files_are_not_read_outside_the_options() {
 /// beside it with and without `exact_shadows`.
 #[test]
 fn exact_shadows_keep_volume_shadows() {
-    use rrt_host::camera::Camera;
+    use rrt_host::render::camera::Camera;
     use rrt_host::render::{RenderOptions, render};
     use rrt_host::trace::{TraceOptions, Tracer};
     let d = temp_dir("exact-volume");

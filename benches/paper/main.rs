@@ -31,7 +31,7 @@ use indicatif::ProgressBar;
 use rrt_core::Connectivity;
 use rrt_core::discrete_ray::{DiscreteRay, WalkEnd};
 use rrt_core::raster::{Raster, cell};
-use rrt_host::camera::Camera;
+use rrt_host::render::camera::Camera;
 use rrt_host::render::{Image, RenderOptions, render};
 use rrt_host::scene::{Scene, View};
 use rrt_host::trace::{RayStats, TraceOptions, Tracer};

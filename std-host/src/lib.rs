@@ -34,14 +34,12 @@
 
 #![forbid(unsafe_code)]
 
-pub mod camera;
 #[cfg(any(test, feature = "check"))]
 pub mod check;
 pub mod cli;
 pub mod fit;
 pub mod frame;
 pub mod output;
-pub mod rasterfile;
 pub mod render;
 pub mod scene;
 pub mod shape;

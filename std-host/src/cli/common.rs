@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::CliError;
 use super::ray::ConnectivityArg;
 use crate::fit::{FitOptions, default_max_memory};
-use crate::rasterfile;
+use crate::output::rasterfile;
 use crate::scene::{Scene, View};
 use crate::voxelize::{BuildOptions, BuildReport, VoxelScene, build};
 use crate::world::Bounds;

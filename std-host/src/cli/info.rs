@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use super::CliError;
 use crate::fit::Bytes;
-use crate::rasterfile;
+use crate::output::rasterfile;
 use rrt_core::voxelize::Separation;
 
 /// Arguments of `rrt info`.

@@ -65,7 +65,7 @@ pub enum CliError {
     Build(#[from] crate::voxelize::BuildError),
     /// The view.
     #[error(transparent)]
-    Camera(#[from] crate::camera::CameraError),
+    Camera(#[from] crate::render::camera::CameraError),
     /// Setting up the tracer.
     #[error(transparent)]
     Trace(#[from] crate::trace::TraceError),
@@ -74,10 +74,10 @@ pub enum CliError {
     Render(#[from] crate::render::RenderError),
     /// Writing the image.
     #[error(transparent)]
-    Png(#[from] crate::output::OutputError),
+    Png(#[from] crate::output::png::OutputError),
     /// A saved raster.
     #[error(transparent)]
-    RasterFile(#[from] crate::rasterfile::RasterFileError),
+    RasterFile(#[from] crate::output::rasterfile::RasterFileError),
 }
 
 /// Runs a parsed command line, writing reports to `out`.

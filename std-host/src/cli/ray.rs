@@ -134,7 +134,7 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
 /// renderer also tries the objects of its neighbours before resuming).
 fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Result<(), CliError> {
     use rrt_core::raster::cell;
-    let scene = crate::rasterfile::load(path)?;
+    let scene = crate::output::rasterfile::load(path)?;
     let mode: Connectivity = args.connectivity.into();
     if mode == Connectivity::TwentySix
         && scene.separation != rrt_core::voxelize::Separation::TwentySix

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use super::CliError;
 use super::common::{Loaded, RasterArgs, ViewArgs, load_or_build, progress, secs};
-use crate::camera::Camera;
-use crate::output::PngOutput;
+use crate::output::png::PngOutput;
+use crate::render::camera::Camera;
 use crate::render::{RenderOptions, check_sizes, render};
 use crate::trace::{TraceOptions, Tracer};
 

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use super::CliError;
 use super::common::{Loaded, RasterArgs, load_or_build, secs};
 use crate::fit::Bytes;
-use crate::rasterfile;
+use crate::output::rasterfile;
 
 /// Arguments of `rrt voxelize`.
 #[derive(Debug, Clone, clap::Args)]

@@ -30,7 +30,7 @@
 //!
 //! The result, a [`VoxelScene`] ([`voxel_scene`]), holds everything
 //! view-independent: the renderer ([`crate::trace`]) and the saved-raster
-//! file ([`crate::rasterfile`]) both start from it.
+//! file ([`crate::output::rasterfile`]) both start from it.
 
 #![deny(missing_docs)]
 

@@ -162,7 +162,7 @@ impl Camera {
 /// `(i + 0.5)/k − 0.5`, so the `k` samples split the pixel evenly.
 ///
 /// ```
-/// use rrt_host::camera::sample_offset;
+/// use rrt_host::render::camera::sample_offset;
 /// assert_eq!(sample_offset(0, 1), 0.0);
 /// assert_eq!([0, 1].map(|i| sample_offset(i, 2)), [-0.25, 0.25]);
 /// ```

@@ -8,7 +8,7 @@
 //! raster. Each tile is cut into 4×2 pixel blocks
 //! traced through [`Tracer::trace_block`] (eight rays: the lanes of a ray
 //! packet). With supersampling `K`, each pixel gets `K × K` rays at the
-//! sub-pixel offsets of [`crate::camera::sample_offset`] (row by row), and
+//! sub-pixel offsets of [`crate::render::camera::sample_offset`] (row by row), and
 //! their colours are averaged (a box filter) before the 8-bit conversion.
 //!
 //! **Determinism.** Every pixel's colour depends only on its own rays, and
@@ -18,13 +18,15 @@
 
 #![deny(missing_docs)]
 
+pub mod camera;
+
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
 
-use crate::camera::{Camera, sample_offset};
+use self::camera::{Camera, sample_offset};
 use crate::trace::shading;
 use crate::trace::{BLOCK, BLOCK_H, BLOCK_W, RayStats, Tracer};
 use crate::world::Ray;

@@ -1,0 +1,303 @@
+//! Fitting the 3D raster to a scene: world coordinates to fixed-point
+//! raster coordinates, once.
+//!
+//! The raster's box is the box around all geometry ([`Scene::bounds`]:
+//! spheres ± radius, polygon vertices, cone end discs ± radius) grown by a
+//! margin of a few voxels on every side, or exactly the box the caller
+//! gives. Voxels are cubes: `raster N` is the number of voxels along the
+//! box's longest axis, and each other axis gets `ceil(extent / voxel)`
+//! voxels (plus the margins), the geometry centred in it.
+//!
+//! [`fit`] then converts every object to the core's fixed-point geometry
+//! ([`rrt_core::geometry`]: positions in 1/65536 voxel, unit normals
+//! scaled by 2^30): spheres, triangles (polygons fan-triangulated, `pp`
+//! patches with their vertex normals normalised) and open cones; and
+//! every light to a fixed-point position (lights may lie outside the
+//! raster). [`RasterFrame`] keeps the mapping both ways.
+//!
+//! * [`size`]: the raster's frame for a scene ([`frame`]);
+//! * [`memory`]: the memory estimate ([`estimate_memory`]);
+//! * [`meminfo`]: the machine's memory and the default limit.
+//!
+//! Before anything is allocated, [`MemoryEstimate`] bounds what the
+//! voxelized raster will take, and [`fit`] refuses a raster that would
+//! exceed the caller's limit ([`default_max_memory`]: half the machine's
+//! RAM).
+
+#![deny(missing_docs)]
+
+pub mod meminfo;
+pub mod memory;
+pub mod size;
+
+#[cfg(test)]
+mod tests;
+
+use glam::DVec3;
+use rrt_core::geometry::Point;
+use rrt_core::object_table as table;
+use rrt_core::raster::MAX_AXIS;
+
+pub use self::meminfo::{default_max_memory, parse_meminfo, total_memory};
+pub use self::memory::{Bytes, Dims, MemoryEstimate, estimate_memory};
+pub use self::size::{DEFAULT_MARGIN, frame};
+
+use crate::frame::RasterFrame;
+use crate::scene::{Object, Scene, SourceLoc};
+use crate::shape::{Shape, Surface, Unfit};
+use crate::world::Bounds;
+
+/// How to fit the raster.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Voxels along the longest axis (1 to 65536).
+    pub raster: u32,
+    /// World box to fill instead of the geometry's bounds (used exactly,
+    /// without margin).
+    pub bounds: Option<Bounds>,
+    /// Voxels of margin around computed bounds on every side.
+    pub margin: u32,
+    /// Refuse rasters whose estimated memory exceeds this many bytes.
+    pub max_memory: u64,
+    /// Count sphere interiors in the memory estimate (a voxelizer that
+    /// fills solids); surfaces are always counted.
+    pub solid_spheres: bool,
+}
+
+impl FitOptions {
+    /// `raster` voxels along the longest axis, computed bounds with the
+    /// default margin, half the machine's memory as the limit, solid
+    /// spheres counted.
+    #[must_use]
+    pub fn new(raster: u32) -> Self {
+        Self {
+            raster,
+            bounds: None,
+            margin: DEFAULT_MARGIN,
+            max_memory: default_max_memory(),
+            solid_spheres: true,
+        }
+    }
+}
+
+/// Why a raster cannot be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FitError {
+    /// `raster N` out of range.
+    #[error("raster {0}: expected 1 to {MAX_AXIS} voxels along the longest axis")]
+    RasterSize(u32),
+    /// `raster N` leaves nothing inside the margins.
+    #[error("raster {raster}: too small for a margin of {margin} voxels on each side; use at least {}", 2 * u64::from(*margin) + 1)]
+    RasterBelowMargin {
+        /// The raster size.
+        raster: u32,
+        /// The margin.
+        margin: u32,
+    },
+    /// Explicit bounds that are not a box.
+    #[error("bounds {min} to {max}: expected finite corners with min < max on every axis")]
+    BadBounds {
+        /// Lowest corner.
+        min: DVec3,
+        /// Highest corner.
+        max: DVec3,
+    },
+    /// The geometry has no extent (or is not finite).
+    #[error("{file}: the geometry's bounds {min} to {max} have no size to fit a raster to")]
+    NoExtent {
+        /// The scene file.
+        file: String,
+        /// Lowest corner.
+        min: DVec3,
+        /// Highest corner.
+        max: DVec3,
+    },
+    /// The estimated memory exceeds the limit.
+    #[error("raster {dims}: needs about {} ({estimate}), more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(estimate.total()), Bytes(*limit))]
+    TooMuchMemory {
+        /// Voxels per axis, e.g. `1024×1024×87`.
+        dims: Dims,
+        /// The estimate.
+        estimate: MemoryEstimate,
+        /// The limit in bytes.
+        limit: u64,
+    },
+    /// A light or object lies too far from the raster for fixed point.
+    #[error("{loc}: {what} lies more than 2^31 voxels from the raster")]
+    OutOfRange {
+        /// Where it is defined.
+        loc: SourceLoc,
+        /// What it is.
+        what: &'static str,
+    },
+}
+
+/// One object of the object table: its exact world geometry and, made of
+/// it, the core's fixed-point geometry in the raster.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedObject {
+    /// The world geometry (what intersection verification intersects).
+    pub shape: Shape,
+    /// The core's object-table entry: the fixed-point geometry the
+    /// voxelizer draws and the light pass reads.
+    pub entry: table::Shape,
+    /// Index into `Scene::materials`.
+    pub material: usize,
+    /// What the scene calls it (`sphere`, `cone`, `polygon`), for messages.
+    pub kind: &'static str,
+    /// Where the scene object is defined.
+    pub loc: SourceLoc,
+}
+
+/// A light in fixed-point raster coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FittedLight {
+    /// Position in fixed units (anywhere within [`MAX_FIXED`](crate::frame::MAX_FIXED)).
+    pub position: Point,
+    /// Colour (white if the file gives none).
+    pub colour: DVec3,
+}
+
+/// Objects left out of the object table.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Dropped {
+    /// Triangles and cones that have no area once in fixed point.
+    pub degenerate: usize,
+    /// Objects entirely outside explicit bounds.
+    pub outside: usize,
+}
+
+/// A scene fitted to a raster.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fitted {
+    /// The mapping between world and raster.
+    pub frame: RasterFrame,
+    /// The object table: spheres, then cones, then polygon triangles, each
+    /// in file order.
+    pub objects: Vec<FittedObject>,
+    /// Lights in file order.
+    pub lights: Vec<FittedLight>,
+    /// The memory estimate that was checked.
+    pub memory: MemoryEstimate,
+    /// What was left out.
+    pub dropped: Dropped,
+}
+
+/// Fits a raster to `scene`, checks the memory estimate, and converts the
+/// geometry and lights to fixed point.
+///
+/// # Errors
+/// [`FitError`]: an absurd raster size, bad explicit bounds, geometry
+/// without extent, an estimate above `opts.max_memory`, or a light or
+/// object too far from the raster.
+pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
+    let frame = frame(scene, opts)?;
+    let memory = estimate_memory(scene, &frame, opts.solid_spheres);
+    if memory.total() > opts.max_memory {
+        return Err(FitError::TooMuchMemory {
+            dims: Dims(frame.dims()),
+            estimate: memory,
+            limit: opts.max_memory,
+        });
+    }
+    let mut table = Table {
+        frame: &frame,
+        world: frame.world_bounds(),
+        objects: Vec::with_capacity(
+            scene.spheres.len() + scene.cones.len() + scene.triangle_count() + scene.tori.len(),
+        ),
+        dropped: Dropped::default(),
+    };
+    table.add_all(&scene.spheres)?;
+    table.add_all(&scene.cones)?;
+    for p in &scene.polygons {
+        if table.outside(scene.polygon_bounds(p)) {
+            table.dropped.outside += p.count.saturating_sub(2);
+            continue;
+        }
+        for t in scene.polygon_triangles(p) {
+            table.add(t, p.material, "polygon", &p.loc)?;
+        }
+    }
+    table.add_all(&scene.tori)?;
+    let lights = scene
+        .lights
+        .iter()
+        .map(|l| {
+            Ok(FittedLight {
+                position: frame.to_fixed(l.position).ok_or(FitError::OutOfRange {
+                    loc: l.loc.clone(),
+                    what: "light",
+                })?,
+                colour: l.rgb(),
+            })
+        })
+        .collect::<Result<_, FitError>>()?;
+    let Table {
+        objects, dropped, ..
+    } = table;
+    Ok(Fitted {
+        frame,
+        objects,
+        lights,
+        memory,
+        dropped,
+    })
+}
+
+/// The object table as [`fit`] fills it.
+struct Table<'f> {
+    frame: &'f RasterFrame,
+    /// The raster's world box.
+    world: Bounds,
+    objects: Vec<FittedObject>,
+    dropped: Dropped,
+}
+
+impl Table<'_> {
+    /// Whether world box `b` lies entirely outside the raster.
+    fn outside(&self, b: Bounds) -> bool {
+        b.max.cmplt(self.world.min).any() || b.min.cmpgt(self.world.max).any()
+    }
+
+    /// Adds `shape` of a scene object (`kind` at `loc`), or counts it as
+    /// dropped when nothing of it is left in fixed point.
+    fn add<S: Surface>(
+        &mut self,
+        shape: S,
+        material: usize,
+        kind: &'static str,
+        loc: &SourceLoc,
+    ) -> Result<(), FitError> {
+        match shape.to_fixed(self.frame) {
+            Ok(fixed) => self.objects.push(FittedObject {
+                shape: shape.into(),
+                entry: S::entry(fixed),
+                material,
+                kind,
+                loc: loc.clone(),
+            }),
+            Err(Unfit::Degenerate) => self.dropped.degenerate += 1,
+            Err(Unfit::OutOfRange) => {
+                return Err(FitError::OutOfRange {
+                    loc: loc.clone(),
+                    what: kind,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds every object of `list` that does not lie outside the raster.
+    fn add_all<S: Surface>(&mut self, list: &[Object<S>]) -> Result<(), FitError> {
+        for o in list {
+            if self.outside(o.shape.bounds()) {
+                self.dropped.outside += 1;
+                continue;
+            }
+            self.add(o.shape, o.material, S::KIND, &o.loc)?;
+        }
+        Ok(())
+    }
+}
