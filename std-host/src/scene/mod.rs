@@ -22,13 +22,16 @@
 
 #![deny(missing_docs)]
 
+pub mod bezier;
 pub mod bpt;
-mod error;
-mod loc;
+#[cfg(any(test, feature = "check"))]
+mod check;
+pub(crate) mod error;
+pub(crate) mod loc;
 pub mod nff;
 pub mod obj;
 pub mod objects;
-mod text;
+pub(crate) mod text;
 pub mod toml;
 
 use std::collections::BTreeMap;
@@ -39,6 +42,8 @@ use glam::DVec3;
 use crate::shape::{Cone, Primitive, Sphere, Torus, Triangle};
 use crate::world::Bounds;
 
+#[cfg(any(test, feature = "check"))]
+pub use check::check_scene;
 pub use error::{Found, SceneError};
 pub use loc::SourceLoc;
 pub use nff::ParseOptions;
@@ -394,75 +399,4 @@ impl Scene {
         }
         b
     }
-}
-
-/// Checks the guarantees documented on [`Scene`]; for tests and fuzzing.
-///
-/// # Errors
-/// A description of the first broken guarantee.
-#[cfg(any(test, feature = "check"))]
-pub fn check_scene(s: &Scene) -> Result<(), String> {
-    let finite = |v: DVec3, what: &str| {
-        if v.is_finite() {
-            Ok(())
-        } else {
-            Err(format!("{what} not finite: {v}"))
-        }
-    };
-    if s.materials.is_empty() {
-        return Err("no materials".into());
-    }
-    if s.vertices.len() != s.normals.len() {
-        return Err("normals not parallel to vertices".into());
-    }
-    if s.has_no_objects() {
-        return Err("no objects".into());
-    }
-    let v = &s.view;
-    finite(v.from, "from")?;
-    finite(v.at, "at")?;
-    finite(v.up, "up")?;
-    if !(v.angle > 0.0 && v.angle < 180.0) || v.resolution.contains(&0) {
-        return Err(format!("bad view {v:?}"));
-    }
-    if (v.at - v.from).cross(v.up).length_squared() == 0.0 {
-        return Err("degenerate view".into());
-    }
-    finite(s.background, "background")?;
-    for l in &s.lights {
-        finite(l.position, "light")?;
-        finite(l.rgb(), "light colour")?;
-    }
-    for m in &s.materials {
-        finite(m.colour, "material colour")?;
-        let ok = [m.kd, m.ks, m.shine, m.transmittance, m.ior]
-            .iter()
-            .all(|x| x.is_finite() && *x >= 0.0);
-        if !ok || m.transmittance > 1.0 || (m.transmittance > 0.0 && m.ior <= 0.0) {
-            return Err(format!("bad material {m:?}"));
-        }
-    }
-    let nm = s.materials.len();
-    for o in &s.spheres {
-        objects::check_object(o, nm)?;
-    }
-    for o in &s.cones {
-        objects::check_object(o, nm)?;
-    }
-    for o in &s.tori {
-        objects::check_object(o, nm)?;
-    }
-    for p in &s.polygons {
-        if p.material >= nm || p.count < 3 || s.vertices.get(p.range()).is_none() {
-            return Err(format!("bad polygon {p:?}"));
-        }
-        for i in p.range() {
-            finite(s.vertices[i], "vertex")?;
-            let n = s.normals[i];
-            if p.patch && n.try_normalize().is_none() {
-                return Err(format!("bad patch normal {n}"));
-            }
-        }
-    }
-    objects::check(s)
 }

@@ -9,11 +9,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use rrt_core::csg::CsgNode;
-#[cfg(any(test, feature = "check"))]
-use rrt_core::csg::MAX_NODES;
 
-#[cfg(any(test, feature = "check"))]
-use super::Scene;
 use super::SourceLoc;
 use crate::shape::{Cone, Cuboid, Primitive, SolidPrimitive, Sphere, Torus};
 use crate::texture::{AnyTexture, Blend};
@@ -244,90 +240,4 @@ pub struct SceneTexture {
     pub blend: Blend,
     /// Where it is defined.
     pub loc: SourceLoc,
-}
-
-#[cfg(any(test, feature = "check"))]
-fn finite(v: DVec3, what: &str) -> Result<(), String> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(format!("{what} not finite: {v}"))
-    }
-}
-
-#[cfg(any(test, feature = "check"))]
-fn positive(x: f64) -> bool {
-    x > 0.0 && x.is_finite()
-}
-
-/// An object's material index and its primitive's invariants (part of
-/// [`super::check_scene`]).
-#[cfg(any(test, feature = "check"))]
-pub(crate) fn check_object<S: Primitive + std::fmt::Debug>(
-    o: &super::Object<S>,
-    materials: usize,
-) -> Result<(), String> {
-    if o.material >= materials {
-        return Err(format!(
-            "{}: material {} of {materials}",
-            S::KIND,
-            o.material
-        ));
-    }
-    o.shape
-        .validate()
-        .map_err(|e| format!("bad {} {:?}: {e}", S::KIND, o.shape))
-}
-
-/// The guarantees of [`Scene`] about the objects of this module (part of
-/// [`super::check_scene`]).
-#[cfg(any(test, feature = "check"))]
-pub(crate) fn check(s: &Scene) -> Result<(), String> {
-    let nm = s.materials.len();
-    let mat = |m: usize, what: &str| {
-        if m < nm {
-            Ok(())
-        } else {
-            Err(format!("{what}: material {m} of {nm}"))
-        }
-    };
-    for v in &s.volumes {
-        mat(v.material, "volume")?;
-        v.data.classifier.validate().map_err(|e| e.to_string())?;
-    }
-    for v in &s.voxes {
-        mat(v.material, "vox")?;
-        finite(v.position, "vox position")?;
-        if !positive(v.cell) {
-            return Err(format!("vox cell {}", v.cell));
-        }
-    }
-    for c in &s.csgs {
-        if c.nodes.is_empty() || c.nodes.len() > MAX_NODES {
-            return Err(format!("CSG tree of {} nodes", c.nodes.len()));
-        }
-        for (i, n) in c.nodes.iter().enumerate() {
-            let ok = match *n {
-                CsgNode::Leaf(l) => usize::from(l) < c.leaves.len(),
-                CsgNode::Union(a, b) | CsgNode::Intersection(a, b) | CsgNode::Difference(a, b) => {
-                    usize::from(a) < i && usize::from(b) < i
-                }
-            };
-            if !ok {
-                return Err(format!("CSG node {i}: {n:?}"));
-            }
-        }
-        for l in &c.leaves {
-            mat(l.material, "CSG leaf")?;
-            l.shape
-                .validate()
-                .map_err(|e| format!("bad solid {:?}: {e}", l.shape))?;
-        }
-    }
-    for (&m, &t) in &s.material_textures {
-        if m >= nm || t >= s.textures.len() {
-            return Err(format!("material {m} → texture {t}"));
-        }
-    }
-    Ok(())
 }

@@ -1,0 +1,195 @@
+//! The builder: a parsed TOML document into a [`Scene`], every value
+//! checked, every error located at its key.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use ::toml::Spanned;
+use glam::DVec3;
+
+use super::Options;
+use super::schema::{Doc, V3};
+use crate::scene::error::SceneError;
+use crate::scene::loc::SourceLoc;
+use crate::scene::objects::SceneVolume;
+use crate::scene::text::byte_loc;
+use crate::scene::{Light, Material, Polygon, Scene, View};
+
+pub(super) struct Builder<'t> {
+    pub(super) file: Arc<str>,
+    pub(super) text: &'t str,
+    pub(super) dir: PathBuf,
+    pub(super) opts: Options,
+    pub(super) materials: BTreeMap<String, usize>,
+    pub(super) volumes: BTreeMap<String, SceneVolume>,
+}
+
+pub(super) fn finite3(v: V3) -> Option<DVec3> {
+    let d = DVec3::from(v);
+    d.is_finite().then_some(d)
+}
+
+impl Builder<'_> {
+    pub(super) fn loc(&self, span: std::ops::Range<usize>) -> SourceLoc {
+        byte_loc(&self.file, self.text.as_bytes(), span.start)
+    }
+
+    pub(super) fn err(
+        &self,
+        span: std::ops::Range<usize>,
+        key: &str,
+        msg: impl Into<String>,
+    ) -> SceneError {
+        SceneError::Toml {
+            loc: self.loc(span),
+            key: key.to_owned(),
+            msg: msg.into(),
+        }
+    }
+
+    pub(super) fn vec3(
+        &self,
+        span: &std::ops::Range<usize>,
+        key: &str,
+        v: V3,
+    ) -> Result<DVec3, SceneError> {
+        finite3(v).ok_or_else(|| self.err(span.clone(), key, "expected finite numbers"))
+    }
+
+    pub(super) fn path(
+        &self,
+        p: &Spanned<String>,
+        key: &str,
+    ) -> Result<(PathBuf, String), SceneError> {
+        if !self.opts.read_files {
+            return Err(self.err(p.span(), key, "files are not read here"));
+        }
+        let full = self.dir.join(p.get_ref());
+        if !full.is_file() {
+            return Err(self.err(p.span(), key, format!("{}: no such file", full.display())));
+        }
+        let shown = full.to_string_lossy().into_owned();
+        Ok((full, shown))
+    }
+
+    pub(super) fn build(mut self, doc: &Doc) -> Result<Scene, SceneError> {
+        let cs = doc.camera.span();
+        let c = doc.camera.get_ref();
+        let view = View {
+            from: self.vec3(&cs, "camera.from", c.from)?,
+            at: self.vec3(&cs, "camera.at", c.at)?,
+            up: self.vec3(&cs, "camera.up", c.up)?,
+            angle: c.angle,
+            hither: c.hither,
+            resolution: c.resolution,
+            loc: self.loc(cs.clone()),
+        };
+        if view.from == view.at {
+            return Err(self.err(cs, "camera.at", "equals camera.from"));
+        }
+        if view.up.cross(view.at - view.from).length_squared() == 0.0 {
+            return Err(self.err(cs, "camera.up", "parallel to the view direction"));
+        }
+        if !(view.angle > 0.0 && view.angle < 180.0) {
+            return Err(self.err(cs, "camera.angle", "expected 0 < angle < 180"));
+        }
+        if !view.hither.is_finite() {
+            return Err(self.err(cs, "camera.hither", "expected a finite number"));
+        }
+        if view.resolution.contains(&0) || view.resolution.iter().any(|&r| r > 1 << 15) {
+            return Err(self.err(cs, "camera.resolution", "expected 1 to 32768 pixels"));
+        }
+        let mut scene = Scene::empty(Arc::clone(&self.file), view);
+        if let Some(b) = doc.background {
+            scene.background = finite3(b)
+                .filter(|b| b.cmpge(DVec3::ZERO).all() && b.cmple(DVec3::ONE).all())
+                .ok_or_else(|| {
+                    self.err(0..0, "background", "expected colour channels in [0, 1]")
+                })?;
+        }
+        for l in &doc.light {
+            let s = l.span();
+            let d = l.get_ref();
+            scene.lights.push(Light {
+                position: self.vec3(&s, "light.position", d.position)?,
+                colour: d
+                    .colour
+                    .map(|c| self.vec3(&s, "light.colour", c))
+                    .transpose()?,
+                loc: self.loc(s),
+            });
+        }
+        for (name, m) in &doc.material {
+            self.material(&mut scene, name, m)?;
+        }
+        for (name, v) in &doc.volume {
+            let sv = self.volume(name, v)?;
+            self.volumes.insert(name.clone(), sv);
+        }
+        for o in &doc.object {
+            self.object(&mut scene, doc, o)?;
+        }
+        if scene.has_no_objects() {
+            return Err(SceneError::NoObjects {
+                file: Arc::clone(&self.file),
+            });
+        }
+        if scene.materials.is_empty() {
+            scene.materials.push(Material::DEFAULT);
+        }
+        Ok(scene)
+    }
+
+    pub(super) fn material_of(
+        &self,
+        m: Option<&Spanned<String>>,
+        at: &std::ops::Range<usize>,
+        key: &str,
+    ) -> Result<usize, SceneError> {
+        let Some(m) = m else {
+            return Err(self.err(at.clone(), key, "missing: every object names a material"));
+        };
+        self.materials.get(m.get_ref()).copied().ok_or_else(|| {
+            self.err(
+                m.span(),
+                key,
+                format!("no [material.{}] in this scene", m.get_ref()),
+            )
+        })
+    }
+
+    pub(super) fn push_polygon(
+        &self,
+        scene: &mut Scene,
+        vertices: &[DVec3],
+        normals: Option<&[DVec3]>,
+        material: usize,
+        loc: &SourceLoc,
+        span: &std::ops::Range<usize>,
+    ) -> Result<(), SceneError> {
+        if scene.vertices.len().saturating_add(vertices.len()) > self.opts.max_vertices {
+            return Err(self.err(
+                span.clone(),
+                "object",
+                format!("more than {} vertices in the scene", self.opts.max_vertices),
+            ));
+        }
+        let first = scene.vertices.len();
+        scene.vertices.extend_from_slice(vertices);
+        match normals {
+            Some(n) => scene.normals.extend_from_slice(n),
+            None => scene
+                .normals
+                .extend(std::iter::repeat_n(DVec3::ZERO, vertices.len())),
+        }
+        scene.polygons.push(Polygon {
+            first,
+            count: vertices.len(),
+            patch: normals.is_some(),
+            material,
+            loc: loc.clone(),
+        });
+        Ok(())
+    }
+}

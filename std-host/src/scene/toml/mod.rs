@@ -1,0 +1,143 @@
+//! TOML scenes: what NFF cannot say.
+//!
+//! A TOML scene has a `[camera]`, `[[light]]`s, named `[material.NAME]`s
+//! (optionally with a `texture`), named volume data `[volume.NAME]`, named
+//! CSG leaves `[solid.NAME]` and a list of `[[object]]`s. Each object has
+//! exactly one shape key and a `material` name:
+//!
+//! | key | what |
+//! | --- | --- |
+//! | `sphere = { centre, radius }` | NFF `s` |
+//! | `cone = { base, base_radius, apex, apex_radius, capped }` | NFF `c` (open); `capped = true` makes it a closed solid |
+//! | `polygon = [[x, y, z], …]` | NFF `p` |
+//! | `box = { min, max }` | an axis-aligned box (six polygons) |
+//! | `torus = { centre, axis, major, minor }` | a torus |
+//! | `bezier = { file, steps }` | the bicubic patches of a `.bpt` file, each tessellated into `steps × steps` quads with the patch's exact normals (NFF `pp`) |
+//! | `mesh = { file, smooth }` | an OBJ triangle mesh (`tobj`); `smooth` interpolates the file's (or averaged) vertex normals |
+//! | `nff = "file.nff"` | every object, light and material of an NFF file (its view is ignored) |
+//! | `volume = "NAME"` | a volume of `[volume.NAME]`: its iso-surface, gray-level normals |
+//! | `vox = { file, position, cell }` | a MagicaVoxel model |
+//! | `csg = { difference = ["a", { union = ["b", "c"] }] }` | a CSG tree over `[solid.NAME]`s |
+//!
+//! Objects may also give `transform = { translate, scale, rotate_x, rotate_y, rotate_z }`
+//! for meshes, Bézier patches and polygons (applied as scale, then the
+//! rotations in x, y, z order, in degrees, then the translation).
+//!
+//! Paths are relative to the scene file's directory. A CSG tree's leaves
+//! are names of `[solid.NAME]` tables, which cannot refer to CSG trees, so
+//! a tree has no cycles by construction. A volume may take part in a CSG
+//! tree only as the left operand of a difference or intersection whose
+//! other operand has no volume (the paper's box cut out of the head): the
+//! volume's voxels inside (or outside) the other operand count as
+//! transparent before its boundary is found.
+//!
+//! # Errors
+//! Unknown keys (`deny_unknown_fields`), wrong types, missing keys, bad
+//! values and the errors of the files a scene refers to are
+//! [`SceneError::Toml`] naming the scene file, line and column (from
+//! toml's spans) and the key. Sizes are checked before anything is
+//! allocated: file sizes against their readers' limits, volume and vox
+//! dimensions against [`Options`].
+
+mod build;
+mod csg;
+mod material;
+mod object;
+mod schema;
+mod volume;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use self::build::Builder;
+use self::schema::Doc;
+use super::Scene;
+use super::error::SceneError;
+use super::text::{byte_loc, read_text};
+
+/// Largest TOML scene file read, in bytes.
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// Limits of a TOML scene, checked before allocating.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// Limits for each volume's samples.
+    pub volume: crate::volume::Limits,
+    /// Most `.vox` file bytes.
+    pub max_vox_bytes: u64,
+    /// Most vertices over all polygons (meshes, patches, NFF includes).
+    pub max_vertices: usize,
+    /// Most `steps` per Bézier patch side.
+    pub max_patch_steps: u32,
+    /// Whether files may be read at all (the fuzz target parses without).
+    pub read_files: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            volume: crate::volume::Limits::default(),
+            max_vox_bytes: 256 << 20,
+            max_vertices: 1 << 26,
+            max_patch_steps: 64,
+            read_files: true,
+        }
+    }
+}
+
+/// Reads the TOML scene at `path`.
+///
+/// # Errors
+/// [`SceneError`] naming the file, and the line, column and key for
+/// everything wrong inside it (module docs).
+pub fn load(path: &Path, opts: &Options) -> Result<Scene, SceneError> {
+    let name: Arc<str> = Arc::from(path.to_string_lossy().as_ref());
+    let text = read_text(path, &name, MAX_FILE_BYTES)?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse(&name, &text, &dir, opts)
+}
+
+/// Parses TOML scene text; `file` names it in messages, relative paths are
+/// taken from `dir`.
+///
+/// # Errors
+/// As [`load`].
+pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene, SceneError> {
+    let file: Arc<str> = Arc::from(file);
+    let doc: Doc = ::toml::from_str(text).map_err(|e| {
+        let at = e.span().map_or(0, |s| s.start);
+        SceneError::Toml {
+            loc: byte_loc(&file, text.as_bytes(), at),
+            key: key_before(text, at),
+            msg: e.message().trim().to_owned(),
+        }
+    })?;
+    Builder {
+        file,
+        text,
+        dir: dir.to_path_buf(),
+        opts: *opts,
+        materials: BTreeMap::new(),
+        volumes: BTreeMap::new(),
+    }
+    .build(&doc)
+}
+
+/// The key whose value starts at byte `at` (`key = value` on that line),
+/// or empty: names the key of a wrong-typed value, which toml's message
+/// does not.
+fn key_before(text: &str, at: usize) -> String {
+    let Some(before) = text.get(..at) else {
+        return String::new();
+    };
+    let line = before.rsplit('\n').next().unwrap_or("");
+    let Some(lhs) = line.trim_end().strip_suffix('=') else {
+        return String::new();
+    };
+    let lhs = lhs.trim_end();
+    let start = lhs
+        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.'))
+        .map_or(0, |i| i + 1);
+    lhs.get(start..).unwrap_or("").to_owned()
+}

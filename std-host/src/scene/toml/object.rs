@@ -1,0 +1,393 @@
+//! Objects: an `[[object]]`'s one shape key into the scene's objects, with
+//! its material, location and (for polygons, patches and meshes)
+//! transform.
+
+use std::ops::Range;
+use std::sync::Arc;
+
+use ::toml::Spanned;
+use glam::{DAffine3, DQuat, DVec3};
+
+use super::build::Builder;
+use super::csg::single_leaf;
+use super::schema::{
+    BezierDef, BoxDef, ConeDef, Doc, MeshDef, ObjectDef, SHAPE_KEYS, ShapeDef, SphereDef, TorusDef,
+    TransformDef, V3, VoxDef,
+};
+use crate::scene::error::SceneError;
+use crate::scene::loc::SourceLoc;
+use crate::scene::objects::{Solid, VolumeObject, VoxObject};
+use crate::scene::{Object, Scene, bezier, bpt, nff, obj};
+use crate::shape::Sphere;
+
+/// What every shape of an object gets: where it is defined, its material
+/// and its transform.
+struct At {
+    span: Range<usize>,
+    loc: SourceLoc,
+    material: usize,
+    transform: DAffine3,
+}
+
+impl Builder<'_> {
+    pub(super) fn object(
+        &self,
+        scene: &mut Scene,
+        doc: &Doc,
+        o: &Spanned<ObjectDef>,
+    ) -> Result<(), SceneError> {
+        let s = o.span();
+        let d = o.get_ref();
+        let [shape] = d.shapes()[..] else {
+            return Err(self.err(s, "object", format!("expected exactly one of {SHAPE_KEYS}")));
+        };
+        let transform = match &d.transform {
+            None => DAffine3::IDENTITY,
+            Some(t) => self.transform(t, &s)?,
+        };
+        let takes_transform = matches!(
+            shape,
+            ShapeDef::Polygon(_) | ShapeDef::Bezier(_) | ShapeDef::Mesh(_)
+        );
+        if d.transform.is_some() && !takes_transform {
+            return Err(self.err(
+                s,
+                "object.transform",
+                "only polygons, bezier patches and meshes take a transform",
+            ));
+        }
+        let material = match shape {
+            ShapeDef::Nff(n) => {
+                if d.material.is_some() {
+                    return Err(self.err(
+                        s,
+                        "object.material",
+                        "an NFF file brings its own materials",
+                    ));
+                }
+                return self.nff(scene, n, &s);
+            }
+            ShapeDef::Csg(c) => return self.csg(scene, doc, c, d.material.as_ref(), &s),
+            _ => self.material_of(d.material.as_ref(), &s, "object.material")?,
+        };
+        let at = At {
+            loc: self.loc(s.clone()),
+            span: s,
+            material,
+            transform,
+        };
+        match shape {
+            ShapeDef::Sphere(sp) => self.sphere(scene, sp, at),
+            ShapeDef::Cone(c) => self.cone_object(scene, c, at),
+            ShapeDef::Polygon(p) => self.polygon(scene, p, &at),
+            ShapeDef::Box(b) => self.cuboid(scene, b, &at),
+            ShapeDef::Torus(t) => self.torus_object(scene, t, at),
+            ShapeDef::Bezier(b) => self.bezier(scene, b, &at),
+            ShapeDef::Mesh(m) => self.mesh(scene, m, &at),
+            ShapeDef::Volume(v) => self.volume_object(scene, v, at),
+            ShapeDef::Vox(v) => self.vox(scene, v, at),
+            ShapeDef::Nff(_) | ShapeDef::Csg(_) => Ok(()),
+        }
+    }
+
+    /// Scale, then the rotations in x, y, z order (degrees), then the
+    /// translation.
+    fn transform(&self, t: &TransformDef, s: &Range<usize>) -> Result<DAffine3, SceneError> {
+        let tr = self.vec3(s, "object.transform.translate", t.translate)?;
+        let angles_ok = [t.rotate_x, t.rotate_y, t.rotate_z]
+            .iter()
+            .all(|a| a.is_finite());
+        if !(t.scale.is_finite() && t.scale > 0.0 && angles_ok) {
+            return Err(self.err(
+                s.clone(),
+                "object.transform",
+                "expected scale > 0 and finite angles",
+            ));
+        }
+        let q = DQuat::from_rotation_z(t.rotate_z.to_radians())
+            * DQuat::from_rotation_y(t.rotate_y.to_radians())
+            * DQuat::from_rotation_x(t.rotate_x.to_radians());
+        Ok(DAffine3::from_scale_rotation_translation(
+            DVec3::splat(t.scale),
+            q,
+            tr,
+        ))
+    }
+
+    fn sphere(&self, scene: &mut Scene, sp: &SphereDef, at: At) -> Result<(), SceneError> {
+        let centre = self.vec3(&at.span, "object.sphere.centre", sp.centre)?;
+        if !(sp.radius.is_finite() && sp.radius > 0.0) {
+            return Err(self.err(at.span, "object.sphere.radius", "expected a number > 0"));
+        }
+        scene.spheres.push(Object {
+            shape: Sphere {
+                centre,
+                radius: sp.radius,
+            },
+            material: at.material,
+            loc: at.loc,
+        });
+        Ok(())
+    }
+
+    /// An open cone (NFF `c`), or a capped one: a one-solid CSG tree.
+    fn cone_object(&self, scene: &mut Scene, c: &ConeDef, at: At) -> Result<(), SceneError> {
+        let shape = self.cone(c, &at.span, "object.cone")?;
+        if c.capped {
+            scene
+                .csgs
+                .push(single_leaf(Solid::Cone(shape), at.material, at.loc));
+        } else {
+            scene.cones.push(Object {
+                shape,
+                material: at.material,
+                loc: at.loc,
+            });
+        }
+        Ok(())
+    }
+
+    fn polygon(&self, scene: &mut Scene, p: &[V3], at: &At) -> Result<(), SceneError> {
+        let s = &at.span;
+        if p.len() < 3 || p.len() > 1 << 16 {
+            return Err(self.err(s.clone(), "object.polygon", "expected 3 to 65536 vertices"));
+        }
+        let v = p
+            .iter()
+            .map(|&q| {
+                self.vec3(s, "object.polygon", q)
+                    .map(|q| at.transform.transform_point3(q))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        self.push_polygon(scene, &v, None, at.material, &at.loc, s)
+    }
+
+    /// A box as its six faces.
+    fn cuboid(&self, scene: &mut Scene, b: &BoxDef, at: &At) -> Result<(), SceneError> {
+        let s = &at.span;
+        let lo = self.vec3(s, "object.box.min", b.min)?;
+        let hi = self.vec3(s, "object.box.max", b.max)?;
+        if !lo.cmplt(hi).all() {
+            return Err(self.err(s.clone(), "object.box", "expected min < max on every axis"));
+        }
+        for face in box_faces(lo, hi) {
+            self.push_polygon(scene, &face, None, at.material, &at.loc, s)?;
+        }
+        Ok(())
+    }
+
+    fn torus_object(&self, scene: &mut Scene, t: &TorusDef, at: At) -> Result<(), SceneError> {
+        scene.tori.push(Object {
+            shape: self.torus(t, &at.span, "object.torus")?,
+            material: at.material,
+            loc: at.loc,
+        });
+        Ok(())
+    }
+
+    /// The patches of a `.bpt` file, each tessellated into `steps × steps`
+    /// polygonal patches.
+    fn bezier(&self, scene: &mut Scene, b: &BezierDef, at: &At) -> Result<(), SceneError> {
+        let s = &at.span;
+        if b.steps == 0 || b.steps > self.opts.max_patch_steps {
+            return Err(self.err(
+                s.clone(),
+                "object.bezier.steps",
+                format!("expected 1 to {}", self.opts.max_patch_steps),
+            ));
+        }
+        let (path, shown) = self.path(&b.file, "object.bezier.file")?;
+        let patches = bpt::load(&path, &shown)
+            .map_err(|e| self.err(b.file.span(), "object.bezier.file", e.to_string()))?;
+        let per = (b.steps as usize + 1).pow(2);
+        if patches
+            .len()
+            .saturating_mul(per)
+            .saturating_add(scene.vertices.len())
+            > self.opts.max_vertices
+        {
+            return Err(self.err(s.clone(), "object.bezier", "too many vertices"));
+        }
+        for p in &patches {
+            let c = p.map(|row| row.map(|q| at.transform.transform_point3(q)));
+            for (quad, normals) in bezier::tessellate(&c, b.steps) {
+                self.push_polygon(scene, &quad, Some(&normals), at.material, &at.loc, s)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// An OBJ mesh's triangles, flat or with the file's (or averaged)
+    /// vertex normals.
+    fn mesh(&self, scene: &mut Scene, m: &MeshDef, at: &At) -> Result<(), SceneError> {
+        let s = &at.span;
+        let transform = at.transform;
+        let (path, shown) = self.path(&m.file, "object.mesh.file")?;
+        let mesh = obj::load(&path, &shown)
+            .map_err(|e| self.err(m.file.span(), "object.mesh.file", e.to_string()))?;
+        if mesh
+            .triangles
+            .len()
+            .saturating_mul(3)
+            .saturating_add(scene.vertices.len())
+            > self.opts.max_vertices
+        {
+            return Err(self.err(s.clone(), "object.mesh", "too many vertices"));
+        }
+        let normals = if m.smooth {
+            Some(
+                mesh.normals
+                    .clone()
+                    .unwrap_or_else(|| obj::smooth_normals(&mesh)),
+            )
+        } else {
+            None
+        };
+        let pos: Vec<DVec3> = mesh
+            .positions
+            .iter()
+            .map(|&p| transform.transform_point3(p))
+            .collect();
+        for t in &mesh.triangles {
+            let idx = t.map(|i| i as usize);
+            let (Some(a), Some(b2), Some(c)) = (pos.get(idx[0]), pos.get(idx[1]), pos.get(idx[2]))
+            else {
+                return Err(self.err(s.clone(), "object.mesh", "index out of range"));
+            };
+            let n = normals.as_ref().map(|n| {
+                idx.map(|i| {
+                    let v = n.get(i).copied().unwrap_or(DVec3::ZERO);
+                    transform.transform_vector3(v).normalize_or_zero()
+                })
+            });
+            // A vertex without a usable normal: the flat triangle.
+            let n = n.filter(|n| n.iter().all(|v| v.length_squared() > 0.5));
+            self.push_polygon(
+                scene,
+                &[*a, *b2, *c],
+                n.as_ref().map(|n| &n[..]),
+                at.material,
+                &at.loc,
+                s,
+            )?;
+        }
+        Ok(())
+    }
+
+    fn volume_object(
+        &self,
+        scene: &mut Scene,
+        v: &Spanned<String>,
+        at: At,
+    ) -> Result<(), SceneError> {
+        let data = self.volumes.get(v.get_ref()).ok_or_else(|| {
+            self.err(
+                v.span(),
+                "object.volume",
+                format!("no [volume.{}] in this scene", v.get_ref()),
+            )
+        })?;
+        scene.volumes.push(VolumeObject {
+            data: data.clone(),
+            material: at.material,
+            loc: at.loc,
+        });
+        Ok(())
+    }
+
+    fn vox(&self, scene: &mut Scene, v: &VoxDef, at: At) -> Result<(), SceneError> {
+        let (path, _) = self.path(&v.file, "object.vox.file")?;
+        let size = std::fs::metadata(&path)
+            .map(|m| m.len())
+            .unwrap_or(u64::MAX);
+        if size > self.opts.max_vox_bytes {
+            return Err(self.err(
+                v.file.span(),
+                "object.vox.file",
+                format!(
+                    "{size} bytes, more than the limit of {}",
+                    self.opts.max_vox_bytes
+                ),
+            ));
+        }
+        let vox = crate::vox::read(&path)
+            .map_err(|e| self.err(v.file.span(), "object.vox.file", e.to_string()))?;
+        let position = self.vec3(&at.span, "object.vox.position", v.position)?;
+        if !(v.cell.is_finite() && v.cell > 0.0) {
+            return Err(self.err(at.span, "object.vox.cell", "expected a number > 0"));
+        }
+        scene.voxes.push(VoxObject {
+            vox: Arc::new(vox),
+            position,
+            cell: v.cell,
+            material: at.material,
+            loc: at.loc,
+        });
+        Ok(())
+    }
+
+    /// Every object, light and material of an NFF file (its view is
+    /// ignored).
+    fn nff(
+        &self,
+        scene: &mut Scene,
+        n: &Spanned<String>,
+        s: &Range<usize>,
+    ) -> Result<(), SceneError> {
+        let (path, _) = self.path(n, "object.nff")?;
+        let inc = nff::load(&path, &nff::ParseOptions::default())
+            .map_err(|e| self.err(n.span(), "object.nff", e.to_string()))?;
+        self.include(scene, inc, s)
+    }
+
+    fn include(
+        &self,
+        scene: &mut Scene,
+        inc: Scene,
+        s: &std::ops::Range<usize>,
+    ) -> Result<(), SceneError> {
+        if scene.vertices.len().saturating_add(inc.vertices.len()) > self.opts.max_vertices {
+            return Err(self.err(s.clone(), "object.nff", "too many vertices"));
+        }
+        let m0 = scene.materials.len();
+        let v0 = scene.vertices.len();
+        scene.materials.extend(inc.materials);
+        scene.lights.extend(inc.lights);
+        scene.vertices.extend(inc.vertices);
+        scene.normals.extend(inc.normals);
+        scene.spheres.extend(inc.spheres.into_iter().map(|mut o| {
+            o.material += m0;
+            o
+        }));
+        scene.cones.extend(inc.cones.into_iter().map(|mut o| {
+            o.material += m0;
+            o
+        }));
+        scene.polygons.extend(inc.polygons.into_iter().map(|mut o| {
+            o.material += m0;
+            o.first += v0;
+            o
+        }));
+        Ok(())
+    }
+}
+
+/// The six faces of a box, wound counter-clockwise seen from outside.
+fn box_faces(lo: DVec3, hi: DVec3) -> [[DVec3; 4]; 6] {
+    let p = |x: bool, y: bool, z: bool| {
+        DVec3::new(
+            if x { hi.x } else { lo.x },
+            if y { hi.y } else { lo.y },
+            if z { hi.z } else { lo.z },
+        )
+    };
+    let (f, t) = (false, true);
+    [
+        [p(f, f, f), p(f, t, f), p(t, t, f), p(t, f, f)], // z = lo
+        [p(f, f, t), p(t, f, t), p(t, t, t), p(f, t, t)], // z = hi
+        [p(f, f, f), p(t, f, f), p(t, f, t), p(f, f, t)], // y = lo
+        [p(f, t, f), p(f, t, t), p(t, t, t), p(t, t, f)], // y = hi
+        [p(f, f, f), p(f, f, t), p(f, t, t), p(f, t, f)], // x = lo
+        [p(t, f, f), p(t, t, f), p(t, t, t), p(t, f, t)], // x = hi
+    ]
+}

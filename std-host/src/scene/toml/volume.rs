@@ -1,0 +1,153 @@
+//! Volume data: NRRD and raw files and computed metaballs, classified and
+//! placed in the world.
+
+use std::sync::Arc;
+
+use ::toml::Spanned;
+use glam::DVec3;
+
+use super::build::Builder;
+use super::schema::VolumeDef;
+use crate::scene::error::SceneError;
+use crate::scene::objects::SceneVolume;
+use crate::volume::computed::{self, Metaball, Metaballs};
+use crate::volume::raw::{self, RawSpec};
+use crate::volume::{self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, SampleType};
+
+impl Builder<'_> {
+    pub(super) fn volume(
+        &self,
+        name: &str,
+        v: &Spanned<VolumeDef>,
+    ) -> Result<SceneVolume, SceneError> {
+        let s = v.span();
+        let d = v.get_ref();
+        let key = |k: &str| format!("volume.{name}.{k}");
+        let sources = usize::from(d.file.is_some())
+            + usize::from(d.raw.is_some())
+            + usize::from(d.metaballs.is_some());
+        if sources != 1 {
+            return Err(self.err(
+                s,
+                &key("file"),
+                "expected exactly one of file (NRRD), raw, metaballs",
+            ));
+        }
+        let data = if let Some(f) = &d.file {
+            let (path, _) = self.path(f, &key("file"))?;
+            volume::nrrd::read(&path, &self.opts.volume)
+                .map_err(|e| self.err(f.span(), &key("file"), e.to_string()))?
+        } else if let Some(r) = &d.raw {
+            let sample_type = match r.sample_type.as_str() {
+                "uint8" | "u8" => SampleType::U8,
+                "int16" | "i16" => SampleType::I16,
+                "uint16" | "u16" => SampleType::U16,
+                "float" | "f32" => SampleType::F32,
+                _ => {
+                    return Err(self.err(
+                        s,
+                        &key("raw.type"),
+                        "expected uint8, int16, uint16 or float",
+                    ));
+                }
+            };
+            let (path, _) = self.path(&r.file, &key("raw.file"))?;
+            let spec = RawSpec {
+                dims: r.dims,
+                sample_type,
+                endian: if r.big_endian {
+                    Endian::Big
+                } else {
+                    Endian::Little
+                },
+                grid: Grid::axis_aligned(r.spacing, DVec3::ZERO),
+                skip: r.skip,
+            };
+            raw::read(&path, &spec, &self.opts.volume)
+                .map_err(|e| self.err(r.file.span(), &key("raw"), e.to_string()))?
+        } else if let Some(m) = &d.metaballs {
+            let lo = self.vec3(&s, &key("metaballs.min"), m.min)?;
+            let hi = self.vec3(&s, &key("metaballs.max"), m.max)?;
+            let n = m.dims.map(|d| f64::from(d.max(2) - 1));
+            let spacing = [
+                (hi.x - lo.x) / n[0],
+                (hi.y - lo.y) / n[1],
+                (hi.z - lo.z) / n[2],
+            ];
+            let mut balls = Vec::with_capacity(m.balls.len().min(1024));
+            for b in &m.balls {
+                if !(b.iter().all(|x| x.is_finite()) && b[3] > 0.0) {
+                    return Err(self.err(
+                        s,
+                        &key("metaballs.balls"),
+                        "expected finite [x, y, z, radius > 0, strength]",
+                    ));
+                }
+                balls.push(Metaball {
+                    centre: DVec3::new(b[0], b[1], b[2]),
+                    radius: b[3],
+                    strength: b[4],
+                });
+            }
+            computed::sample(
+                &Metaballs(balls),
+                m.dims,
+                Grid::axis_aligned(spacing, lo),
+                &self.opts.volume,
+            )
+            .map_err(|e| self.err(s.clone(), &key("metaballs"), e.to_string()))?
+        } else {
+            return Err(self.err(s, &key("file"), "no data"));
+        };
+        let mut classifier = Classifier::iso(d.iso);
+        if let Some(o) = &d.opacity {
+            let ramp = Ramp::new(o.iter().map(|p| (p[0], p[1])).collect())
+                .map_err(|e| self.err(s.clone(), &key("opacity"), e.to_string()))?;
+            classifier = classifier.with_opacity(ramp);
+        }
+        if let Some(c) = &d.colours {
+            let mut pts = Vec::with_capacity(c.len().min(4096));
+            for p in c {
+                if !p.iter().all(|x| x.is_finite())
+                    || p[1..].iter().any(|&x| !(0.0..=1.0).contains(&x))
+                {
+                    return Err(self.err(
+                        s,
+                        &key("colours"),
+                        "expected [value, r, g, b] with channels in [0, 1]",
+                    ));
+                }
+                let ch = |x: f64| (x * 255.0).round() as u8;
+                pts.push((p[0], [ch(p[1]), ch(p[2]), ch(p[3])]));
+            }
+            let ramp = ColorRamp::new(pts)
+                .map_err(|e| self.err(s.clone(), &key("colours"), e.to_string()))?;
+            classifier = classifier.with_color(ramp);
+        }
+        classifier
+            .validate()
+            .map_err(|e| self.err(s.clone(), &key("iso"), e.to_string()))?;
+        let placement = match (&d.fit, d.translate, d.scale) {
+            (Some(b), None, None) => Placement::fit_into(
+                &data,
+                crate::world::Bounds {
+                    min: self.vec3(&s, &key("fit.min"), b.min)?,
+                    max: self.vec3(&s, &key("fit.max"), b.max)?,
+                },
+            ),
+            (None, t, sc) => Placement::new(
+                self.vec3(&s, &key("translate"), t.unwrap_or_default())?,
+                sc.unwrap_or(1.0),
+            ),
+            _ => {
+                return Err(self.err(s, &key("fit"), "give fit, or translate and scale, not both"));
+            }
+        }
+        .map_err(|e| self.err(s.clone(), &key("fit"), e.to_string()))?;
+        Ok(SceneVolume {
+            volume: Arc::new(data),
+            placement,
+            classifier,
+        })
+    }
+}
