@@ -704,6 +704,11 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     let obj_len = expect(4, m.objects.saturating_mul(OBJECT_LEN))?;
     let mat_len = expect(5, u64::from(m.materials) * MATERIAL_LEN)?;
     let light_len = expect(6, u64::from(m.lights) * LIGHT_LEN)?;
+    let section = |file: &mut File, k: usize, len: usize| -> Result<Vec<u8>, RasterFileError> {
+        let mut b = vec![0u8; len];
+        read_section(file, path, &h, k, &mut b)?;
+        Ok(b)
+    };
 
     let mut plane = Plane::zeroed(plane_len).map_err(|source| RasterFileError::Io {
         path: path.to_path_buf(),
@@ -711,84 +716,12 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         source,
     })?;
     read_section(&mut file, path, &h, 1, &mut plane)?;
-    let mut b = vec![0u8; dir_len];
-    read_section(&mut file, path, &h, 2, &mut b)?;
-    let directory: Vec<u32> = b
-        .chunks_exact(4)
-        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    drop(b);
+    let directory = directory_from(&section(&mut file, 2, dir_len)?);
     let records = read_records(&mut file, path, &h, rec_len)?;
-
-    let mut b = vec![0u8; mat_len];
-    read_section(&mut file, path, &h, 5, &mut b)?;
-    let materials: Vec<Material> = b
-        .chunks_exact(MATERIAL_LEN as usize)
-        .map(|chunk| {
-            let mut c = Cursor::new(chunk);
-            Material {
-                colour: c.vec(),
-                kd: c.f64(),
-                ks: c.f64(),
-                shine: c.f64(),
-                transmittance: c.f64(),
-                ior: c.f64(),
-                loc: None,
-            }
-        })
-        .collect();
-    for (i, mt) in materials.iter().enumerate() {
-        let ok = mt.colour.is_finite()
-            && [mt.kd, mt.ks, mt.shine, mt.transmittance, mt.ior]
-                .iter()
-                .all(|v| v.is_finite() && *v >= 0.0)
-            && mt.transmittance <= 1.0;
-        if !ok {
-            return Err(invalid(format!("material {i} has a value out of range")));
-        }
-    }
-    let mut b = vec![0u8; obj_len];
-    read_section(&mut file, path, &h, 4, &mut b)?;
-    let mut objects = Vec::with_capacity(b.len() / OBJECT_LEN as usize);
-    for (i, chunk) in b.chunks_exact(OBJECT_LEN as usize).enumerate() {
-        let mut c = Cursor::new(chunk);
-        let kind = c.u32();
-        let material = c.u32();
-        let slots: Slots = std::array::from_fn(|_| c.f64());
-        let Some(shape) = Shape::load(kind, &slots) else {
-            return Err(invalid(format!("object {i} has unknown kind {kind}")));
-        };
-        let material = u16::try_from(material)
-            .ok()
-            .filter(|&mt| usize::from(mt) < materials.len())
-            .ok_or_else(|| {
-                invalid(format!(
-                    "object {i} names material {material}, beyond the table"
-                ))
-            })?;
-        if let Err(e) = shape.validate() {
-            return Err(invalid(format!("object {i}: {}: {e}", shape.kind())));
-        }
-        objects.push(WorldObject { shape, material });
-    }
-    let mut b = vec![0u8; light_len];
-    read_section(&mut file, path, &h, 6, &mut b)?;
-    let lights: Vec<WorldLight> = b
-        .chunks_exact(LIGHT_LEN as usize)
-        .map(|chunk| {
-            let mut c = Cursor::new(chunk);
-            WorldLight {
-                position: c.vec(),
-                colour: c.vec(),
-            }
-        })
-        .collect();
-    if lights
-        .iter()
-        .any(|l| !(l.position.is_finite() && l.colour.is_finite()))
-    {
-        return Err(invalid("a light is not finite".into()));
-    }
+    let materials = materials_from(&section(&mut file, 5, mat_len)?).map_err(invalid)?;
+    let objects =
+        objects_from(&section(&mut file, 4, obj_len)?, materials.len()).map_err(invalid)?;
+    let lights = lights_from(&section(&mut file, 6, light_len)?).map_err(invalid)?;
     RecordStore::new(extent, &directory, &records).map_err(|e| invalid(e.to_string()))?;
     for (i, r) in records.iter().enumerate() {
         if r.object as usize >= objects.len() || usize::from(r.material) >= materials.len() {
@@ -815,6 +748,88 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         background: m.background,
         view: m.view,
     })
+}
+
+/// The brick directory section.
+fn directory_from(b: &[u8]) -> Vec<u32> {
+    b.chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+/// The materials section, each value in range.
+fn materials_from(b: &[u8]) -> Result<Vec<Material>, String> {
+    let materials: Vec<Material> = b
+        .chunks_exact(MATERIAL_LEN as usize)
+        .map(|chunk| {
+            let mut c = Cursor::new(chunk);
+            Material {
+                colour: c.vec(),
+                kd: c.f64(),
+                ks: c.f64(),
+                shine: c.f64(),
+                transmittance: c.f64(),
+                ior: c.f64(),
+                loc: None,
+            }
+        })
+        .collect();
+    for (i, mt) in materials.iter().enumerate() {
+        let ok = mt.colour.is_finite()
+            && [mt.kd, mt.ks, mt.shine, mt.transmittance, mt.ior]
+                .iter()
+                .all(|v| v.is_finite() && *v >= 0.0)
+            && mt.transmittance <= 1.0;
+        if !ok {
+            return Err(format!("material {i} has a value out of range"));
+        }
+    }
+    Ok(materials)
+}
+
+/// The objects section: each shape's saved form ([`Shape::load`]), valid,
+/// with a material among the `materials`.
+fn objects_from(b: &[u8], materials: usize) -> Result<Vec<WorldObject>, String> {
+    let mut objects = Vec::with_capacity(b.len() / OBJECT_LEN as usize);
+    for (i, chunk) in b.chunks_exact(OBJECT_LEN as usize).enumerate() {
+        let mut c = Cursor::new(chunk);
+        let kind = c.u32();
+        let material = c.u32();
+        let slots: Slots = std::array::from_fn(|_| c.f64());
+        let Some(shape) = Shape::load(kind, &slots) else {
+            return Err(format!("object {i} has unknown kind {kind}"));
+        };
+        let material = u16::try_from(material)
+            .ok()
+            .filter(|&mt| usize::from(mt) < materials)
+            .ok_or_else(|| format!("object {i} names material {material}, beyond the table"))?;
+        if let Err(e) = shape.validate() {
+            return Err(format!("object {i}: {}: {e}", shape.kind()));
+        }
+        objects.push(WorldObject { shape, material });
+    }
+    Ok(objects)
+}
+
+/// The lights section, every number finite.
+fn lights_from(b: &[u8]) -> Result<Vec<WorldLight>, String> {
+    let lights: Vec<WorldLight> = b
+        .chunks_exact(LIGHT_LEN as usize)
+        .map(|chunk| {
+            let mut c = Cursor::new(chunk);
+            WorldLight {
+                position: c.vec(),
+                colour: c.vec(),
+            }
+        })
+        .collect();
+    if lights
+        .iter()
+        .any(|l| !(l.position.is_finite() && l.colour.is_finite()))
+    {
+        return Err("a light is not finite".into());
+    }
+    Ok(lights)
 }
 
 fn read_records(

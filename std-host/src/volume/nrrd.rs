@@ -364,6 +364,8 @@ fn shown(text: &[u8]) -> String {
     out.escape_debug().to_string()
 }
 
+/// The header of the collected `fields`: every required field present,
+/// every value in range.
 fn build_header(
     path: &Path,
     fields: &Fields,
@@ -394,65 +396,19 @@ fn build_header(
     }
     let ty = fields.get("type").ok_or_else(|| missing("type", ""))?;
     let sample_type = parse_type(&ty.value).map_err(|m| herr(ty.line, m))?;
-
     let dim = fields
         .get("dimension")
         .ok_or_else(|| missing("dimension", ""))?;
-    match dim.value.parse::<u32>() {
-        Ok(3) => {}
-        Ok(d) => {
-            return Err(herr(
-                dim.line,
-                format!("dimension: {d} axes; only 3D volumes (dimension: 3) are supported"),
-            ));
-        }
-        Err(_) => {
-            return Err(herr(
-                dim.line,
-                format!("dimension: expected an integer, found `{}`", dim.value),
-            ));
-        }
-    }
-
+    parse_dimension(&dim.value).map_err(|m| herr(dim.line, m))?;
     let sizes = fields.get("sizes").ok_or_else(|| missing("sizes", ""))?;
     let dims = parse_sizes(&sizes.value).map_err(|m| herr(sizes.line, m))?;
-
-    let encoding = match fields.get("encoding") {
-        None => return Err(missing("encoding", "")),
-        Some(f) => match f.value.as_str() {
-            "raw" => Encoding::Raw,
-            "gzip" | "gz" => Encoding::Gzip,
-            "ascii" | "text" | "txt" => Encoding::Ascii,
-            "hex" | "bzip2" | "bz2" | "zrl" => {
-                return Err(herr(
-                    f.line,
-                    format!(
-                        "encoding: `{}` is not supported (raw, gzip or ascii)",
-                        f.value
-                    ),
-                ));
-            }
-            other => {
-                return Err(herr(
-                    f.line,
-                    format!("encoding: unknown encoding `{other}` (raw, gzip or ascii)"),
-                ));
-            }
-        },
-    };
-
+    let enc = fields
+        .get("encoding")
+        .ok_or_else(|| missing("encoding", ""))?;
+    let encoding = parse_encoding(&enc.value).map_err(|m| herr(enc.line, m))?;
     let endian = match fields.get("endian") {
         None => None,
-        Some(f) => Some(match f.value.as_str() {
-            "little" => Endian::Little,
-            "big" => Endian::Big,
-            other => {
-                return Err(herr(
-                    f.line,
-                    format!("endian: expected `little` or `big`, found `{other}`"),
-                ));
-            }
-        }),
+        Some(f) => Some(parse_endian(&f.value).map_err(|m| herr(f.line, m))?),
     };
     if endian.is_none() && sample_type.size() > 1 && encoding != Encoding::Ascii {
         return Err(missing(
@@ -460,43 +416,10 @@ fn build_header(
             " (needed for multi-byte samples in raw or gzip data)",
         ));
     }
-
     let grid = parse_geometry(fields).map_err(|(line, m)| herr(line, m))?;
-
     let byte_skip = match fields.get("byte skip") {
         None => 0,
-        Some(f) => {
-            let v: i64 = f.value.parse().map_err(|_| {
-                herr(
-                    f.line,
-                    format!("byte skip: expected an integer, found `{}`", f.value),
-                )
-            })?;
-            if v < -1 {
-                return Err(herr(
-                    f.line,
-                    format!("byte skip: expected -1 or a count ≥ 0, found {v}"),
-                ));
-            }
-            // Skipped decompressed bytes cost as much as samples: bounded
-            // like them (a gzip bomb cannot make the reader spin).
-            if encoding == Encoding::Gzip && v.unsigned_abs() > limits.max_bytes {
-                return Err(herr(
-                    f.line,
-                    format!(
-                        "byte skip: {v} decompressed bytes to skip, more than the limit of {} bytes",
-                        limits.max_bytes
-                    ),
-                ));
-            }
-            if v == -1 && encoding != Encoding::Raw {
-                return Err(herr(
-                    f.line,
-                    "byte skip: -1 (data at the end of the file) needs raw encoding".into(),
-                ));
-            }
-            v
-        }
+        Some(f) => parse_byte_skip(&f.value, encoding, limits).map_err(|m| herr(f.line, m))?,
     };
     let line_skip = match fields.get("line skip") {
         None => 0,
@@ -507,29 +430,9 @@ fn build_header(
             )
         })?,
     };
-
     let data_file = match fields.get("data file") {
         None => None,
-        Some(f) if f.value == "LOCAL" => None,
-        Some(f) => {
-            let v = f.value.as_str();
-            if v.starts_with("LIST") || v.contains('%') || v.split_whitespace().count() > 1 {
-                return Err(herr(
-                    f.line,
-                    format!("data file: `{v}`: only a single data file is supported"),
-                ));
-            }
-            if !may_open_files {
-                return Err(herr(
-                    f.line,
-                    format!(
-                        "data file: `{v}`: a detached header read from memory cannot open its data file"
-                    ),
-                ));
-            }
-            let base = path.parent().unwrap_or_else(|| Path::new(""));
-            Some(base.join(v))
-        }
+        Some(f) => parse_data_file(&f.value, path, may_open_files).map_err(|m| herr(f.line, m))?,
     };
     if data_file.is_none() && !ended {
         // `data file: LOCAL` without the empty line.
@@ -552,6 +455,88 @@ fn build_header(
         line_skip,
         header_bytes,
     })
+}
+
+/// `dimension`: only 3.
+fn parse_dimension(value: &str) -> Result<(), String> {
+    match value.parse::<u32>() {
+        Ok(3) => Ok(()),
+        Ok(d) => Err(format!(
+            "dimension: {d} axes; only 3D volumes (dimension: 3) are supported"
+        )),
+        Err(_) => Err(format!("dimension: expected an integer, found `{value}`")),
+    }
+}
+
+/// `encoding`: raw, gzip or ascii.
+fn parse_encoding(value: &str) -> Result<Encoding, String> {
+    match value {
+        "raw" => Ok(Encoding::Raw),
+        "gzip" | "gz" => Ok(Encoding::Gzip),
+        "ascii" | "text" | "txt" => Ok(Encoding::Ascii),
+        "hex" | "bzip2" | "bz2" | "zrl" => Err(format!(
+            "encoding: `{value}` is not supported (raw, gzip or ascii)"
+        )),
+        other => Err(format!(
+            "encoding: unknown encoding `{other}` (raw, gzip or ascii)"
+        )),
+    }
+}
+
+/// `endian`: little or big.
+fn parse_endian(value: &str) -> Result<Endian, String> {
+    match value {
+        "little" => Ok(Endian::Little),
+        "big" => Ok(Endian::Big),
+        other => Err(format!(
+            "endian: expected `little` or `big`, found `{other}`"
+        )),
+    }
+}
+
+/// `byte skip`: -1 (raw data at the end of the file) or a count, bounded
+/// for gzip data like the samples (a gzip bomb cannot make the reader
+/// spin).
+fn parse_byte_skip(value: &str, encoding: Encoding, limits: &Limits) -> Result<i64, String> {
+    let v: i64 = value
+        .parse()
+        .map_err(|_| format!("byte skip: expected an integer, found `{value}`"))?;
+    if v < -1 {
+        return Err(format!("byte skip: expected -1 or a count ≥ 0, found {v}"));
+    }
+    if encoding == Encoding::Gzip && v.unsigned_abs() > limits.max_bytes {
+        return Err(format!(
+            "byte skip: {v} decompressed bytes to skip, more than the limit of {} bytes",
+            limits.max_bytes
+        ));
+    }
+    if v == -1 && encoding != Encoding::Raw {
+        return Err("byte skip: -1 (data at the end of the file) needs raw encoding".into());
+    }
+    Ok(v)
+}
+
+/// `data file`: `LOCAL` (`None`) or one file beside the header.
+fn parse_data_file(
+    value: &str,
+    header: &Path,
+    may_open_files: bool,
+) -> Result<Option<PathBuf>, String> {
+    if value == "LOCAL" {
+        return Ok(None);
+    }
+    if value.starts_with("LIST") || value.contains('%') || value.split_whitespace().count() > 1 {
+        return Err(format!(
+            "data file: `{value}`: only a single data file is supported"
+        ));
+    }
+    if !may_open_files {
+        return Err(format!(
+            "data file: `{value}`: a detached header read from memory cannot open its data file"
+        ));
+    }
+    let base = header.parent().unwrap_or_else(|| Path::new(""));
+    Ok(Some(base.join(value)))
 }
 
 fn parse_type(value: &str) -> Result<SampleType, String> {
