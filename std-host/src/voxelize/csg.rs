@@ -9,7 +9,7 @@ use rrt_core::csg::{self, CsgNode, CsgTree, IgnoreLeaf, LeafFill};
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::voxelize::Separation;
 
-use super::objects::Pass;
+use super::pass::Pass;
 use super::{BuildError, volume};
 use crate::frame::RasterFrame;
 use crate::scene::{Csg, Solid, VolumeObject};

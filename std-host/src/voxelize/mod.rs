@@ -38,6 +38,7 @@ pub mod csg;
 pub mod light;
 pub mod materials;
 pub mod objects;
+pub mod pass;
 pub mod plane;
 pub mod texture;
 pub mod volume;
@@ -61,7 +62,7 @@ pub use self::voxel_scene::{VoxelScene, WorldLight, WorldObject, finish_plane, l
 
 use self::light::LightScene;
 use self::materials::MaterialTable;
-use self::objects::Pass;
+use self::pass::Pass;
 use self::plane::Plane;
 use self::texture::InRaster;
 use crate::fit::{self, Bytes, FitError, FitOptions};

@@ -10,35 +10,14 @@
 //! [`Shape::Voxels`], whose hits verification keeps.
 
 use rrt_core::object_table as table;
-use rrt_core::store::{Counter, Filler, ObjectAttrs};
 use rrt_core::voxelize::Separation;
 
-use super::texture::InRaster;
+use super::pass::Pass;
 use super::{BuildError, csg, volume, vox};
 use crate::fit::{Fitted, FittedObject};
 use crate::frame::RasterFrame;
 use crate::scene::{Csg, Scene, VolumeObject, VoxObject};
 use crate::shape::{self, Shape};
-use crate::texture::AnyTexture;
-
-/// Where an object's voxels go.
-pub enum Pass<'a, 'p, 'd, 'r> {
-    /// The count pass.
-    Count(&'a mut Counter<'p, 'd>),
-    /// The fill pass: the object's attributes (object id, material,
-    /// colour), the attributes of each CSG leaf, and the texture of the
-    /// object's material, if any.
-    Fill {
-        /// The filler.
-        filler: &'a mut Filler<'p, 'd, 'r>,
-        /// The object's attributes.
-        attrs: ObjectAttrs,
-        /// Per CSG leaf (for CSG objects).
-        leaves: Vec<ObjectAttrs>,
-        /// The material's texture.
-        texture: Option<&'a InRaster<AnyTexture>>,
-    },
-}
 
 /// One object of the object table; its id is its index in
 /// [`in_id_order`]'s list.

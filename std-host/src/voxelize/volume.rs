@@ -36,7 +36,7 @@ use rrt_core::voxelize::volume::{self, Block};
 use rrt_core::voxelize::{Separation, Surfel, VoxelSink};
 
 use super::BuildError;
-use super::objects::Pass;
+use super::pass::Pass;
 use crate::frame::RasterFrame;
 use crate::scene::VolumeObject;
 use crate::volume::resample::Quantizer;

@@ -8,7 +8,7 @@ use rrt_core::store::Texture;
 use rrt_core::voxelize::{Surfel, VoxelSink};
 
 use super::BuildError;
-use super::objects::Pass;
+use super::pass::Pass;
 use crate::frame::RasterFrame;
 use crate::scene::VoxObject;
 use crate::vox::VoxScene;
