@@ -7,15 +7,21 @@
 //! ([`crate::shape`]), voxelization, the tracer and the saved-raster file.
 
 use glam::DVec3;
-use rrt_core::fixed::VOXEL;
+use rrt_core::discrete_ray::{ORIGIN_LIMIT, ORIGIN_LIMIT_BITS};
+use rrt_core::fixed::{FRAC_BITS, VOXEL};
 use rrt_core::geometry::{NORMAL_ONE, Point, UnitVector};
 use rrt_core::raster::Extent;
 
 use crate::world::{Bounds, Ray};
 
 /// Farthest any fixed-point coordinate may lie from the raster's origin:
-/// 2^31 voxels (so products of coordinates stay far from `i64` limits).
-pub const MAX_FIXED: i64 = (1 << 31) * VOXEL;
+/// the core's discrete-ray origin limit ([`ORIGIN_LIMIT`], 2^31 voxels),
+/// so that every point the host converts is a valid ray origin and
+/// products of coordinates stay far from `i64` limits.
+pub const MAX_FIXED: i64 = ORIGIN_LIMIT;
+
+/// `log2` of [`MAX_FIXED`] in voxels, for messages.
+pub const MAX_FIXED_VOXEL_BITS: u32 = ORIGIN_LIMIT_BITS - FRAC_BITS;
 
 /// The raster's place in the world: voxel `(i, j, k)` spans
 /// `origin + [i, i+1) × [j, j+1) × [k, k+1) · voxel_size`.

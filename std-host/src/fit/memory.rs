@@ -5,16 +5,18 @@ use std::f64::consts::PI;
 use std::fmt;
 
 use rrt_core::raster::LINE_CELLS;
+use rrt_core::store;
+use rrt_core::voxel::VoxelRecord;
 
 use crate::frame::RasterFrame;
 use crate::scene::Scene;
 
-/// Bytes per voxel record, for the memory estimate.
-pub const RECORD_BYTES: u64 = 20;
-/// Voxels per brick of the brick directory, for the memory estimate.
-pub const BRICK_VOXELS: u64 = 512;
-/// Bytes per brick directory entry.
-pub const BRICK_ENTRY_BYTES: u64 = 4;
+/// Bytes per voxel record ([`VoxelRecord`]).
+pub const RECORD_BYTES: u64 = size_of::<VoxelRecord>() as u64;
+/// Voxels per brick of the brick directory ([`store::BRICK_VOXELS`]).
+pub const BRICK_VOXELS: u64 = store::BRICK_VOXELS as u64;
+/// Bytes per brick directory entry (a `u32` record offset).
+pub const BRICK_ENTRY_BYTES: u64 = size_of::<u32>() as u64;
 /// Upper bound on the voxels per voxel² of surface for the thickest
 /// (26-tunnel-free) voxelization: a standard digital surface is
 /// `|nx| + |ny| + |nz| ≤ √3` voxels thick.

@@ -42,7 +42,7 @@ pub use self::meminfo::{default_max_memory, parse_meminfo, total_memory};
 pub use self::memory::{Bytes, Dims, MemoryEstimate, estimate_memory};
 pub use self::size::{DEFAULT_MARGIN, frame};
 
-use crate::frame::RasterFrame;
+use crate::frame::{MAX_FIXED_VOXEL_BITS, RasterFrame};
 use crate::scene::{Object, Scene, SourceLoc};
 use crate::shape::{Shape, Surface, Unfit};
 use crate::world::Bounds;
@@ -124,7 +124,7 @@ pub enum FitError {
         limit: u64,
     },
     /// A light or object lies too far from the raster for fixed point.
-    #[error("{loc}: {what} lies more than 2^31 voxels from the raster")]
+    #[error("{loc}: {what} lies more than 2^{MAX_FIXED_VOXEL_BITS} voxels from the raster")]
     OutOfRange {
         /// Where it is defined.
         loc: SourceLoc,

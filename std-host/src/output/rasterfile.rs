@@ -73,7 +73,11 @@ const META_LEN: u64 = 192;
 const OBJECT_LEN: u64 = 8 + 8 * SLOTS as u64;
 const MATERIAL_LEN: u64 = 64;
 const LIGHT_LEN: u64 = 48;
-const RECORD_LEN: u64 = 20;
+/// A record in the file: its fields in order, as large as the core's
+/// record.
+const RECORD_LEN: u64 = size_of::<VoxelRecord>() as u64;
+/// A brick directory entry (a `u32` record offset).
+const DIRECTORY_ENTRY_LEN: u64 = size_of::<u32>() as u64;
 const NAMES: [&str; SECTIONS] = [
     "meta",
     "plane",
@@ -331,7 +335,8 @@ pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
             1 => c.put(&meta_bytes(scene)),
             2 => c.put(&scene.plane),
             3 => {
-                let mut b = Vec::with_capacity(scene.directory.len() * 4);
+                let mut b =
+                    Vec::with_capacity(scene.directory.len() * DIRECTORY_ENTRY_LEN as usize);
                 for d in &scene.directory {
                     b.extend_from_slice(&d.to_le_bytes());
                 }
@@ -699,7 +704,7 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     // sections all lie inside the file: no allocation exceeds its size.
     let plane_len = expect(1, extent.len() as u64)?;
     let dir_n = directory_len(extent).ok_or_else(|| invalid("too many bricks".into()))?;
-    let dir_len = expect(2, dir_n as u64 * 4)?;
+    let dir_len = expect(2, dir_n as u64 * DIRECTORY_ENTRY_LEN)?;
     let rec_len = expect(3, m.records.saturating_mul(RECORD_LEN))?;
     let obj_len = expect(4, m.objects.saturating_mul(OBJECT_LEN))?;
     let mat_len = expect(5, u64::from(m.materials) * MATERIAL_LEN)?;

@@ -63,6 +63,7 @@ use glam::DVec3;
 
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
+use super::text::byte_loc;
 use super::{Light, Material, Object, Polygon, Scene, View};
 use crate::shape::{Cone, Sphere};
 
@@ -171,18 +172,6 @@ fn parse_in(file: Arc<str>, bytes: &[u8], opts: &ParseOptions) -> Result<Scene, 
 
 /// The location of byte `at`, whose prefix is valid UTF-8 up to the last
 /// line start (columns of an invalid prefix count bytes).
-fn byte_loc(file: &Arc<str>, bytes: &[u8], at: usize) -> SourceLoc {
-    let before = bytes.get(..at).unwrap_or(bytes);
-    let line_start = before
-        .iter()
-        .rposition(|&b| b == b'\n')
-        .map_or(0, |p| p + 1);
-    let lines = before.iter().filter(|&&b| b == b'\n').count();
-    let tail = before.get(line_start..).unwrap_or(&[]);
-    let column = std::str::from_utf8(tail).map_or(tail.len(), |s| s.chars().count());
-    SourceLoc::new(Arc::clone(file), to_u32(lines + 1), to_u32(column + 1))
-}
-
 fn to_u32(n: usize) -> u32 {
     u32::try_from(n).unwrap_or(u32::MAX)
 }

@@ -54,7 +54,7 @@ pub use resample::{PlacedVolume, Placement, SAMPLE_MAX};
 /// Default limit on the bytes of samples one volume may take (4 GiB).
 pub const DEFAULT_MAX_BYTES: u64 = 4 << 30;
 /// Most samples along one axis of a volume (the core's raster axis limit).
-pub const MAX_AXIS: u32 = 1 << 16;
+pub const MAX_AXIS: u32 = rrt_core::raster::MAX_AXIS;
 
 /// Size limits checked before anything is allocated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -87,7 +87,7 @@ impl VoxelScene {
     /// Bytes held by the plane, its line level, directory and records.
     #[must_use]
     pub fn memory(&self) -> u64 {
-        let dir = self.directory.len().saturating_mul(4);
+        let dir = self.directory.len().saturating_mul(size_of::<u32>());
         let rec = self
             .records
             .len()
