@@ -6,8 +6,6 @@
 //! * [`nrrd_input`]: the NRRD reader and a volume's raster block;
 //! * [`check_scene`]: the guarantees of a parsed [`Scene`](crate::scene::Scene).
 
-#![deny(missing_docs)]
-
 use glam::DVec3;
 use rrt_core::raster::Extent;
 

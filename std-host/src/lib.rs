@@ -1,38 +1,81 @@
-//! # rrt-host: discrete ray tracing on a host
+//! # rrt-host: 3D raster ray tracing on a host
 //!
-//! Everything around the integer core `rrt-core`, with std and `f64`:
+//! Everything around the integer core [`rrt_core`], with `std` and `f64`:
+//! the pipeline of Yagel, Cohen and Kaufman's *discrete ray tracing*
+//! (1992), one module per phase, the data flowing one way.
 //!
-//! * [`scene`]: NFF and TOML scenes in world coordinates and their strict
-//!   parsers, with located errors.
-//! * [`camera`]: the pinhole camera of `embree_nff` (rays through pixel
-//!   centres), with supersampling positions.
-//! * [`fit`]: fitting the 3D raster to a scene: world → fixed-point raster
-//!   coordinates, once; the memory estimate and limit.
-//! * [`shade`]: shading maths (SPD intensities, Phong, Whitted secondary
-//!   rays, refraction), matching `embree_nff`.
-//! * [`shape`]: the shape model: each primitive's validation, fixed-point
-//!   geometry, voxelizer call and exact intersection for verification.
-//! * [`object_table`]: the world object table (each object's exact
-//!   geometry) and lights, indexed by the voxel records.
-//! * [`build`]: the preprocessing pipeline, scene → fitted raster →
-//!   count and fill passes → proximity flags → light visibility, giving a
-//!   [`build::VoxelScene`]; [`plane`]: the plane's huge-page memory.
-//! * [`trace`]: the recursive discrete ray tracer, intersection
-//!   verification, the acne rule for secondary rays.
-//! * [`render`]: tiles on rayon, 4×2 primary blocks (ray packets),
-//!   supersampling, deterministic for any thread count; [`output`]: PNG.
-//! * [`rasterfile`]: saved rasters (versioned, checksummed).
-//! * `check` (feature `check`): invariant checkers shared by tests and
-//!   fuzz targets.
-//! * [`cli`]: the `rrt` command line (the binary only parses arguments).
-//! * [`volume`]: sampled (NRRD, raw) and computed volumes, resampling,
-//!   placement in the world and classification.
-//! * [`texture`]: image maps and solid textures, precomputed per voxel.
-//! * [`vox`]: MagicaVoxel `.vox` models.
-//! * [`voxel_objects`]: volumes, `.vox` models and CSG trees in the build
-//!   pipeline.
-
-#![forbid(unsafe_code)]
+//! ```text
+//!  parse          fit              voxelize (+ light)        trace              render         output
+//!  scene::Scene ─▶ fit::Fitted ─▶ voxelize::VoxelScene ─▶ trace::Tracer ─▶ render::Image ─▶ output::png
+//!                                       │     ▲
+//!                                       ▼     │
+//!                                 output::rasterfile (save, load)
+//! ```
+//!
+//! * [`scene`] (parse): NFF and TOML scenes in world coordinates, and the
+//!   assets they name: [`texture`]s, sampled and computed [`volume`]s,
+//!   MagicaVoxel models ([`vox`]). None of them knows the raster.
+//! * [`shape`]: the shape model. Each primitive is described once, with
+//!   its validation, fixed-point geometry, core voxelizer call,
+//!   object-table entry, exact intersection and saved form.
+//! * [`fit`]: the raster's frame ([`frame::RasterFrame`]), the memory
+//!   estimate checked against the limit, every primitive and light in
+//!   fixed point.
+//! * [`voxelize`]: the count and fill passes over the object table, the
+//!   light pass (visibility bits, precomputed illumination), the proximity
+//!   field and the line level: a [`voxelize::VoxelScene`], everything that
+//!   does not depend on the view.
+//! * [`trace`]: the recursive discrete ray tracer: the discrete walk,
+//!   intersection verification, shading.
+//! * [`render`]: the camera, tiles on rayon's threads, 4×2 blocks of
+//!   primary rays, supersampling.
+//! * [`output`]: PNG, and saved rasters (versioned, checksummed), which are
+//!   read back to render a voxelized scene from any view.
+//! * [`cli`]: the `rrt` command line; the binary only parses arguments.
+//! * [`world`] and [`frame`]: world-space bounds, rays and hits, and the
+//!   raster's frame, shared by the phases.
+//! * `check` (feature `check`): invariant checkers shared by the tests and
+//!   the fuzz targets.
+//!
+//! # Guarantees
+//! * **Located errors.** Bad input (a scene, an asset, a saved raster, an
+//!   argument) gives one error naming the file and, where there is one, the
+//!   line, column and key or field. Sizes are checked before anything is
+//!   allocated: a file, volume or raster larger than its limit is refused,
+//!   not attempted.
+//! * **No panic on input.** No input makes the library panic, hang or
+//!   abort on allocation; the fuzz targets hold the readers to it.
+//! * **Deterministic.** Images, voxelized rasters and saved files are
+//!   byte-identical for every thread count: each record's light and each
+//!   pixel's colour depend only on unchanged inputs, and sums are taken in
+//!   a fixed order.
+//! * **Nothing lost.** Outputs are written to a temporary file beside the
+//!   target and renamed over it.
+//!
+//! # Example
+//! A sphere from NFF text, voxelized in a 64-voxel raster and rendered:
+//!
+//! ```
+//! use indicatif::ProgressBar;
+//! use rrt_host::render::camera::Camera;
+//! use rrt_host::render::{RenderOptions, render};
+//! use rrt_host::scene::Scene;
+//! use rrt_host::trace::{TraceOptions, Tracer};
+//! use rrt_host::voxelize::{BuildOptions, build};
+//!
+//! let nff = "v\nfrom 0 -4 1\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.1\nresolution 24 16\n\
+//!            l 2 -3 4\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\n";
+//! let scene = Scene::parse("ball.nff", nff.as_bytes())?;
+//! let (voxels, report) = build(&scene, &BuildOptions::new(64), &ProgressBar::hidden())?;
+//! assert!(report.records > 0);
+//! let tracer = Tracer::new(&voxels, TraceOptions::default())?;
+//! let [w, h] = voxels.view.resolution;
+//! let camera = Camera::new(&voxels.view, w, h)?;
+//! let (image, stats, _) = render(&tracer, &camera, &RenderOptions::default(), &ProgressBar::hidden())?;
+//! assert_eq!(image.rgb.len(), 3 * 24 * 16);
+//! assert!(stats.hits > 0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 #[cfg(any(test, feature = "check"))]
 pub mod check;

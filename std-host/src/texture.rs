@@ -30,8 +30,6 @@
 //! (`uv' = uv · scale + offset`, so scale 4 tiles the image 4 times) and
 //! the [`Wrap`] rule. Image lookups are bilinear between pixel centres.
 
-#![deny(missing_docs)]
-
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 

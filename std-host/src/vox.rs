@@ -59,8 +59,6 @@
 //! models: a [`VoxError`] naming the file and the byte offset (or scene
 //! node).
 
-#![deny(missing_docs)]
-
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;

@@ -24,8 +24,6 @@
 //! exceed the caller's limit ([`default_max_memory`]: half the machine's
 //! RAM).
 
-#![deny(missing_docs)]
-
 pub mod meminfo;
 pub mod memory;
 pub mod size;

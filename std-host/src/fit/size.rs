@@ -15,7 +15,7 @@ pub const DEFAULT_MARGIN: u32 = 2;
 /// The raster's frame for `scene` (no allocation, no conversion).
 ///
 /// # Errors
-/// As [`fit`], less the memory and range checks.
+/// As [`fit`](super::fit()), less the memory and range checks.
 pub fn frame(scene: &Scene, opts: &FitOptions) -> Result<RasterFrame, FitError> {
     let n = opts.raster;
     if n == 0 || n > MAX_AXIS {

@@ -7,8 +7,6 @@
 //! it over `OUT.png`, so a failed or interrupted run never leaves a
 //! truncated image under the output's name.
 
-#![deny(missing_docs)]
-
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};

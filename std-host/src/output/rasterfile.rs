@@ -42,8 +42,6 @@
 //! anyway, and a plane read into anonymous memory gets huge pages
 //! ([`Plane`]), which a file mapping does not.
 
-#![deny(missing_docs)]
-
 use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};

@@ -21,8 +21,6 @@
 //! samples sit at offsets `(i + 0.5)/K − 0.5` pixels from the centre on
 //! each axis ([`sample_offset`]); `K = 1` is the centre ray.
 
-#![deny(missing_docs)]
-
 use glam::DVec3;
 
 use crate::scene::View;

@@ -16,8 +16,6 @@
 //! index. The image is therefore byte-identical for every thread count.
 //! The ray counts are integer sums, identical as well.
 
-#![deny(missing_docs)]
-
 pub mod camera;
 
 use std::sync::atomic::{AtomicU64, Ordering};

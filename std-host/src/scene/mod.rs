@@ -1,6 +1,7 @@
 //! World-space scenes, as read from NFF or TOML scene files.
 //!
-//! A [`Scene`] is the description the build pipeline ([`crate::build`])
+//! A [`Scene`] is the description the pipeline ([`crate::fit`],
+//! [`crate::voxelize`])
 //! takes, in `f64` world coordinates: the view, the background, lights,
 //! materials (with optional textures) and objects, each object referring
 //! to its material by index. Two front-ends make one:
@@ -19,8 +20,6 @@
 //!
 //! Read a scene with [`Scene::load`] (a file, NFF or TOML by its
 //! extension) or [`Scene::parse`] (NFF bytes).
-
-#![deny(missing_docs)]
 
 pub mod bezier;
 pub mod bpt;

@@ -1,9 +1,9 @@
 //! The objects a scene has beyond NFF's: volumes, MagicaVoxel models, CSG
 //! trees (tori and capped cones are one-solid trees), and textures.
 //!
-//! They are what the TOML front-end ([`super::toml`]) reads; the build
-//! pipeline ([`crate::build`]) voxelizes them next to the NFF objects, in
-//! the same raster, through the same two passes.
+//! They are what the TOML front-end ([`super::toml`]) reads; voxelization
+//! ([`crate::voxelize`]) puts them in the same raster as the primitives,
+//! through the same two passes.
 
 use std::sync::Arc;
 

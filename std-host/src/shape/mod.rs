@@ -34,10 +34,6 @@
 //! ([`crate::trace::shading::face_forward`]). Tangent (grazing) rays count as hits.
 //! No input makes them panic; non-finite input gives `None`.
 
-// `!(x >= 0.0)` is deliberate throughout: it is true for NaN, which must
-// be refused like any other out-of-range value.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 pub mod cone;
 pub mod cuboid;
 mod roots;

@@ -1,7 +1,8 @@
 //! The recursive discrete ray tracer (the paper's ray tracing phase).
 //!
 //! A ray is traced by stepping its 3D discrete line through the raster
-//! ([`DiscreteRay`], clipped to the raster box: the paper's two endpoints)
+//! ([`DiscreteRay`](rrt_core::discrete_ray::DiscreteRay), clipped to the
+//! raster box: the paper's two endpoints)
 //! until the first non-transparent voxel: the hit. Its record gives the
 //! object, colour, stored normal, the precomputed ambient + diffuse
 //! illumination and two visibility bits per light. The colour is then
@@ -12,7 +13,7 @@
 //!        +  Ks·reflected  +  T·refracted
 //! ```
 //!
-//! as `embree_nff` shades (see [`crate::shade`]): `N` the stored normal
+//! as `embree_nff` shades (see [`shading`]): `N` the stored normal
 //! turned towards the viewer (two-sided shading), `R` the reflection of the
 //! light direction `L`, `V` towards the eye. Shadow rays are fired at render
 //! time only for lights whose bits say *translucent*; `att` multiplies the
@@ -77,7 +78,8 @@
 //! # Packets
 //! [`Tracer::trace_block`] traces eight primary rays (a 4×2 pixel block)
 //! in two stages: first every ray is walked to its first non-transparent
-//! voxel, by a [`RayPacket8`] stepping the eight lanes together (or by the
+//! voxel, by a [`RayPacket8`](rrt_core::packet::RayPacket8) stepping the
+//! eight lanes together (or by the
 //! scalar walk, [`TraceOptions::packets`]); then each ray's hit is resolved
 //! (verification and resumption, shading, secondary rays) by the scalar
 //! code, which resumes the very `DiscreteRay` the packet left in its lane.
@@ -93,10 +95,6 @@
 //! plane ([`rrt_core::raster::Raster::with_lines`]: one stand-in cell per
 //! 64 plane cells, small enough to stay in cache). [`RayStats::steps`]
 //! counts voxels visited, a jump as one.
-
-#![deny(missing_docs)]
-// `!(x < y)` is deliberate: it is true for NaN, which must be refused too.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod shade;
 pub mod shading;
@@ -137,11 +135,12 @@ pub struct TraceOptions {
     /// The acne rule's slab and angle, and the connectivity of render-time
     /// shadow rays (those of the light pass by default).
     pub light: LightParams,
-    /// Walk primary rays eight at a time in a [`RayPacket8`] instead of one
-    /// by one with empty-space skipping. Both give the same image; the
-    /// packet does not skip, and on balls4 (raster 2048, 512², one thread)
-    /// the skipping scalar walk rendered in 0.37 s against the packets'
-    /// 0.48 s (one run, medians of three), so it is the default.
+    /// Walk primary rays eight at a time in a
+    /// [`RayPacket8`](rrt_core::packet::RayPacket8) instead of one by one
+    /// with empty-space skipping. Both give the same image (the packet is
+    /// bit-identical to the scalar walk); the packet does not skip empty
+    /// space, and the scalar walk, the faster of the two where it was
+    /// measured, is the default.
     pub packets: bool,
     /// Exact shadows for verified hits (a quality option beyond the paper,
     /// which uses the precomputed light bits): from each verified hit a
@@ -185,7 +184,7 @@ pub struct RayStats {
     /// not meet the voxel's object (the paper's false hits).
     pub false_hits: u64,
     /// Discrete hits whose own object failed verification but an object
-    /// owning a neighbouring voxel passed it (see [`verify`]'s use in the
+    /// owning a neighbouring voxel passed it (see [`verify()`]'s use in the
     /// module docs).
     pub neighbour_hits: u64,
     /// Rays (of any kind but shadow) that met at least one false hit.

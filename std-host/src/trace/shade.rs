@@ -125,7 +125,7 @@ impl Tracer<'_> {
     /// between (each object once), 0 if an opaque voxel blocks.
     ///
     /// `exact` (unit direction and distance to the light) makes it an
-    /// exact shadow ray ([`TraceOptions::exact_shadows`]): a 6-connected
+    /// exact shadow ray ([`TraceOptions::exact_shadows`](super::TraceOptions::exact_shadows)): a 6-connected
     /// walk, which meets every voxel the continuous segment passes
     /// through, and a voxel counts only if the continuous segment
     /// intersects its object (each object tested once); voxels of objects

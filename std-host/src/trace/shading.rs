@@ -28,8 +28,6 @@
 //! with round-to-nearest, as `embree_nff`'s `(uint8_t)(v*255 + 0.5)`; no
 //! gamma ([`to_rgb8`]).
 
-#![deny(missing_docs)]
-
 use glam::DVec3;
 
 use crate::scene::Material;

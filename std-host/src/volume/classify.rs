@@ -35,8 +35,6 @@
 //! 1, 1/√2, 1/√3). [`gray_gradient`] is the same operator in `f64`, used
 //! to check the core's normals and by tests.
 
-#![deny(missing_docs)]
-
 use glam::DVec3;
 
 use super::{Volume, VolumeError};

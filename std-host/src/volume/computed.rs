@@ -22,8 +22,6 @@
 //! assert!(Classifier::iso(0.5).count(&v) > 0);
 //! ```
 
-#![deny(missing_docs)]
-
 use glam::DVec3;
 use rayon::prelude::*;
 

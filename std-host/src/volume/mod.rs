@@ -33,8 +33,6 @@
 //! outside the cells a volume has no value ([`Volume::sample_index`]
 //! returns `None`).
 
-#![deny(missing_docs)]
-
 use std::fmt;
 use std::path::PathBuf;
 

@@ -46,8 +46,6 @@
 //! exactly the samples the header promises: short data and extra data are
 //! both errors (a header whose `sizes` lie is caught either way).
 
-#![deny(missing_docs)]
-
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};

@@ -16,8 +16,6 @@
 //! # Ok::<(), rrt_host::volume::VolumeError>(())
 //! ```
 
-#![deny(missing_docs)]
-
 use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::Path;

@@ -23,8 +23,6 @@
 //! assert_eq!(placed.sample_world(DVec3::splat(0.5)), Some(25.0));
 //! ```
 
-#![deny(missing_docs)]
-
 use glam::{DAffine3, DMat3, DVec3};
 use rayon::prelude::*;
 

@@ -32,8 +32,6 @@
 //! view-independent: the renderer ([`crate::trace`]) and the saved-raster
 //! file ([`crate::output::rasterfile`]) both start from it.
 
-#![deny(missing_docs)]
-
 pub mod csg;
 pub mod light;
 pub mod materials;

@@ -2,12 +2,10 @@
 //! for transparent huge pages.
 //!
 //! The plane is one byte per voxel (a 2048³ raster is 8 GiB) and discrete
-//! rays read it in long strides, so TLB misses dominate a cold walk; with
-//! 2 MiB pages a 512³ traversal measured 1.2–1.3× faster here. The pages
-//! come zeroed and are only backed by memory when touched. `madvise` is a
-//! hint: where huge pages are unavailable the map works with normal pages.
-
-#![deny(missing_docs)]
+//! rays read it in long strides, so TLB misses dominate a cold walk; 2 MiB
+//! pages cut them. The pages come zeroed and are only backed by memory
+//! when touched. `madvise` is a hint: where huge pages are unavailable the
+//! map works with normal pages.
 
 use std::ops::{Deref, DerefMut};
 

@@ -6,8 +6,8 @@
 //! the core's volume voxelizer takes: one `u16` per raster voxel and a
 //! threshold ([`RasterBlock`]). [`PlacedVolume::voxelize`] runs the core's
 //! volume voxelizer over it in bounded slabs; [`VolumeColors`] colours the
-//! voxels from the classifier's colour ramp; [`voxelize_object`] puts a
-//! scene's volume object through the count or the fill pass.
+//! voxels from the classifier's colour ramp; the builder puts a scene's
+//! volume object through the count or the fill pass here.
 //!
 //! ```
 //! use glam::DVec3;
