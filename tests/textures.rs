@@ -11,10 +11,10 @@ use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, Texture, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
-use rrt_host::frame::RasterFrame;
-use rrt_host::texture::{
+use rrt_host::assets::texture::{
     Blend, Checker, ImageTexture, Mapping, Marble, TextureError, Wood, WorldTexture, Wrap,
 };
+use rrt_host::frame::RasterFrame;
 use rrt_host::voxelize::texture::InRaster;
 
 fn tmp(name: &str) -> PathBuf {

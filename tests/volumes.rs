@@ -10,15 +10,15 @@ use glam::DVec3;
 use rrt_core::raster::Extent;
 use rrt_core::store::Texture;
 use rrt_core::voxelize::{NORMAL_ONE, Separation, Surfel, VoxelSink};
-use rrt_host::frame::RasterFrame;
-use rrt_host::volume::classify::gray_normal;
-use rrt_host::volume::computed::{self, Metaball, Metaballs, ScreenedSources};
-use rrt_host::volume::raw::{self, RawSpec};
-use rrt_host::volume::resample::{Quantizer, resample_cubic};
-use rrt_host::volume::{
+use rrt_host::assets::volume::classify::gray_normal;
+use rrt_host::assets::volume::computed::{self, Metaball, Metaballs, ScreenedSources};
+use rrt_host::assets::volume::raw::{self, RawSpec};
+use rrt_host::assets::volume::resample::{Quantizer, resample_cubic};
+use rrt_host::assets::volume::{
     Classifier, ColorRamp, Endian, Grid, Limits, Placement, Ramp, SampleType, Samples, Volume,
     VolumeError, nrrd,
 };
+use rrt_host::frame::RasterFrame;
 use rrt_host::voxelize::volume::VolumeColors;
 
 fn fixture(name: &str) -> PathBuf {

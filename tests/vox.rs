@@ -8,7 +8,7 @@ use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::NORMAL_ONE;
-use rrt_host::vox::{self, VoxError};
+use rrt_host::assets::vox::{self, VoxError};
 use rrt_host::voxelize::vox::VoxPlacement;
 
 const RED: [u8; 3] = [255, 0, 0];

@@ -1,6 +1,6 @@
 //! The paper's MRI head as a [`VoxelScene`]: the host has no scene-file
 //! syntax for volumes yet, so this runs the builder's steps directly on the
-//! volume library (`rrt_host::volume`): the iso-surface layer of the
+//! volume library (`rrt_host::assets::volume`): the iso-surface layer of the
 //! classified samples through the core's volume voxelizer (count pass, fill
 //! pass), light visibility, the proximity distance field.
 //!
@@ -21,9 +21,9 @@ use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
+use rrt_host::assets::volume::{Classifier, Limits as VolumeLimits, Placement, nrrd};
 use rrt_host::frame::RasterFrame;
 use rrt_host::scene::{Material, View, light_intensity};
-use rrt_host::volume::{Classifier, Limits as VolumeLimits, Placement, nrrd};
 use rrt_host::voxelize::WorldLight;
 use rrt_host::voxelize::plane::Plane;
 use rrt_host::voxelize::{MAX_MATERIALS, VoxelScene, finish_plane};

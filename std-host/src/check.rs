@@ -9,11 +9,11 @@
 use glam::DVec3;
 use rrt_core::raster::Extent;
 
+use crate::assets::volume::{Classifier, Limits, Placement, Samples, nrrd, sample_count};
 use crate::fit::{FitOptions, fit};
 use crate::frame::RasterFrame;
 use crate::render::camera::Camera;
 use crate::scene::{ParseOptions, nff};
-use crate::volume::{Classifier, Limits, Placement, Samples, nrrd, sample_count};
 
 pub use crate::scene::check_scene;
 

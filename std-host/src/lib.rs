@@ -13,8 +13,8 @@
 //! ```
 //!
 //! * [`scene`] (parse): NFF and TOML scenes in world coordinates, and the
-//!   assets they name: [`texture`]s, sampled and computed [`volume`]s,
-//!   MagicaVoxel models ([`vox`]). None of them knows the raster.
+//!   [`assets`] they name: textures, sampled and computed volumes,
+//!   MagicaVoxel models. None of them knows the raster.
 //! * [`shape`]: the shape model. Each primitive is described once, with
 //!   its validation, fixed-point geometry, core voxelizer call,
 //!   object-table entry, exact intersection and saved form.
@@ -77,6 +77,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod assets;
 #[cfg(any(test, feature = "check"))]
 pub mod check;
 pub mod cli;
@@ -86,9 +87,6 @@ pub mod output;
 pub mod render;
 pub mod scene;
 pub mod shape;
-pub mod texture;
 pub mod trace;
-pub mod volume;
-pub mod vox;
 pub mod voxelize;
 pub mod world;

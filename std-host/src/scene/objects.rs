@@ -11,10 +11,10 @@ use glam::DVec3;
 use rrt_core::csg::CsgNode;
 
 use super::SourceLoc;
+use crate::assets::texture::{AnyTexture, Blend};
+use crate::assets::volume::{Classifier, PlacedVolume, Placement, Volume};
+use crate::assets::vox::VoxScene;
 use crate::shape::{Cone, Cuboid, Primitive, SolidPrimitive, Sphere, Torus};
-use crate::texture::{AnyTexture, Blend};
-use crate::volume::{Classifier, PlacedVolume, Placement, Volume};
-use crate::vox::VoxScene;
 use crate::world::Bounds;
 
 /// A classified volume placed in the world: the data, where it goes and
@@ -59,7 +59,7 @@ pub struct VolumeObject {
 }
 
 /// A MagicaVoxel model placed in the world: world cell `c` of the model
-/// (MagicaVoxel's frame, z up, see [`crate::vox`]) covers the cube
+/// (MagicaVoxel's frame, z up, see [`crate::assets::vox`]) covers the cube
 /// `position + cell · (c + [0, 1)³)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VoxObject {
@@ -227,7 +227,7 @@ impl Csg {
 /// What a texture computes.
 #[derive(Clone, Debug, PartialEq)]
 pub enum TextureKind {
-    /// An image map or a solid texture ([`crate::texture`]).
+    /// An image map or a solid texture ([`crate::assets::texture`]).
     World(AnyTexture),
 }
 

@@ -63,9 +63,9 @@ use self::materials::MaterialTable;
 use self::pass::Pass;
 use self::plane::Plane;
 use self::texture::InRaster;
+use crate::assets::texture::AnyTexture;
 use crate::fit::{self, Bytes, FitError, FitOptions};
 use crate::scene::{Scene, SourceLoc, TextureKind};
-use crate::texture::AnyTexture;
 
 /// How to build.
 #[derive(Clone, Copy, Debug, PartialEq)]

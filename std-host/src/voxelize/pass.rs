@@ -4,7 +4,7 @@
 use rrt_core::store::{Counter, Filler, ObjectAttrs};
 
 use super::texture::InRaster;
-use crate::texture::AnyTexture;
+use crate::assets::texture::AnyTexture;
 
 /// Where an object's voxels go.
 pub enum Pass<'a, 'p, 'd, 'r> {

@@ -8,7 +8,7 @@
 //! use rrt_core::raster::Extent;
 //! use rrt_core::store::Texture;
 //! use rrt_host::frame::RasterFrame;
-//! use rrt_host::texture::{Blend, Checker};
+//! use rrt_host::assets::texture::{Blend, Checker};
 //! use rrt_host::voxelize::texture::InRaster;
 //! let frame = RasterFrame { extent: Extent::cube(64).unwrap(),
 //!                           origin: DVec3::ZERO, voxel_size: 0.125 };
@@ -25,8 +25,8 @@ use glam::DVec3;
 use rrt_core::store::Texture;
 use rrt_core::voxelize::NORMAL_ONE;
 
+use crate::assets::texture::{Blend, WorldTexture};
 use crate::frame::RasterFrame;
-use crate::texture::{Blend, WorldTexture};
 
 /// A [`WorldTexture`] in a raster: the core's [`Texture`].
 #[derive(Clone, Debug)]

@@ -13,7 +13,7 @@
 //! use glam::DVec3;
 //! use rrt_core::raster::Extent;
 //! use rrt_host::frame::RasterFrame;
-//! use rrt_host::volume::{Classifier, Grid, Placement, Samples, Volume};
+//! use rrt_host::assets::volume::{Classifier, Grid, Placement, Samples, Volume};
 //! // 2×2×2 samples 10 mm apart, sample (0,0,0) at the physical origin.
 //! let v = Volume::new([2, 2, 2], Grid::axis_aligned([10.0; 3], DVec3::ZERO),
 //!                     Samples::U8(vec![0, 0, 0, 0, 0, 0, 0, 200])).unwrap();
@@ -37,10 +37,12 @@ use rrt_core::voxelize::{Separation, Surfel, VoxelSink};
 
 use super::BuildError;
 use super::pass::Pass;
+use crate::assets::volume::resample::Quantizer;
+use crate::assets::volume::{
+    Classifier, DimsFmt, PlacedVolume, SampleType, VolumeError, sample_count,
+};
 use crate::frame::RasterFrame;
 use crate::scene::VolumeObject;
-use crate::volume::resample::Quantizer;
-use crate::volume::{Classifier, DimsFmt, PlacedVolume, SampleType, VolumeError, sample_count};
 
 /// A predicate on raster voxels: which to keep (see
 /// [`PlacedVolume::voxelize_where`]).
@@ -483,7 +485,7 @@ mod tests {
     use rrt_core::raster::Extent;
 
     use super::*;
-    use crate::volume::{Classifier, Grid, Placement, Samples, Volume};
+    use crate::assets::volume::{Classifier, Grid, Placement, Samples, Volume};
 
     fn ball(n: u32) -> Volume {
         let c = (f64::from(n) - 1.0) / 2.0;

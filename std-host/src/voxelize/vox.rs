@@ -9,9 +9,9 @@ use rrt_core::voxelize::{Surfel, VoxelSink};
 
 use super::BuildError;
 use super::pass::Pass;
+use crate::assets::vox::VoxScene;
 use crate::frame::RasterFrame;
 use crate::scene::VoxObject;
-use crate::vox::VoxScene;
 
 /// Where a scene's world cells go in the raster: cell `c` covers raster
 /// voxels `offset + c·scale + [0, scale)³`.

@@ -5,10 +5,12 @@ use glam::DVec3;
 
 use super::build::Builder;
 use super::schema::{MaterialDef, TextureDef};
+use crate::assets::texture::{
+    AnyTexture, Blend, Checker, ImageTexture, Mapping, Marble, Wood, Wrap,
+};
 use crate::scene::error::SceneError;
 use crate::scene::objects::{SceneTexture, TextureKind};
 use crate::scene::{Material, Scene};
-use crate::texture::{AnyTexture, Blend, Checker, ImageTexture, Mapping, Marble, Wood, Wrap};
 
 impl Builder<'_> {
     pub(super) fn material(
@@ -78,7 +80,7 @@ impl Builder<'_> {
                 "expected exactly one of checker, marble, wood, image",
             ));
         }
-        let bad = |e: crate::texture::TextureError| self.err(s.clone(), key, e.to_string());
+        let bad = |e: crate::assets::texture::TextureError| self.err(s.clone(), key, e.to_string());
         let any = if let Some(c) = &d.checker {
             AnyTexture::Checker(
                 Checker::new(self.vec3(&s, key, c.origin)?, c.size, c.colours).map_err(bad)?,

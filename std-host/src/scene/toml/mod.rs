@@ -63,7 +63,7 @@ pub const MAX_FILE_BYTES: u64 = 16 << 20;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Options {
     /// Limits for each volume's samples.
-    pub volume: crate::volume::Limits,
+    pub volume: crate::assets::volume::Limits,
     /// Most `.vox` file bytes.
     pub max_vox_bytes: u64,
     /// Most vertices over all polygons (meshes, patches, NFF includes).
@@ -77,7 +77,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Self {
-            volume: crate::volume::Limits::default(),
+            volume: crate::assets::volume::Limits::default(),
             max_vox_bytes: 256 << 20,
             max_vertices: 1 << 26,
             max_patch_steps: 64,

@@ -310,7 +310,7 @@ impl Builder<'_> {
                 ),
             ));
         }
-        let vox = crate::vox::read(&path)
+        let vox = crate::assets::vox::read(&path)
             .map_err(|e| self.err(v.file.span(), "object.vox.file", e.to_string()))?;
         let position = self.vec3(&at.span, "object.vox.position", v.position)?;
         if !(v.cell.is_finite() && v.cell > 0.0) {

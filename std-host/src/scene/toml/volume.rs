@@ -8,11 +8,13 @@ use glam::DVec3;
 
 use super::build::Builder;
 use super::schema::VolumeDef;
+use crate::assets::volume::computed::{self, Metaball, Metaballs};
+use crate::assets::volume::raw::{self, RawSpec};
+use crate::assets::volume::{
+    self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, SampleType,
+};
 use crate::scene::error::SceneError;
 use crate::scene::objects::SceneVolume;
-use crate::volume::computed::{self, Metaball, Metaballs};
-use crate::volume::raw::{self, RawSpec};
-use crate::volume::{self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, SampleType};
 
 impl Builder<'_> {
     pub(super) fn volume(

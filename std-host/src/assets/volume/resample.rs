@@ -13,7 +13,7 @@
 //!
 //! ```
 //! use glam::DVec3;
-//! use rrt_host::volume::{Grid, Placement, Samples, Volume};
+//! use rrt_host::assets::volume::{Grid, Placement, Samples, Volume};
 //! // 2×2×2 samples 10 mm apart, sample (0,0,0) at the physical origin.
 //! let v = Volume::new([2, 2, 2], Grid::axis_aligned([10.0; 3], DVec3::ZERO),
 //!                     Samples::U8(vec![0, 0, 0, 0, 0, 0, 0, 200])).unwrap();

@@ -3,8 +3,8 @@
 //! samples (after an optional number of header bytes to skip).
 //!
 //! ```no_run
-//! use rrt_host::volume::raw::{self, RawSpec};
-//! use rrt_host::volume::{Endian, Grid, Limits, SampleType};
+//! use rrt_host::assets::volume::raw::{self, RawSpec};
+//! use rrt_host::assets::volume::{Endian, Grid, Limits, SampleType};
 //! let spec = RawSpec {
 //!     dims: [256, 256, 110],
 //!     sample_type: SampleType::U8,
@@ -13,7 +13,7 @@
 //!     skip: 0,
 //! };
 //! let engine = raw::read("engine.256x256x110", &spec, &Limits::default())?;
-//! # Ok::<(), rrt_host::volume::VolumeError>(())
+//! # Ok::<(), rrt_host::assets::volume::VolumeError>(())
 //! ```
 
 use std::fs::File;

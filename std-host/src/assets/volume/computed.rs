@@ -9,8 +9,8 @@
 //!
 //! ```
 //! use glam::DVec3;
-//! use rrt_host::volume::computed::{Metaball, Metaballs, sample};
-//! use rrt_host::volume::{Classifier, Grid, Limits};
+//! use rrt_host::assets::volume::computed::{Metaball, Metaballs, sample};
+//! use rrt_host::assets::volume::{Classifier, Grid, Limits};
 //! let blobs = Metaballs(vec![
 //!     Metaball { centre: DVec3::new(-0.4, 0.0, 0.0), radius: 1.0, strength: 1.0 },
 //!     Metaball { centre: DVec3::new(0.4, 0.0, 0.0), radius: 1.0, strength: 1.0 },

@@ -14,7 +14,7 @@
 //!
 //! ```
 //! use glam::DVec3;
-//! use rrt_host::texture::{Blend, Checker, WorldTexture};
+//! use rrt_host::assets::texture::{Blend, Checker, WorldTexture};
 //! let checker = Checker::new(DVec3::ZERO, 1.0, [[255, 255, 255], [200, 0, 0]]).unwrap();
 //! // (0.4375, 0.4375, 0.4375) lies in the white cell, x = 1.4375 in the red one.
 //! let white = checker.world_color(DVec3::splat(0.4375), DVec3::Z, [9; 3]);

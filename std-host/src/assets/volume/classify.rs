@@ -2,7 +2,7 @@
 //! the gray-level gradient normal.
 //!
 //! ```
-//! use rrt_host::volume::{Classifier, ColorRamp, Ramp};
+//! use rrt_host::assets::volume::{Classifier, ColorRamp, Ramp};
 //! // Skin at 20 and above, bone (≥ 120) white, soft tissue skin-coloured;
 //! // values 60..80 cut away by the opacity ramp.
 //! let c = Classifier::iso(20.0)

@@ -3,7 +3,7 @@
 //! `int16`, `uint16` and `float`.
 //!
 //! ```
-//! use rrt_host::volume::{nrrd, Limits, SampleType};
+//! use rrt_host::assets::volume::{nrrd, Limits, SampleType};
 //! let mut file = b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 1 1\n\
 //!                  spacings: 0.5 0.5 2\nencoding: raw\n\n".to_vec();
 //! file.extend_from_slice(&[7, 9]);

@@ -4,7 +4,7 @@
 //!
 //! ```
 //! use dot_vox::{DotVoxData, Model, Size, Voxel};
-//! use rrt_host::vox;
+//! use rrt_host::assets::vox;
 //! // A 2×1×1 model written with dot_vox, read back.
 //! let data = DotVoxData {
 //!     version: 150,
