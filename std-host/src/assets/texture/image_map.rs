@@ -1,0 +1,428 @@
+//! Image maps: a 2D image wrapped onto surfaces by a planar, cylindrical
+//! or spherical mapping, looked up bilinearly between pixel centres.
+
+use std::f64::consts::{PI, TAU};
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::{TextureError, WorldTexture, invalid};
+
+/// What happens outside `[0, 1)` in texture coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Wrap {
+    /// Tile the image.
+    #[default]
+    Repeat,
+    /// Mirror every other tile.
+    Mirror,
+    /// Extend the edge pixels.
+    Clamp,
+}
+
+impl Wrap {
+    /// `t` brought into `[0, 1]`.
+    #[must_use]
+    pub fn apply(self, t: f64) -> f64 {
+        match self {
+            Self::Repeat => t - t.floor(),
+            Self::Mirror => {
+                let m = t.rem_euclid(2.0);
+                if m > 1.0 { 2.0 - m } else { m }
+            }
+            Self::Clamp => t.clamp(0.0, 1.0),
+        }
+    }
+}
+
+/// How world points get texture coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Mapping {
+    /// Projection onto a plane: `u = (p − origin)·u_axis / |u_axis|²`,
+    /// likewise `v`: the image spans `u_axis` × `v_axis` in the world.
+    Planar {
+        /// World point of texture coordinates (0, 0).
+        origin: DVec3,
+        /// The image's width in the world (direction and length).
+        u_axis: DVec3,
+        /// The image's height in the world (direction and length).
+        v_axis: DVec3,
+    },
+    /// Around an axis: `u` is the angle about `axis` from `reference`
+    /// (counter-clockwise seen from the axis' tip) over 2π, `v` the
+    /// height along `axis` over its length.
+    Cylindrical {
+        /// A point on the axis (height 0).
+        origin: DVec3,
+        /// The axis; its length is the height of one image.
+        axis: DVec3,
+        /// The direction of `u = 0` (its part across the axis is used).
+        reference: DVec3,
+    },
+    /// Around a centre: `u` is the longitude about `pole` from
+    /// `reference` over 2π, `v` the latitude from the south pole (0) to
+    /// the north pole (1).
+    Spherical {
+        /// The centre.
+        centre: DVec3,
+        /// The direction of the north pole.
+        pole: DVec3,
+        /// The direction of longitude 0 (its part across the pole is
+        /// used).
+        reference: DVec3,
+    },
+}
+
+/// An orthonormal frame `(e1, e2, axis)` from an axis and a reference
+/// direction across it.
+fn frame_of(axis: DVec3, reference: DVec3) -> Option<(DVec3, DVec3, DVec3)> {
+    let a = axis.try_normalize()?;
+    let e1 = (reference - a * reference.dot(a)).try_normalize()?;
+    Some((e1, a.cross(e1), a))
+}
+
+impl Mapping {
+    /// Checks the mapping's vectors are finite and usable.
+    ///
+    /// # Errors
+    /// [`TextureError::Invalid`] naming the parameter.
+    pub fn validate(&self) -> Result<(), TextureError> {
+        let finite = |name: &'static str, v: DVec3| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(invalid(name, format!("{v} is not finite")))
+            }
+        };
+        match *self {
+            Self::Planar {
+                origin,
+                u_axis,
+                v_axis,
+            } => {
+                finite("planar mapping origin", origin)?;
+                finite("planar mapping u axis", u_axis)?;
+                finite("planar mapping v axis", v_axis)?;
+                if u_axis.length_squared() == 0.0 || v_axis.length_squared() == 0.0 {
+                    return Err(invalid(
+                        "planar mapping",
+                        "the u and v axes must be non-zero".into(),
+                    ));
+                }
+                if u_axis.cross(v_axis).length() <= 1e-12 * u_axis.length() * v_axis.length() {
+                    return Err(invalid(
+                        "planar mapping",
+                        "the u and v axes are parallel".into(),
+                    ));
+                }
+            }
+            Self::Cylindrical {
+                origin,
+                axis,
+                reference,
+            } => {
+                finite("cylindrical mapping origin", origin)?;
+                finite("cylindrical mapping axis", axis)?;
+                finite("cylindrical mapping reference", reference)?;
+                if frame_of(axis, reference).is_none() {
+                    return Err(invalid(
+                        "cylindrical mapping",
+                        "the axis must be non-zero and the reference not along it".into(),
+                    ));
+                }
+            }
+            Self::Spherical {
+                centre,
+                pole,
+                reference,
+            } => {
+                finite("spherical mapping centre", centre)?;
+                finite("spherical mapping pole", pole)?;
+                finite("spherical mapping reference", reference)?;
+                if frame_of(pole, reference).is_none() {
+                    return Err(invalid(
+                        "spherical mapping",
+                        "the pole must be non-zero and the reference not along it".into(),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Texture coordinates of world point `p` (before scale, offset and
+    /// wrap); `None` on a cylinder's axis or at a sphere's centre.
+    #[must_use]
+    pub fn uv(&self, p: DVec3) -> Option<[f64; 2]> {
+        match *self {
+            Self::Planar {
+                origin,
+                u_axis,
+                v_axis,
+            } => {
+                let d = p - origin;
+                Some([
+                    d.dot(u_axis) / u_axis.length_squared(),
+                    d.dot(v_axis) / v_axis.length_squared(),
+                ])
+            }
+            Self::Cylindrical {
+                origin,
+                axis,
+                reference,
+            } => {
+                let (e1, e2, _) = frame_of(axis, reference)?;
+                let d = p - origin;
+                let (x, y) = (d.dot(e1), d.dot(e2));
+                if x == 0.0 && y == 0.0 {
+                    return None;
+                }
+                Some([
+                    y.atan2(x).rem_euclid(TAU) / TAU,
+                    d.dot(axis) / axis.length_squared(),
+                ])
+            }
+            Self::Spherical {
+                centre,
+                pole,
+                reference,
+            } => {
+                let (e1, e2, a) = frame_of(pole, reference)?;
+                let d = (p - centre).try_normalize()?;
+                let lon = d.dot(e2).atan2(d.dot(e1)).rem_euclid(TAU);
+                let lat = d.dot(a).clamp(-1.0, 1.0).acos();
+                Some([lon / TAU, 1.0 - lat / PI])
+            }
+        }
+    }
+}
+
+/// An RGB image mapped onto surfaces.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageTexture {
+    width: u32,
+    height: u32,
+    pixels: Vec<[u8; 3]>,
+    mapping: Mapping,
+    /// `uv' = uv · scale + offset`.
+    pub scale: [f64; 2],
+    /// See `scale`.
+    pub offset: [f64; 2],
+    /// Outside `[0, 1)`.
+    pub wrap: Wrap,
+}
+
+/// Largest image accepted, in pixels (256 megapixels).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+
+impl ImageTexture {
+    /// Reads a PNG or JPEG file (format told by its content, not its
+    /// name).
+    ///
+    /// # Errors
+    /// [`TextureError::Io`], [`TextureError::NotImage`] for a file that is
+    /// not a PNG or JPEG, [`TextureError::Decode`] for a damaged one or one
+    /// above [`MAX_IMAGE_PIXELS`], [`TextureError::Invalid`] for a bad
+    /// mapping.
+    pub fn open(path: impl AsRef<Path>, mapping: Mapping) -> Result<Self, TextureError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|source| TextureError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_bytes(path, &bytes, mapping)
+    }
+
+    /// Decodes a PNG or JPEG held in memory, named `path` in errors.
+    ///
+    /// # Errors
+    /// As [`ImageTexture::open`].
+    pub fn from_bytes(path: &Path, bytes: &[u8], mapping: Mapping) -> Result<Self, TextureError> {
+        let format = match image::guess_format(bytes) {
+            Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => f,
+            Ok(other) => {
+                return Err(TextureError::NotImage {
+                    path: path.to_path_buf(),
+                    detail: format!("a {other:?} image"),
+                });
+            }
+            Err(_) => {
+                let head: String = bytes
+                    .iter()
+                    .take(8)
+                    .map(|b| format!("{b:02x}"))
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                return Err(TextureError::NotImage {
+                    path: path.to_path_buf(),
+                    detail: if bytes.is_empty() {
+                        "the file is empty".into()
+                    } else {
+                        format!("no PNG or JPEG signature (starts with {head})")
+                    },
+                });
+            }
+        };
+        let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(MAX_IMAGE_PIXELS * 4);
+        reader.limits(limits);
+        let img = reader.decode().map_err(|source| TextureError::Decode {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let rgb = img.to_rgb8();
+        Self::from_rgb(
+            rgb.width(),
+            rgb.height(),
+            rgb.pixels().map(|p| p.0).collect(),
+            mapping,
+        )
+    }
+
+    /// An image from its pixels (row 0 at the top, `width` per row).
+    ///
+    /// # Errors
+    /// [`TextureError::Invalid`] for an empty image, a pixel count that is
+    /// not `width · height`, or a bad mapping.
+    pub fn from_rgb(
+        width: u32,
+        height: u32,
+        pixels: Vec<[u8; 3]>,
+        mapping: Mapping,
+    ) -> Result<Self, TextureError> {
+        if width == 0 || height == 0 {
+            return Err(invalid("image texture", "the image is empty".into()));
+        }
+        if u64::try_from(pixels.len()).ok() != Some(u64::from(width) * u64::from(height)) {
+            return Err(invalid(
+                "image texture",
+                format!("{} pixels for {width}×{height}", pixels.len()),
+            ));
+        }
+        mapping.validate()?;
+        Ok(Self {
+            width,
+            height,
+            pixels,
+            mapping,
+            scale: [1.0, 1.0],
+            offset: [0.0, 0.0],
+            wrap: Wrap::Repeat,
+        })
+    }
+
+    /// With `uv' = uv · scale + offset`.
+    ///
+    /// # Errors
+    /// [`TextureError::Invalid`] unless both are finite and the scales
+    /// non-zero.
+    pub fn with_transform(
+        mut self,
+        scale: [f64; 2],
+        offset: [f64; 2],
+    ) -> Result<Self, TextureError> {
+        if !scale.iter().chain(&offset).all(|x| x.is_finite()) || scale.contains(&0.0) {
+            return Err(invalid(
+                "image texture",
+                format!(
+                    "scale {scale:?} / offset {offset:?}: expected finite numbers, scales non-zero"
+                ),
+            ));
+        }
+        self.scale = scale;
+        self.offset = offset;
+        Ok(self)
+    }
+
+    /// With the wrap rule.
+    #[must_use]
+    pub fn with_wrap(mut self, wrap: Wrap) -> Self {
+        self.wrap = wrap;
+        self
+    }
+
+    /// Width and height in pixels.
+    #[must_use]
+    pub const fn size(&self) -> [u32; 2] {
+        [self.width, self.height]
+    }
+
+    /// The mapping.
+    #[must_use]
+    pub const fn mapping(&self) -> &Mapping {
+        &self.mapping
+    }
+
+    fn pixel(&self, x: u32, y: u32) -> [f64; 3] {
+        let i = u64::from(y.min(self.height - 1)) * u64::from(self.width)
+            + u64::from(x.min(self.width - 1));
+        let p = usize::try_from(i)
+            .ok()
+            .and_then(|i| self.pixels.get(i))
+            .copied()
+            .unwrap_or([0; 3]);
+        p.map(f64::from)
+    }
+
+    /// The bilinear colour at texture coordinates `(u, v)` after scale,
+    /// offset and wrap.
+    #[must_use]
+    pub fn at_uv(&self, uv: [f64; 2]) -> [u8; 3] {
+        let u = self.wrap.apply(uv[0] * self.scale[0] + self.offset[0]);
+        let v = self.wrap.apply(uv[1] * self.scale[1] + self.offset[1]);
+        let (w, h) = (f64::from(self.width), f64::from(self.height));
+        // Continuous pixel coordinates, pixel centres at +½; v up.
+        let x = u * w - 0.5;
+        let y = (1.0 - v) * h - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let repeat = self.wrap == Wrap::Repeat;
+        let idx = |c: f64, n: u32| -> u32 {
+            let n = i64::from(n);
+            // |c| ≤ n + 1.
+            let c = c as i64;
+            let c = if repeat {
+                c.rem_euclid(n)
+            } else {
+                c.clamp(0, n - 1)
+            };
+            u32::try_from(c).unwrap_or(0)
+        };
+        let (xa, xb) = (idx(x0, self.width), idx(x0 + 1.0, self.width));
+        let (ya, yb) = (idx(y0, self.height), idx(y0 + 1.0, self.height));
+        let (p00, p10, p01, p11) = (
+            self.pixel(xa, ya),
+            self.pixel(xb, ya),
+            self.pixel(xa, yb),
+            self.pixel(xb, yb),
+        );
+        let mut out = [0u8; 3];
+        for c in 0..3 {
+            let top = p00[c] + (p10[c] - p00[c]) * fx;
+            let bot = p01[c] + (p11[c] - p01[c]) * fx;
+            // Between two u8 values.
+            out[c] = (top + (bot - top) * fy).round().clamp(0.0, 255.0) as u8;
+        }
+        out
+    }
+}
+
+impl WorldTexture for ImageTexture {
+    fn world_color(&self, p: DVec3, _n: DVec3, base: [u8; 3]) -> [u8; 3] {
+        self.mapping.uv(p).map_or(base, |uv| self.at_uv(uv))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrap_rules() {
+        assert_eq!(Wrap::Repeat.apply(1.25), 0.25);
+        assert_eq!(Wrap::Repeat.apply(-0.25), 0.75);
+        assert_eq!(Wrap::Mirror.apply(1.25), 0.75);
+        assert_eq!(Wrap::Clamp.apply(-3.0), 0.0);
+    }
+}
