@@ -50,7 +50,7 @@ use rrt_core::connectivity::Connectivity;
 use rrt_core::light::{LightError, LightParams, LightReport};
 use rrt_core::object_table::MAX_LIGHTS;
 use rrt_core::raster::RasterMut;
-use rrt_core::store::{self, Counter, Limits, directory_len};
+use rrt_core::store::{self, Built, Counter, Limits, Sizing, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 use rrt_core::voxelize::error::VoxelizeError;
@@ -60,12 +60,13 @@ pub use self::voxel_scene::{VoxelScene, WorldLight, WorldObject, finish_plane, l
 
 use self::light::LightScene;
 use self::materials::MaterialTable;
+use self::objects::TableObject;
 use self::pass::Pass;
 use self::plane::Plane;
-use self::texture::InRaster;
-use crate::assets::texture::AnyTexture;
+use self::texture::MaterialTextures;
 use crate::fit::{self, Bytes, FitError, FitOptions};
-use crate::scene::{Scene, SourceLoc, TextureKind};
+use crate::frame::RasterFrame;
+use crate::scene::{Scene, SourceLoc};
 
 /// How to build.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -242,31 +243,15 @@ pub fn build(
         directory_len(extent).ok_or_else(|| BuildError::Raster("too many bricks".into()))?;
     let mut directory = vec![0u32; dir_len];
     progress.set_length(u64::try_from(2 * n).unwrap_or(u64::MAX));
-    // Each texture once, in the raster.
-    let textures: Vec<InRaster<AnyTexture>> = scene
-        .textures
-        .iter()
-        .map(|t| match &t.kind {
-            TextureKind::World(w) => InRaster::new(w.clone(), frame, t.blend),
-        })
-        .collect();
-    let texture_of = |m: usize| {
-        scene
-            .material_textures
-            .get(&m)
-            .and_then(|&t| textures.get(t))
-    };
 
-    progress.set_message("voxelizing (count pass)");
-    let raster =
-        RasterMut::new(extent, &mut plane).map_err(|e| BuildError::Raster(e.to_string()))?;
-    let mut counter = Counter::new(raster, &mut directory)?;
-    for o in &objects {
-        o.voxelize(&frame, separation, Pass::Count(&mut counter))?;
-        progress.inc(1);
-    }
-    let offers = counter.report().offers;
-    let sizing = counter.finish()?;
+    let (sizing, offers) = count_pass(
+        &objects,
+        &frame,
+        separation,
+        &mut plane,
+        &mut directory,
+        progress,
+    )?;
     let records_n = sizing.records();
     let needed = u64::try_from(
         extent
@@ -283,26 +268,18 @@ pub fn build(
             limit: opts.fit.max_memory,
         });
     }
-
-    progress.set_message("voxelizing (fill pass)");
     let mut records = vec![VoxelRecord::default(); records_n];
-    let limits = Limits {
-        objects: u32::try_from(n).unwrap_or(u32::MAX),
-        materials: u32::try_from(materials.list.len()).unwrap_or(u32::MAX),
-    };
-    let mut filler = sizing.fill(&mut records, limits)?;
-    for (id, o) in objects.iter().enumerate() {
-        let m = o.material();
-        let pass = Pass::Fill {
-            filler: &mut filler,
-            attrs: materials.attrs(id, m),
-            leaves: o.leaf_materials().map(|l| materials.attrs(id, l)).collect(),
-            texture: texture_of(m),
-        };
-        o.voxelize(&frame, separation, pass)?;
-        progress.inc(1);
-    }
-    let built = filler.finish()?;
+    let textures = MaterialTextures::new(scene, frame);
+    let built = fill_pass(
+        &objects,
+        &frame,
+        separation,
+        sizing,
+        &mut records,
+        &materials,
+        &textures,
+        progress,
+    )?;
     let voxelize = t0.elapsed();
 
     let t1 = Instant::now();
@@ -360,4 +337,61 @@ pub fn build(
         },
         report,
     ))
+}
+
+/// The count pass: every object's voxels counted into the plane and the
+/// brick directory. Returns the sizing of the records and the voxels
+/// offered.
+fn count_pass<'p, 'd>(
+    objects: &[TableObject<'_>],
+    frame: &RasterFrame,
+    separation: Separation,
+    plane: &'p mut [u8],
+    directory: &'d mut [u32],
+    progress: &ProgressBar,
+) -> Result<(Sizing<'p, 'd>, u64), BuildError> {
+    progress.set_message("voxelizing (count pass)");
+    let raster =
+        RasterMut::new(frame.extent, plane).map_err(|e| BuildError::Raster(e.to_string()))?;
+    let mut counter = Counter::new(raster, directory)?;
+    for o in objects {
+        o.voxelize(frame, separation, Pass::Count(&mut counter))?;
+        progress.inc(1);
+    }
+    let offers = counter.report().offers;
+    Ok((counter.finish()?, offers))
+}
+
+/// The fill pass: every object again, into `records`, named with its
+/// object id, material and colour (a textured material's colour computed
+/// per voxel). Returns the store, its bricks sorted and proximity flags set.
+#[allow(clippy::too_many_arguments)]
+fn fill_pass<'p, 'd, 'r>(
+    objects: &[TableObject<'_>],
+    frame: &RasterFrame,
+    separation: Separation,
+    sizing: Sizing<'p, 'd>,
+    records: &'r mut [VoxelRecord],
+    materials: &MaterialTable,
+    textures: &MaterialTextures,
+    progress: &ProgressBar,
+) -> Result<Built<'p, 'd, 'r>, BuildError> {
+    progress.set_message("voxelizing (fill pass)");
+    let limits = Limits {
+        objects: u32::try_from(objects.len()).unwrap_or(u32::MAX),
+        materials: u32::try_from(materials.list.len()).unwrap_or(u32::MAX),
+    };
+    let mut filler = sizing.fill(records, limits)?;
+    for (id, o) in objects.iter().enumerate() {
+        let m = o.material();
+        let pass = Pass::Fill {
+            filler: &mut filler,
+            attrs: materials.attrs(id, m),
+            leaves: o.leaf_materials().map(|l| materials.attrs(id, l)).collect(),
+            texture: textures.of(m),
+        };
+        o.voxelize(frame, separation, pass)?;
+        progress.inc(1);
+    }
+    Ok(filler.finish()?)
 }

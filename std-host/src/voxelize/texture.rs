@@ -21,12 +21,15 @@
 //!                          [0, 0, 1 << 30], [9; 3]), [200, 0, 0]);
 //! ```
 
+use std::collections::BTreeMap;
+
 use glam::DVec3;
 use rrt_core::store::Texture;
 use rrt_core::voxelize::NORMAL_ONE;
 
-use crate::assets::texture::{Blend, WorldTexture};
+use crate::assets::texture::{AnyTexture, Blend, WorldTexture};
 use crate::frame::RasterFrame;
+use crate::scene::{Scene, TextureKind};
 
 /// A [`WorldTexture`] in a raster: the core's [`Texture`].
 #[derive(Clone, Debug)]
@@ -56,5 +59,36 @@ impl<T> InRaster<T> {
             frame,
             blend,
         }
+    }
+}
+
+/// Each texture of a scene once, in the raster, and which material has
+/// which.
+#[derive(Debug)]
+pub struct MaterialTextures<'s> {
+    textures: Vec<InRaster<AnyTexture>>,
+    of_material: &'s BTreeMap<usize, usize>,
+}
+
+impl<'s> MaterialTextures<'s> {
+    /// The textures of `scene` in the raster `frame`.
+    #[must_use]
+    pub fn new(scene: &'s Scene, frame: RasterFrame) -> Self {
+        Self {
+            textures: scene
+                .textures
+                .iter()
+                .map(|t| match &t.kind {
+                    TextureKind::World(w) => InRaster::new(w.clone(), frame, t.blend),
+                })
+                .collect(),
+            of_material: &scene.material_textures,
+        }
+    }
+
+    /// The texture of scene material `m`, if it has one.
+    #[must_use]
+    pub fn of(&self, m: usize) -> Option<&InRaster<AnyTexture>> {
+        self.textures.get(*self.of_material.get(&m)?)
     }
 }

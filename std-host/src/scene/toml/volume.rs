@@ -1,9 +1,11 @@
 //! Volume data: NRRD and raw files and computed metaballs, classified and
 //! placed in the world.
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use ::toml::Spanned;
+
 use glam::DVec3;
 
 use super::build::Builder;
@@ -11,7 +13,7 @@ use super::schema::VolumeDef;
 use crate::assets::volume::computed::{self, Metaball, Metaballs};
 use crate::assets::volume::raw::{self, RawSpec};
 use crate::assets::volume::{
-    self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, SampleType,
+    self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, SampleType, Volume,
 };
 use crate::scene::error::SceneError;
 use crate::scene::objects::SceneVolume;
@@ -35,10 +37,28 @@ impl Builder<'_> {
                 "expected exactly one of file (NRRD), raw, metaballs",
             ));
         }
-        let data = if let Some(f) = &d.file {
+        let data = self.volume_data(d, &s, &key)?;
+        let classifier = self.classifier(d, &s, &key)?;
+        let placement = self.placement(d, &data, &s, &key)?;
+        Ok(SceneVolume {
+            volume: Arc::new(data),
+            placement,
+            classifier,
+        })
+    }
+
+    /// The samples of a volume: an NRRD file, a raw file or metaballs.
+    fn volume_data(
+        &self,
+        d: &VolumeDef,
+        s: &Range<usize>,
+        key: &dyn Fn(&str) -> String,
+    ) -> Result<Volume, SceneError> {
+        let s = s.clone();
+        if let Some(f) = &d.file {
             let (path, _) = self.path(f, &key("file"))?;
             volume::nrrd::read(&path, &self.opts.volume)
-                .map_err(|e| self.err(f.span(), &key("file"), e.to_string()))?
+                .map_err(|e| self.err(f.span(), &key("file"), e.to_string()))
         } else if let Some(r) = &d.raw {
             let sample_type = match r.sample_type.as_str() {
                 "uint8" | "u8" => SampleType::U8,
@@ -66,7 +86,7 @@ impl Builder<'_> {
                 skip: r.skip,
             };
             raw::read(&path, &spec, &self.opts.volume)
-                .map_err(|e| self.err(r.file.span(), &key("raw"), e.to_string()))?
+                .map_err(|e| self.err(r.file.span(), &key("raw"), e.to_string()))
         } else if let Some(m) = &d.metaballs {
             let lo = self.vec3(&s, &key("metaballs.min"), m.min)?;
             let hi = self.vec3(&s, &key("metaballs.max"), m.max)?;
@@ -97,10 +117,20 @@ impl Builder<'_> {
                 Grid::axis_aligned(spacing, lo),
                 &self.opts.volume,
             )
-            .map_err(|e| self.err(s.clone(), &key("metaballs"), e.to_string()))?
+            .map_err(|e| self.err(s.clone(), &key("metaballs"), e.to_string()))
         } else {
-            return Err(self.err(s, &key("file"), "no data"));
-        };
+            Err(self.err(s.clone(), &key("file"), "no data"))
+        }
+    }
+
+    /// The iso-value and the optional opacity and colour ramps.
+    fn classifier(
+        &self,
+        d: &VolumeDef,
+        s: &Range<usize>,
+        key: &dyn Fn(&str) -> String,
+    ) -> Result<Classifier, SceneError> {
+        let s = s.clone();
         let mut classifier = Classifier::iso(d.iso);
         if let Some(o) = &d.opacity {
             let ramp = Ramp::new(o.iter().map(|p| (p[0], p[1])).collect())
@@ -129,9 +159,21 @@ impl Builder<'_> {
         classifier
             .validate()
             .map_err(|e| self.err(s.clone(), &key("iso"), e.to_string()))?;
-        let placement = match (&d.fit, d.translate, d.scale) {
+        Ok(classifier)
+    }
+
+    /// Where the volume goes: fitted into a box, or translated and scaled.
+    fn placement(
+        &self,
+        d: &VolumeDef,
+        data: &Volume,
+        s: &Range<usize>,
+        key: &dyn Fn(&str) -> String,
+    ) -> Result<Placement, SceneError> {
+        let s = s.clone();
+        match (&d.fit, d.translate, d.scale) {
             (Some(b), None, None) => Placement::fit_into(
-                &data,
+                data,
                 crate::world::Bounds {
                     min: self.vec3(&s, &key("fit.min"), b.min)?,
                     max: self.vec3(&s, &key("fit.max"), b.max)?,
@@ -145,11 +187,6 @@ impl Builder<'_> {
                 return Err(self.err(s, &key("fit"), "give fit, or translate and scale, not both"));
             }
         }
-        .map_err(|e| self.err(s.clone(), &key("fit"), e.to_string()))?;
-        Ok(SceneVolume {
-            volume: Arc::new(data),
-            placement,
-            classifier,
-        })
+        .map_err(|e| self.err(s.clone(), &key("fit"), e.to_string()))
     }
 }
