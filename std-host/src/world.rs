@@ -30,6 +30,21 @@ impl Bounds {
         self.max = self.max.max(hi);
     }
 
+    /// Grows the box to hold `other`.
+    pub fn include_bounds(&mut self, other: Self) {
+        self.include(other.min, other.max);
+    }
+
+    /// The box around `points` ([`Bounds::EMPTY`] for none).
+    #[must_use]
+    pub fn around(points: impl IntoIterator<Item = DVec3>) -> Self {
+        let mut b = Self::EMPTY;
+        for p in points {
+            b.include(p, p);
+        }
+        b
+    }
+
     /// Whether the box holds at least one point.
     #[must_use]
     pub fn is_empty(&self) -> bool {

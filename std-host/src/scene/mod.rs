@@ -304,11 +304,7 @@ impl Scene {
     /// The box around the vertices of `polygon`.
     #[must_use]
     pub fn polygon_bounds(&self, polygon: &Polygon) -> Bounds {
-        let mut b = Bounds::EMPTY;
-        for &v in self.polygon_vertices(polygon) {
-            b.include(v, v);
-        }
-        b
+        Bounds::around(self.polygon_vertices(polygon).iter().copied())
     }
 
     /// The triangles of `polygon`'s fan: vertices 0, `t + 1`, `t + 2` for
@@ -366,12 +362,10 @@ impl Scene {
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::EMPTY;
         for s in &self.spheres {
-            let w = s.shape.bounds();
-            b.include(w.min, w.max);
+            b.include_bounds(s.shape.bounds());
         }
         for c in &self.cones {
-            let w = c.shape.disc_bounds();
-            b.include(w.min, w.max);
+            b.include_bounds(c.shape.disc_bounds());
         }
         for p in &self.polygons {
             for &v in self.polygon_vertices(p) {
@@ -379,22 +373,16 @@ impl Scene {
             }
         }
         for t in &self.tori {
-            let w = t.shape.bounds();
-            b.include(w.min, w.max);
+            b.include_bounds(t.shape.bounds());
         }
         for v in &self.volumes {
-            let w = v.data.world_bounds();
-            b.include(w.min, w.max);
+            b.include_bounds(v.data.world_bounds());
         }
-        for v in &self.voxes {
-            if let Some(w) = v.world_bounds() {
-                b.include(w.min, w.max);
-            }
+        for w in self.voxes.iter().filter_map(VoxObject::world_bounds) {
+            b.include_bounds(w);
         }
-        for c in &self.csgs {
-            if let Some(w) = c.world_bounds() {
-                b.include(w.min, w.max);
-            }
+        for w in self.csgs.iter().filter_map(Csg::world_bounds) {
+            b.include_bounds(w);
         }
         b
     }

@@ -201,7 +201,7 @@ impl Csg {
                 CsgNode::Union(x, y) => match (get(x), get(y)) {
                     (Some(p), Some(q)) => {
                         let mut u = p;
-                        u.include(q.min, q.max);
+                        u.include_bounds(q);
                         Some(u)
                     }
                     (p, q) => p.or(q),

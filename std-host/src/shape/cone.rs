@@ -5,13 +5,9 @@ use glam::DVec3;
 use rrt_core::csg;
 use rrt_core::geometry;
 use rrt_core::object_table as table;
-use rrt_core::raster::Extent;
-use rrt_core::voxelize::error::VoxelizeError;
-use rrt_core::voxelize::{Separation, VoxelSink, cone};
+use rrt_core::voxelize::cone;
 
-use super::{
-    Primitive, Shape, Slots, SolidPrimitive, Surface, Unfit, get, non_negative, positive, put,
-};
+use super::{Primitive, Slots, SolidPrimitive, Surface, Unfit, get, non_negative, positive, put};
 use crate::frame::RasterFrame;
 use crate::world::{Bounds, Hit, Ray};
 
@@ -105,19 +101,8 @@ impl Surface for Cone {
         Ok(c)
     }
 
-    fn entry(fixed: geometry::Cone) -> table::Shape {
-        table::Shape::Cone(fixed)
-    }
-
-    /// The open lateral surface ([`cone::surface`]).
-    fn voxelize(
-        fixed: &geometry::Cone,
-        separation: Separation,
-        extent: Extent,
-        sink: &mut dyn VoxelSink,
-    ) -> Result<u64, VoxelizeError> {
-        cone::surface(fixed, separation, extent, sink)
-    }
+    // Voxelized by `cone::surface`: the open lateral surface.
+    core_surface!(geometry::Cone, table::Shape::Cone, cone::surface);
 
     /// Ray–open cone or cylinder (NFF `c`: no end caps), a port of
     /// `embree_nff`'s `cone_hit` and `cone_normal` in `f64`. Radii are taken
@@ -201,12 +186,6 @@ impl SolidPrimitive for Cone {
     /// holds no voxel.
     fn solid(&self, frame: &RasterFrame) -> Option<Box<dyn csg::Solid>> {
         Some(Box::new(self.to_core(frame)?))
-    }
-}
-
-impl From<Cone> for Shape {
-    fn from(c: Cone) -> Self {
-        Self::Cone(c)
     }
 }
 

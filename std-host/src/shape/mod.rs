@@ -34,6 +34,26 @@
 //! ([`crate::trace::shading::face_forward`]). Tangent (grazing) rays count as hits.
 //! No input makes them panic; non-finite input gives `None`.
 
+/// [`Surface::entry`] and [`Surface::voxelize`] for a primitive whose
+/// fixed-point geometry `$fixed` is the core object-table entry `$entry`
+/// and is voxelized by the core's `$voxelizer`.
+macro_rules! core_surface {
+    ($fixed:ty, $entry:path, $voxelizer:path) => {
+        fn entry(fixed: $fixed) -> rrt_core::object_table::Shape {
+            $entry(fixed)
+        }
+
+        fn voxelize(
+            fixed: &$fixed,
+            separation: rrt_core::voxelize::Separation,
+            extent: rrt_core::raster::Extent,
+            sink: &mut dyn rrt_core::voxelize::VoxelSink,
+        ) -> Result<u64, rrt_core::voxelize::error::VoxelizeError> {
+            $voxelizer(fixed, separation, extent, sink)
+        }
+    };
+}
+
 pub mod cone;
 pub mod cuboid;
 mod roots;
@@ -160,6 +180,19 @@ pub enum Shape {
     /// normal.
     Voxels,
 }
+
+/// Each surface primitive is a [`Shape`].
+macro_rules! shape_from {
+    ($($variant:ident),*) => {
+        $(impl From<$variant> for Shape {
+            fn from(s: $variant) -> Self {
+                Self::$variant(s)
+            }
+        })*
+    };
+}
+
+shape_from!(Sphere, Cone, Triangle, Torus);
 
 /// `$body` with `$s` bound to the surface primitive in `$shape`, or
 /// `$voxels` for [`Shape::Voxels`].

@@ -4,11 +4,9 @@ use glam::DVec3;
 use rrt_core::csg;
 use rrt_core::geometry;
 use rrt_core::object_table as table;
-use rrt_core::raster::Extent;
-use rrt_core::voxelize::error::VoxelizeError;
-use rrt_core::voxelize::{Separation, VoxelSink, sphere};
+use rrt_core::voxelize::sphere;
 
-use super::{Primitive, Shape, Slots, SolidPrimitive, Surface, Unfit, get, positive, put};
+use super::{Primitive, Slots, SolidPrimitive, Surface, Unfit, get, positive, put};
 use crate::frame::RasterFrame;
 use crate::world::{Bounds, Hit, Ray};
 
@@ -60,19 +58,8 @@ impl Surface for Sphere {
         })
     }
 
-    fn entry(fixed: geometry::Sphere) -> table::Shape {
-        table::Shape::Sphere(fixed)
-    }
-
-    /// The sphere's shell ([`sphere::surface`]).
-    fn voxelize(
-        fixed: &geometry::Sphere,
-        separation: Separation,
-        extent: Extent,
-        sink: &mut dyn VoxelSink,
-    ) -> Result<u64, VoxelizeError> {
-        sphere::surface(fixed, separation, extent, sink)
-    }
+    // Voxelized by `sphere::surface` as its shell.
+    core_surface!(geometry::Sphere, table::Shape::Sphere, sphere::surface);
 
     /// Ray–sphere.
     ///
@@ -123,12 +110,6 @@ impl SolidPrimitive for Sphere {
     fn solid(&self, frame: &RasterFrame) -> Option<Box<dyn csg::Solid>> {
         let s = self.to_fixed(frame).ok()?;
         Some(Box::new(s))
-    }
-}
-
-impl From<Sphere> for Shape {
-    fn from(s: Sphere) -> Self {
-        Self::Sphere(s)
     }
 }
 

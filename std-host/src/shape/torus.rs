@@ -4,12 +4,10 @@ use glam::DVec3;
 use rrt_core::csg;
 use rrt_core::geometry;
 use rrt_core::object_table as table;
-use rrt_core::raster::Extent;
-use rrt_core::voxelize::error::VoxelizeError;
-use rrt_core::voxelize::{Separation, VoxelSink, torus};
+use rrt_core::voxelize::torus;
 
 use super::roots::poly_roots;
-use super::{Primitive, Shape, Slots, SolidPrimitive, Surface, Unfit, get, positive, put};
+use super::{Primitive, Slots, SolidPrimitive, Surface, Unfit, get, positive, put};
 use crate::frame::{RasterFrame, unit_to_fixed};
 use crate::world::{Bounds, Hit, Ray};
 
@@ -76,19 +74,8 @@ impl Surface for Torus {
         self.to_core(frame).ok_or(Unfit::OutOfRange)
     }
 
-    fn entry(fixed: geometry::Torus) -> table::Shape {
-        table::Shape::Torus(fixed)
-    }
-
-    /// The closed surface ([`torus::surface`]).
-    fn voxelize(
-        fixed: &geometry::Torus,
-        separation: Separation,
-        extent: Extent,
-        sink: &mut dyn VoxelSink,
-    ) -> Result<u64, VoxelizeError> {
-        torus::surface(fixed, separation, extent, sink)
-    }
+    // Voxelized by `torus::surface`: the closed surface.
+    core_surface!(geometry::Torus, table::Shape::Torus, torus::surface);
 
     /// Ray–torus: the surface at distance `minor` from the circle of radius
     /// `major` about the unit `axis` through `centre`.
@@ -194,11 +181,5 @@ impl Surface for Torus {
 impl SolidPrimitive for Torus {
     fn solid(&self, frame: &RasterFrame) -> Option<Box<dyn csg::Solid>> {
         Some(Box::new(self.to_core(frame)?))
-    }
-}
-
-impl From<Torus> for Shape {
-    fn from(t: Torus) -> Self {
-        Self::Torus(t)
     }
 }

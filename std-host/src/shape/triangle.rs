@@ -4,11 +4,9 @@
 use glam::DVec3;
 use rrt_core::geometry::{self, Point};
 use rrt_core::object_table as table;
-use rrt_core::raster::Extent;
-use rrt_core::voxelize::error::VoxelizeError;
-use rrt_core::voxelize::{Separation, VoxelSink, triangle};
+use rrt_core::voxelize::triangle;
 
-use super::{Primitive, Shape, Slots, Surface, Unfit, get, put};
+use super::{Primitive, Slots, Surface, Unfit, get, put};
 use crate::frame::{RasterFrame, unit_to_fixed};
 use crate::world::{Bounds, Hit, Ray};
 
@@ -43,11 +41,7 @@ impl Primitive for Triangle {
     }
 
     fn bounds(&self) -> Bounds {
-        let mut b = Bounds::EMPTY;
-        for &v in &self.vertices {
-            b.include(v, v);
-        }
-        b
+        Bounds::around(self.vertices)
     }
 }
 
@@ -75,19 +69,12 @@ impl Surface for Triangle {
         Ok(geometry::Triangle { vertices, normals })
     }
 
-    fn entry(fixed: geometry::Triangle) -> table::Shape {
-        table::Shape::Triangle(fixed)
-    }
-
-    /// Flat, or with interpolated normals ([`triangle::triangle`]).
-    fn voxelize(
-        fixed: &geometry::Triangle,
-        separation: Separation,
-        extent: Extent,
-        sink: &mut dyn VoxelSink,
-    ) -> Result<u64, VoxelizeError> {
-        triangle::triangle(fixed, separation, extent, sink)
-    }
+    // Voxelized by `triangle::triangle`, flat or with interpolated normals.
+    core_surface!(
+        geometry::Triangle,
+        table::Shape::Triangle,
+        triangle::triangle
+    );
 
     /// Ray–triangle (Möller–Trumbore), edges included. With `normals`, the
     /// normal is the normalised barycentric interpolation
@@ -147,12 +134,6 @@ impl Surface for Triangle {
             vertices: [get(slots, 0), get(slots, 3), get(slots, 6)],
             normals: (kind == SMOOTH).then(|| [get(slots, 9), get(slots, 12), get(slots, 15)]),
         })
-    }
-}
-
-impl From<Triangle> for Shape {
-    fn from(t: Triangle) -> Self {
-        Self::Triangle(t)
     }
 }
 

@@ -31,6 +31,16 @@ pub struct FirstWalk {
     found: Option<(usize, VoxelRecord)>,
 }
 
+impl FirstWalk {
+    /// The walk of a ray that misses the raster.
+    const MISSED: Self = Self {
+        ray: None,
+        end: WalkEnd::Exit,
+        steps: 0,
+        found: None,
+    };
+}
+
 /// `x` rounded to the nearest integer, halves away from zero, saturating:
 /// `f64::round` is a library call on the baseline x86-64 target, and this
 /// runs twice per axis for every ray. (The fixed-point ray is whatever this
@@ -85,12 +95,7 @@ impl Tracer<'_> {
     #[must_use]
     pub fn first_walk(&self, ray: &Ray) -> FirstWalk {
         let Some(mut dray) = self.discrete(ray) else {
-            return FirstWalk {
-                ray: None,
-                end: WalkEnd::Exit,
-                steps: 0,
-                found: None,
-            };
+            return FirstWalk::MISSED;
         };
         let end = dray
             .walk_skipping(&self.raster, self.opts.connectivity, u32::MAX, |_, c| {
@@ -112,12 +117,7 @@ impl Tracer<'_> {
         stats: &mut RayStats,
     ) -> FirstWalk {
         let Some(mut dray) = self.discrete(ray) else {
-            return FirstWalk {
-                ray: None,
-                end: WalkEnd::Exit,
-                steps: 0,
-                found: None,
-            };
+            return FirstWalk::MISSED;
         };
         let raster = self.raster;
         let store = self.store;

@@ -487,19 +487,21 @@ impl Volume {
     /// coordinates `[-½, n - ½]` on every axis).
     #[must_use]
     pub fn physical_bounds(&self) -> Bounds {
+        Bounds::around(self.cell_corners().map(|c| self.index_to_physical(c)))
+    }
+
+    /// The eight corners of the cells' box in index coordinates,
+    /// `[-½, n - ½]` on every axis.
+    #[must_use]
+    pub fn cell_corners(&self) -> [DVec3; 8] {
         let hi = DVec3::from(self.dims.map(f64::from)) - 0.5;
-        let mut b = Bounds::EMPTY;
-        for corner in 0..8u8 {
-            let c = DVec3::new(
+        std::array::from_fn(|corner| {
+            DVec3::new(
                 if corner & 1 == 0 { -0.5 } else { hi.x },
                 if corner & 2 == 0 { -0.5 } else { hi.y },
                 if corner & 4 == 0 { -0.5 } else { hi.z },
-            );
-            let p = self.index_to_physical(c);
-            b.min = b.min.min(p);
-            b.max = b.max.max(p);
-        }
-        b
+            )
+        })
     }
 
     /// Trilinear value at continuous index coordinates `p`: `None` outside

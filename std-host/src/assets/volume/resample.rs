@@ -328,19 +328,7 @@ impl<'a> PlacedVolume<'a> {
     /// The world box around the volume's cells.
     #[must_use]
     pub fn world_bounds(&self) -> Bounds {
-        let hi = DVec3::from(self.volume.dims().map(f64::from)) - 0.5;
-        let mut b = Bounds::EMPTY;
-        for corner in 0..8u8 {
-            let c = DVec3::new(
-                if corner & 1 == 0 { -0.5 } else { hi.x },
-                if corner & 2 == 0 { -0.5 } else { hi.y },
-                if corner & 4 == 0 { -0.5 } else { hi.z },
-            );
-            let p = self.index_to_world(c);
-            b.min = b.min.min(p);
-            b.max = b.max.max(p);
-        }
-        b
+        Bounds::around(self.volume.cell_corners().map(|c| self.index_to_world(c)))
     }
 
     /// The volume's trilinear value at a world point, `None` outside its

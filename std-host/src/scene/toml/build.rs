@@ -141,6 +141,25 @@ impl Builder<'_> {
         Ok(scene)
     }
 
+    /// Refuses anything but exactly one of the `given` keys, at `span`.
+    pub(super) fn exactly_one(
+        &self,
+        given: &[bool],
+        span: &std::ops::Range<usize>,
+        key: &str,
+        names: &str,
+    ) -> Result<(), SceneError> {
+        if given.iter().filter(|&&g| g).count() == 1 {
+            Ok(())
+        } else {
+            Err(self.err(
+                span.clone(),
+                key,
+                format!("expected exactly one of {names}"),
+            ))
+        }
+    }
+
     pub(super) fn material_of(
         &self,
         m: Option<&Spanned<String>>,

@@ -92,18 +92,14 @@ impl Builder<'_> {
                 ));
             }
         };
-        let n = usize::from(d.sphere.is_some())
-            + usize::from(d.cuboid.is_some())
-            + usize::from(d.cone.is_some())
-            + usize::from(d.torus.is_some())
-            + usize::from(d.volume.is_some());
-        if n != 1 {
-            return Err(self.err(
-                s,
-                &key,
-                "expected exactly one of sphere, box, cone, torus, volume",
-            ));
-        }
+        let given = [
+            d.sphere.is_some(),
+            d.cuboid.is_some(),
+            d.cone.is_some(),
+            d.torus.is_some(),
+            d.volume.is_some(),
+        ];
+        self.exactly_one(&given, &s, &key, "sphere, box, cone, torus, volume")?;
         let shape = if let Some(sp) = &d.sphere {
             let centre = self.vec3(&s, &key, sp.centre)?;
             if !(sp.radius.is_finite() && sp.radius > 0.0) {

@@ -69,17 +69,13 @@ impl Builder<'_> {
     ) -> Result<SceneTexture, SceneError> {
         let s = t.span();
         let d = t.get_ref();
-        let n = usize::from(d.checker.is_some())
-            + usize::from(d.marble.is_some())
-            + usize::from(d.wood.is_some())
-            + usize::from(d.image.is_some());
-        if n != 1 {
-            return Err(self.err(
-                s,
-                key,
-                "expected exactly one of checker, marble, wood, image",
-            ));
-        }
+        let given = [
+            d.checker.is_some(),
+            d.marble.is_some(),
+            d.wood.is_some(),
+            d.image.is_some(),
+        ];
+        self.exactly_one(&given, &s, key, "checker, marble, wood, image")?;
         let bad = |e: crate::assets::texture::TextureError| self.err(s.clone(), key, e.to_string());
         let any = if let Some(c) = &d.checker {
             AnyTexture::Checker(

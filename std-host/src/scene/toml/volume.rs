@@ -27,16 +27,8 @@ impl Builder<'_> {
         let s = v.span();
         let d = v.get_ref();
         let key = |k: &str| format!("volume.{name}.{k}");
-        let sources = usize::from(d.file.is_some())
-            + usize::from(d.raw.is_some())
-            + usize::from(d.metaballs.is_some());
-        if sources != 1 {
-            return Err(self.err(
-                s,
-                &key("file"),
-                "expected exactly one of file (NRRD), raw, metaballs",
-            ));
-        }
+        let given = [d.file.is_some(), d.raw.is_some(), d.metaballs.is_some()];
+        self.exactly_one(&given, &s, &key("file"), "file (NRRD), raw, metaballs")?;
         let data = self.volume_data(d, &s, &key)?;
         let classifier = self.classifier(d, &s, &key)?;
         let placement = self.placement(d, &data, &s, &key)?;
