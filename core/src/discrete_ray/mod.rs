@@ -72,6 +72,8 @@
 //! ```
 
 mod params;
+pub(crate) mod rules;
+mod skip;
 mod step;
 #[cfg(test)]
 mod tests;
@@ -319,12 +321,12 @@ impl DiscreteRay {
     ) -> WalkEnd {
         let (p, s) = (&self.p, &mut self.s);
         match mode {
-            Connectivity::Six => step::run::<{ step::SIX }, SKIP, C, T>(p, s, cells, budget, test),
+            Connectivity::Six => step::run::<{ rules::SIX }, SKIP, C, T>(p, s, cells, budget, test),
             Connectivity::TwentySix => {
-                step::run::<{ step::TWENTY_SIX }, SKIP, C, T>(p, s, cells, budget, test)
+                step::run::<{ rules::TWENTY_SIX }, SKIP, C, T>(p, s, cells, budget, test)
             }
             Connectivity::Adaptive => {
-                step::run::<{ step::ADAPTIVE }, SKIP, C, T>(p, s, cells, budget, test)
+                step::run::<{ rules::ADAPTIVE }, SKIP, C, T>(p, s, cells, budget, test)
             }
         }
     }
@@ -386,7 +388,7 @@ impl DiscreteRay {
             // A line's stand-in where the line is far from surfaces, else
             // the plane.
             let cells = |i: usize| match lines.get(i >> LINE_BITS) {
-                Some(&l) if l >= step::LINE_JUMP => Some(l),
+                Some(&l) if l >= skip::LINE_JUMP => Some(l),
                 _ => plane.get(i).copied(),
             };
             self.run::<true, _, _>(mode, cells, budget, test)
