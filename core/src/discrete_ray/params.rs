@@ -77,7 +77,7 @@ struct Param {
 
 impl Param {
     /// `self < other`, exactly (products < 2^81, or < 2^62 in a
-    /// [`Narrow`] setup).
+    /// [`narrow`] setup).
     fn lt<W: Wide>(self, other: Self) -> bool {
         W::of(self.n).mul(W::of(other.d)) < W::of(other.n).mul(W::of(self.d))
     }

@@ -4,9 +4,14 @@ use std::collections::HashMap;
 use std::vec;
 use std::vec::Vec;
 
+use super::brick::{brick_of, brick_origin, voxel_at};
+use super::rank_hint::{HINT_SCALE, hint_window};
 use super::*;
 use crate::proximity::flag_neighbourhood;
+use crate::raster::{Extent, RasterMut, cell};
+use crate::voxel::{VoxelRecord, brick_position};
 use crate::voxelize::NORMAL_ONE;
+use crate::voxelize::{Surfel, VoxelSink};
 
 const UP: [i32; 3] = [0, 0, NORMAL_ONE];
 
