@@ -34,7 +34,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, cell_floor, centre, centres_within, check_point, clip, dist_u32, length, split,
-    unit_fast,
+    sub, unit,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Cuboid;
@@ -261,10 +261,10 @@ pub fn contains(
 fn surfel(lo: [i128; 3], hi: [i128; 3], v: [u32; 3]) -> Surfel {
     let c = v.map(centre);
     let q = [0, 1, 2].map(|k| c[k].clamp(lo[k], hi[k]));
-    let w = [0, 1, 2].map(|k| c[k].saturating_sub(q[k]));
+    let w = sub(c, q);
     if w != [0; 3] {
         return Surfel {
-            normal: unit_fast(w).unwrap_or([0, 0, NORMAL_ONE]),
+            normal: unit(w).unwrap_or([0, 0, NORMAL_ONE]),
             distance: dist_u32(length(w)),
         };
     }

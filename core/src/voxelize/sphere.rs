@@ -63,7 +63,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, V, ceil_sqrt, cell_floor, cells_overlapping, centre, centres_within, check_point,
-    clip, dist_u32, isqrt, radial, split,
+    clip, dist_u32, isqrt, radial, split, sub,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Sphere;
@@ -133,7 +133,7 @@ pub fn contains(
 ) -> Result<bool, VoxelizeError> {
     let c = check_point(sphere.centre)?;
     let r = radius(sphere.radius)?;
-    let w = [0, 1, 2].map(|k| centre(v[k]).saturating_sub(c[k]));
+    let w = sub(v.map(centre), c);
     let r2 = r.saturating_mul(r);
     Ok(match separation {
         Separation::TwentySix => {

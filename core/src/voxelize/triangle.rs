@@ -70,7 +70,8 @@
 
 use super::error::VoxelizeError;
 use super::fixmath::{
-    Counter, H, IncDiv, V, ceil_div, centre, check_point, clip, dist_u32, floor_div, isqrt, unit,
+    Counter, H, IncDiv, V, ceil_div, centre, check_point, checked_cross, clip, dist_u32, dot,
+    floor_div, isqrt, sub, unit,
 };
 use super::sphere::{pick, place};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
@@ -160,7 +161,7 @@ pub fn polygon<S: VoxelSink + ?Sized>(
                 .get(i.wrapping_add(1).checked_rem(m).unwrap_or(0))
                 .unwrap_or(v),
         )?;
-        let c = cross(a, b).ok_or(VoxelizeError::Arithmetic)?;
+        let c = checked_cross(a, b).ok_or(VoxelizeError::Arithmetic)?;
         for (s, x) in newell.iter_mut().zip(c) {
             *s = s.checked_add(x).ok_or(VoxelizeError::Arithmetic)?;
         }
@@ -312,31 +313,6 @@ pub fn mesh<S: VoxelSink + ?Sized>(
 /// The next vertex of a triangle, cyclically.
 const NEXT: [usize; 3] = [1, 2, 0];
 
-/// `a·b` saturating (operands stay far below the limit for accepted input).
-#[inline]
-fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
-    a[0].saturating_mul(b[0])
-        .saturating_add(a[1].saturating_mul(b[1]))
-        .saturating_add(a[2].saturating_mul(b[2]))
-}
-
-fn cross(a: [i128; 3], b: [i128; 3]) -> Option<[i128; 3]> {
-    let c = |i: i128, j: i128, k: i128, l: i128| i.checked_mul(j)?.checked_sub(k.checked_mul(l)?);
-    Some([
-        c(a[1], b[2], a[2], b[1])?,
-        c(a[2], b[0], a[0], b[2])?,
-        c(a[0], b[1], a[1], b[0])?,
-    ])
-}
-
-fn sub(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
-    [
-        a[0].saturating_sub(b[0]),
-        a[1].saturating_sub(b[1]),
-        a[2].saturating_sub(b[2]),
-    ]
-}
-
 /// The axis of the largest `|n_k|` (lowest on ties).
 fn dominant(n: [i128; 3]) -> usize {
     let a = n.map(i128::unsigned_abs);
@@ -396,7 +372,7 @@ impl Tri {
         normals: Option<[UnitVector; 3]>,
     ) -> Result<Self, VoxelizeError> {
         let e = [sub(v[1], v[0]), sub(v[2], v[1]), sub(v[0], v[2])];
-        let n = cross(e[0], sub(v[2], v[0])).ok_or(VoxelizeError::Arithmetic)?;
+        let n = checked_cross(e[0], sub(v[2], v[0])).ok_or(VoxelizeError::Arithmetic)?;
         if n == [0; 3] {
             return Err(VoxelizeError::Degenerate);
         }
@@ -463,10 +439,10 @@ impl Tri {
         };
         for e in &self.e {
             for d in dirs {
-                add(cross(*e, *d).ok_or(VoxelizeError::Arithmetic)?)?;
+                add(checked_cross(*e, *d).ok_or(VoxelizeError::Arithmetic)?)?;
             }
             // The column's own 2D bound: e × k̂.
-            add(cross(*e, place(k, 0, 0, 1)).ok_or(VoxelizeError::Arithmetic)?)?;
+            add(checked_cross(*e, place(k, 0, 0, 1)).ok_or(VoxelizeError::Arithmetic)?)?;
         }
         match sep {
             Separation::TwentySix => {
@@ -635,7 +611,7 @@ impl Tri {
         let a = [0, 1, 2].map(|i| {
             let p = sub(self.v[NEXT[i]], c);
             let q = sub(self.v[NEXT[NEXT[i]]], c);
-            cross(p, q).map_or(0, |x| dot(x, self.n_small))
+            checked_cross(p, q).map_or(0, |x| dot(x, self.n_small))
         });
         if a.iter().all(|x| *x >= 0) {
             // Inside: the plane distance along the unit normal.

@@ -45,7 +45,7 @@
 //! constant per sample.
 
 use super::error::{COORD_LIMIT, VoxelizeError};
-use super::fixmath::{Counter, V, dist_u32, isqrt, unit};
+use super::fixmath::{Counter, V, dist_u32, dot, isqrt, unit};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::raster::Extent;
 
@@ -234,9 +234,7 @@ impl<T: Copy + Into<i64>> Grid<'_, T> {
             };
         };
         // |∇f| per voxel = |grad| / (2·1572); distance = (f − thr)/|∇f|.
-        let g2 = grad
-            .iter()
-            .fold(0i128, |s, x| s.saturating_add(x.saturating_mul(*x)));
+        let g2 = dot(grad, grad);
         let glen = isqrt(g2).max(1);
         let excess = i128::from(f.saturating_sub(thr));
         let d = excess
