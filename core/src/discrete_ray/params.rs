@@ -473,19 +473,15 @@ const fn drive_frame(ad: [i64; 3]) -> (usize, usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testkit::Rng;
 
     /// The `i64` setup gives the very ray the `i128` setup gives, on
     /// random rays within its domain: rays from far outside, from inside,
     /// grazing faces, axis-parallel, and segments.
     #[test]
     fn narrow_setup_is_the_wide_setup() {
-        let mut x = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let mut next = move || rng.next_u64();
         let mut compared = 0u32;
         let mut some = 0u32;
         for _ in 0..200_000 {

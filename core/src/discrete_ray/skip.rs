@@ -106,19 +106,15 @@ impl Reciprocal {
 #[cfg(test)]
 mod tests {
     use super::{Reciprocal, jump_count};
+    use crate::testkit::Rng;
 
     /// A jump's crossing count, term and last-step crossing are those of
     /// `k` single 26-steps, ties included (small increments make `f` hit
     /// the interval ends often).
     #[test]
     fn jump_count_is_k_single_steps() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |m: u64| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x % m
-        };
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut next = |m: u64| rng.below(m);
         for case in 0..200_000u32 {
             let big = case % 2 == 0;
             let inc_a = i64::try_from(if big { 2 + next(1 << 40) } else { 2 + next(12) }).unwrap();
@@ -146,13 +142,8 @@ mod tests {
 
     #[test]
     fn reciprocal_division_is_exact() {
-        let mut x = 0x0123_4567_89ab_cdefu64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = Rng(0x0123_4567_89ab_cdef);
+        let mut next = || rng.next_u64();
         for _ in 0..200_000 {
             let d = (next() >> (1 + next() % 62)).max(2);
             let r = Reciprocal::new(i64::try_from(d >> 1).unwrap().max(2));

@@ -221,18 +221,8 @@ fn run<S: VoxelSink + ?Sized>(
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
+    use crate::testkit::Offers;
     use crate::voxelize::fixmath::V;
-    use std::collections::HashMap;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            let e = self.0.entry(v).or_insert(s);
-            if s.distance < e.distance {
-                *e = s;
-            }
-        }
-    }
 
     #[test]
     fn cylinder_shell_is_thin_and_surfels_are_exact() {
@@ -247,9 +237,9 @@ mod tests {
         let e = Extent::cube(21).unwrap();
         let one = i128::from(NORMAL_ONE);
         for sep in [Separation::Six, Separation::TwentySix] {
-            let mut col = Collect(HashMap::new());
+            let mut col = Offers::default();
             surface(&cyl, sep, e, &mut col).unwrap();
-            for (v, s) in &col.0 {
+            for (v, (s, _)) in &col.0 {
                 let z = centre(v[2]);
                 if !(2 * V..=18 * V).contains(&z) {
                     continue;
@@ -274,7 +264,7 @@ mod tests {
     #[test]
     fn bad_input() {
         let e = Extent::cube(4).unwrap();
-        let mut col = Collect(HashMap::new());
+        let mut col = Offers::default();
         let z = Cone {
             base: [0; 3],
             base_radius: 0,

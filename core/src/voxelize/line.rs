@@ -305,6 +305,7 @@ mod tests {
     use super::*;
     use crate::discrete_ray::{Connectivity, DiscreteRay};
     use crate::raster::Raster;
+    use crate::testkit::Rng;
     use std::vec::Vec;
 
     struct Collect(Vec<[u32; 3]>);
@@ -319,13 +320,8 @@ mod tests {
         let e = Extent::new(20, 17, 15).unwrap();
         let plane = std::vec![0u8; e.len()];
         let r = Raster::new(e, &plane).unwrap();
-        let mut seed = 5u64;
-        let mut next = |m: i64| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            i64::try_from(seed >> 33).unwrap() % m
-        };
+        let mut rng = Rng(5u64);
+        let mut next = |m: i64| rng.range(0, m - 1);
         for case in 0..400 {
             let snap = |x: i64| match case % 4 {
                 0 => x & !0xffff,

@@ -298,16 +298,8 @@ fn normal(p: &[[[i128; 3]; 4]; 4], i: u32, j: u32, n: u32) -> Option<UnitVector>
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
-    use crate::voxelize::Surfel;
+    use crate::testkit::Offers;
     use crate::voxelize::fixmath::centre;
-    use std::collections::HashMap;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            self.0.insert(v, s);
-        }
-    }
 
     /// `N⁶ · patch(a/N, b/N)`, exactly.
     fn eval(p: &[[[i128; 3]; 4]; 4], a: u32, b: u32, n: u32) -> [i128; 3] {
@@ -349,7 +341,7 @@ mod tests {
             }
         }
         let bp = BezierPatch { control };
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         surface(
             &bp,
             Separation::TwentySix,

@@ -445,15 +445,8 @@ fn near_far(c: i128, i: u32) -> (i128, i128) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use crate::testkit::{Offers, Rng};
     use std::vec::Vec;
-
-    struct Collect(HashMap<[u32; 3], (Surfel, u32)>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            self.0.entry(v).or_insert((s, 0)).1 += 1;
-        }
-    }
 
     fn brute(s: &Sphere, sep: Separation, e: Extent) -> Vec<[u32; 3]> {
         let [nx, ny, nz] = e.dims();
@@ -473,13 +466,8 @@ mod tests {
     #[test]
     fn scan_matches_membership_and_offers_once() {
         let e = Extent::new(14, 13, 12).unwrap();
-        let mut seed = 7u64;
-        let mut next = |m: i64| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            i64::try_from(seed >> 33).unwrap() % m
-        };
+        let mut rng = Rng(7u64);
+        let mut next = |m: i64| rng.range(0, m - 1);
         for case in 0..60 {
             // Centres on lattice points, centres, faces and random points;
             // some partly outside the raster.
@@ -504,7 +492,7 @@ mod tests {
             };
             for sep in [Separation::Six, Separation::TwentySix] {
                 for solid_too in [false, true] {
-                    let mut c = Collect(HashMap::new());
+                    let mut c = Offers::default();
                     let offers = if solid_too {
                         solid(&s, sep, e, &mut c).unwrap()
                     } else {
@@ -560,7 +548,7 @@ mod tests {
     #[test]
     fn bad_input() {
         let e = Extent::cube(4).unwrap();
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         let z = Sphere {
             centre: [0; 3],
             radius: 0,

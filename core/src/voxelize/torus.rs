@@ -140,14 +140,7 @@ pub fn surface<S: VoxelSink + ?Sized>(
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
-    use std::collections::HashMap;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            self.0.insert(v, s);
-        }
-    }
+    use crate::testkit::Offers;
 
     #[test]
     fn surfels_match_the_true_torus() {
@@ -158,7 +151,7 @@ mod tests {
             major: 7 * VOXEL,
             minor: 3 * VOXEL + 99,
         };
-        let mut col = Collect(HashMap::new());
+        let mut col = Offers::default();
         surface(
             &t,
             Separation::TwentySix,
@@ -166,7 +159,7 @@ mod tests {
             &mut col,
         )
         .unwrap();
-        for (v, s) in &col.0 {
+        for (v, (s, _)) in &col.0 {
             let p = [0, 1, 2].map(|k| centre(v[k]) - i128::from(c));
             let rho = isqrt(p[0] * p[0] + p[1] * p[1]);
             let d = isqrt((rho - 7 * V).pow(2) + p[2] * p[2]) - (3 * V + 99);
@@ -183,7 +176,7 @@ mod tests {
     #[test]
     fn bad_input() {
         let e = Extent::cube(4).unwrap();
-        let mut col = Collect(HashMap::new());
+        let mut col = Offers::default();
         let base = Torus {
             centre: [0; 3],
             axis: [0, 0, NORMAL_ONE],

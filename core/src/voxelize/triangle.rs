@@ -695,32 +695,18 @@ fn centre_range(p: i128, q: i128, lo: i128, hi: i128) -> Option<(i128, i128)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use crate::testkit::{Offers, Rng};
     use std::vec::Vec;
-
-    struct Collect(HashMap<[u32; 3], u32>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], _: Surfel) {
-            *self.0.entry(v).or_insert(0) += 1;
-        }
-    }
-
-    fn rng(seed: &mut u64, m: i64) -> i64 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        i64::try_from(*seed >> 33).unwrap() % m
-    }
 
     #[test]
     fn scan_matches_membership() {
         let e = Extent::new(12, 11, 10).unwrap();
-        let mut seed = 3u64;
+        let mut rng = Rng(3);
         for case in 0..150 {
             let mut vs = [[0i64; 3]; 3];
             for v in &mut vs {
                 for c in v.iter_mut() {
-                    let x = rng(&mut seed, 14 * 65536) - 65536;
+                    let x = rng.range(0, 14 * 65536 - 1) - 65536;
                     *c = match case % 4 {
                         0 => x & !0x7fff,
                         1 => x & !0xffff,
@@ -743,9 +729,9 @@ mod tests {
                 continue;
             }
             for sep in [Separation::Six, Separation::TwentySix] {
-                let mut c = Collect(HashMap::new());
+                let mut c = Offers::default();
                 triangle(&t, sep, e, &mut c).unwrap();
-                assert!(c.0.values().all(|n| *n == 1), "case {case}: offered twice");
+                assert!(c.0.values().all(|o| o.1 == 1), "case {case}: offered twice");
                 let [nx, ny, nz] = e.dims();
                 let mut want = Vec::new();
                 for z in 0..nz {
@@ -823,14 +809,14 @@ mod tests {
             [v, 9 * v, z],
         ];
         let e = Extent::cube(12).unwrap();
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         polygon(&l, Separation::Six, e, &mut c).unwrap();
         // The notch (6..8, 6..8) stays empty; the arms are covered.
         assert!(!c.0.contains_key(&[6, 6, 2]));
         assert!(c.0.contains_key(&[2, 7, 2]) && c.0.contains_key(&[7, 2, 2]));
         let mut rev = l;
         rev.reverse();
-        let mut c2 = Collect(HashMap::new());
+        let mut c2 = Offers::default();
         polygon(&rev, Separation::Six, e, &mut c2).unwrap();
         let mut a: Vec<_> = c.0.keys().collect();
         let mut b: Vec<_> = c2.0.keys().collect();

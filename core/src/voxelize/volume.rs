@@ -252,15 +252,8 @@ impl<T: Copy + Into<i64>> Grid<'_, T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use crate::testkit::Offers;
     use std::vec::Vec;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            assert!(self.0.insert(v, s).is_none());
-        }
-    }
 
     #[test]
     fn ball_boundary_and_normals() {
@@ -290,10 +283,11 @@ mod tests {
         let e = Extent::cube(24).unwrap();
         let one = i128::from(NORMAL_ONE);
         for sep in [Separation::Six, Separation::TwentySix] {
-            let mut c = Collect(HashMap::new());
+            let mut c = Offers::default();
             boundary(&b, 1500u16, sep, e, &mut c).unwrap();
             assert!(c.0.len() > 100);
-            for (v, sf) in &c.0 {
+            assert!(c.0.values().all(|o| o.1 == 1), "a voxel offered twice");
+            for (v, (sf, _)) in &c.0 {
                 let p = [v[0] + 2, v[1] - 3, v[2]];
                 let w = p.map(|c| i128::from(2 * i64::from(c) - 15));
                 let len2: i128 = w.iter().map(|x| x * x).sum();
@@ -314,7 +308,7 @@ mod tests {
             dims: [n; 3],
             offset: [-10, -10, -10],
         };
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         boundary(
             &b,
             1500u16,
