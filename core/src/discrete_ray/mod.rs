@@ -305,11 +305,17 @@ impl DiscreteRay {
         budget: u32,
         test: T,
     ) -> Result<WalkEnd, RayError> {
-        if raster.extent() != self.p.extent {
-            return Err(RayError::ExtentMismatch);
-        }
-        let plane = raster.plane();
+        let plane = self.plane_of(raster)?;
         Ok(self.run::<false, _, _>(mode, |i| plane.get(i).copied(), budget, test))
+    }
+
+    /// The plane of `raster`, which must have the ray's extent.
+    fn plane_of<'r>(&self, raster: &Raster<'r>) -> Result<&'r [u8], RayError> {
+        if raster.extent() == self.p.extent {
+            Ok(raster.plane())
+        } else {
+            Err(RayError::ExtentMismatch)
+        }
     }
 
     fn run<const SKIP: bool, C: Fn(usize) -> Option<u8> + Copy, T: FnMut(usize, u8) -> bool>(
@@ -377,10 +383,7 @@ impl DiscreteRay {
         budget: u32,
         test: T,
     ) -> Result<WalkEnd, RayError> {
-        if raster.extent() != self.p.extent {
-            return Err(RayError::ExtentMismatch);
-        }
-        let plane = raster.plane();
+        let plane = self.plane_of(raster)?;
         let lines = raster.lines();
         Ok(if lines.is_empty() {
             self.run::<true, _, _>(mode, |i| plane.get(i).copied(), budget, test)
@@ -427,10 +430,8 @@ impl DiscreteRay {
         raster: &Raster<'_>,
         mode: Connectivity,
     ) -> Result<Option<Hit>, RayError> {
-        match self.walk_skipping(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)? {
-            WalkEnd::Hit => Ok(Some(self.hit())),
-            WalkEnd::Exit | WalkEnd::Budget => Ok(None),
-        }
+        let end = self.walk_skipping(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)?;
+        Ok(self.hit_after(end))
     }
 
     /// Walks to the first non-transparent ([`cell::OPAQUE`]) voxel, with no
@@ -444,10 +445,13 @@ impl DiscreteRay {
         raster: &Raster<'_>,
         mode: Connectivity,
     ) -> Result<Option<Hit>, RayError> {
-        match self.walk(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)? {
-            WalkEnd::Hit => Ok(Some(self.hit())),
-            WalkEnd::Exit | WalkEnd::Budget => Ok(None),
-        }
+        let end = self.walk(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)?;
+        Ok(self.hit_after(end))
+    }
+
+    /// The hit after a walk that ended with `end`.
+    fn hit_after(&self, end: WalkEnd) -> Option<Hit> {
+        matches!(end, WalkEnd::Hit).then(|| self.hit())
     }
 
     /// The current voxel: after [`WalkEnd::Hit`] the hit voxel, after
@@ -473,9 +477,7 @@ impl DiscreteRay {
         raster: &'r Raster<'r>,
         mode: Connectivity,
     ) -> Result<Voxels<'r>, RayError> {
-        if raster.extent() != self.p.extent {
-            return Err(RayError::ExtentMismatch);
-        }
+        self.plane_of(raster)?;
         Ok(Voxels {
             ray: self,
             raster: *raster,
