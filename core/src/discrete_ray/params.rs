@@ -260,7 +260,9 @@ fn setup_in<W: Wide>(
             diag,
             inc,
             thr: [if a < b { -2 } else { 0 }, if a < c { -2 } else { 0 }],
-            entry_face: t_in.face.map(|k| Face::entered(k, dir[k] > 0)),
+            entry_face: t_in
+                .face
+                .map(|k| Face::entered(k, dir.get(k).is_some_and(|&d| d > 0))),
             entry,
             exit,
         },

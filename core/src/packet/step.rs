@@ -247,14 +247,15 @@ fn step<const MODE: u8>(v: &Lanes, k: &Consts, tie: u8, prox: u8) -> Step {
         TWENTY_SIX | TWENTY_SIX_KEEP_E3 => rem[0].lt0().bits(),
         _ => rem[0].or(rem[1]).or(rem[2]).lt0().bits(),
     };
-    let [e1, e2, e3_stepped] = rules::stepped(v.e, moves, k.inc);
+    let [s1, s2, s3] = rules::stepped(v.e, moves, k.inc);
     let next = Lanes {
+        // TwentySix does not step e3: write-back rebuilds it.
         e: [
-            e1,
-            e2,
+            s1,
+            s2,
             match MODE {
                 TWENTY_SIX => e3,
-                _ => e3_stepped,
+                _ => s3,
             },
         ],
         rem,
