@@ -9,6 +9,7 @@
 #![no_std]
 #![deny(unsafe_code)]
 
+pub mod bench;
 pub mod checks;
 pub mod digest;
 pub mod rays;

@@ -390,16 +390,34 @@ fn with_cut_ball<R>(f: impl FnOnce(&CsgTree<'_>) -> R) -> Result<R, SceneError> 
 /// # Errors
 /// A [`SceneError`] when a buffer is too small or a pass refuses.
 pub fn build(st: &mut Storage<'_>) -> Result<SceneReport, SceneError> {
+    build_with(st, &mut |_, pass| pass())
+}
+
+/// A hook around each stage of [`build_with`]: called with the stage's
+/// name and the stage, which it must run exactly once.
+pub type Probe<'p> = dyn FnMut(&'static str, &mut dyn FnMut()) + 'p;
+
+/// [`build`], each stage run through `probe` (the stack measurement wraps
+/// them; [`build`] just runs them).
+///
+/// # Errors
+/// As [`build`].
+pub fn build_with(st: &mut Storage<'_>, probe: &mut Probe<'_>) -> Result<SceneReport, SceneError> {
     let e = extent()?;
     if directory_len(e) != Some(st.dir.len()) {
         return Err(SceneError::Capacity);
     }
     // Count pass.
     let mut counter = Counter::new(RasterMut::new(e, st.plane)?, st.dir)?;
-    for id in 0..OBJECTS - 1 {
-        offer(id, e, &mut counter)?;
-    }
-    with_cut_ball(|t| csg::voxelize(t, e, &mut IgnoreLeaf(&mut counter)))?;
+    let mut done: Result<(), SceneError> = Ok(());
+    probe("Counter: count pass, every object", &mut || {
+        done = (0..OBJECTS - 1)
+            .try_for_each(|id| offer(id, e, &mut counter))
+            .and_then(|()| {
+                with_cut_ball(|t| csg::voxelize(t, e, &mut IgnoreLeaf(&mut counter))).map(|_| ())
+            });
+    });
+    done?;
     let sizing = counter.finish()?;
     let records = sizing.records();
     // Fill pass.
@@ -417,42 +435,94 @@ pub fn build(st: &mut Storage<'_>) -> Result<SceneReport, SceneError> {
             color: mats.get(m).map(Material::color_u8).unwrap_or_default(),
         }
     };
-    for id in 0..OBJECTS - 1 {
-        filler.begin_object(attrs(id))?;
-        if id == 0 {
-            let tex = checker;
-            offer(id, e, &mut filler.textured(&tex))?;
-        } else {
-            offer(id, e, &mut filler)?;
-        }
-    }
-    let leaf_attrs = [attrs(OBJECTS - 1); 2];
-    let mut leaf_fill = LeafFill::new(&mut filler, &leaf_attrs)?;
-    with_cut_ball(|t| csg::voxelize(t, e, &mut leaf_fill))?;
-    let mut built = filler.finish()?;
+    let mut done: Result<(), SceneError> = Ok(());
+    probe("Filler: fill pass, every object", &mut || {
+        done = (|| {
+            for id in 0..OBJECTS - 1 {
+                filler.begin_object(attrs(id))?;
+                if id == 0 {
+                    let tex = checker;
+                    offer(id, e, &mut filler.textured(&tex))?;
+                } else {
+                    offer(id, e, &mut filler)?;
+                }
+            }
+            let leaf_attrs = [attrs(OBJECTS - 1); 2];
+            let mut leaf_fill = LeafFill::new(&mut filler, &leaf_attrs)?;
+            with_cut_ball(|t| csg::voxelize(t, e, &mut leaf_fill))?;
+            Ok(())
+        })();
+    });
+    done?;
+    let mut filler = Some(filler);
+    let mut finished = None;
+    probe("Filler::finish", &mut || {
+        finished = filler.take().map(|f| f.finish())
+    });
+    let mut built = finished.ok_or(SceneError::Capacity)??;
     let fill = built.report();
     // Light pass.
     let mut table = ObjectTable::new(st.objects, st.patches);
     push_objects(&mut table)?;
+    let lights = lights()?;
     let (raster, mut store) = built.split();
-    let light = illuminate(
-        &raster,
-        &mut store,
-        &table,
-        &mats,
-        &lights()?,
-        &LightParams::default(),
-    )?;
+    let mut light = Err(SceneError::Capacity);
+    probe("illuminate", &mut || {
+        light = illuminate(
+            &raster,
+            &mut store,
+            &table,
+            &mats,
+            &lights,
+            &LightParams::default(),
+        )
+        .map_err(SceneError::from);
+    });
+    let light = light?;
     // Finish the plane for skipping walks.
     let (mut raster, store) = built.into_parts();
-    distance_field(&mut raster);
-    write_rank_hints(&mut raster, &store.as_store());
+    probe("distance_field + write_rank_hints", &mut || {
+        distance_field(&mut raster);
+        write_rank_hints(&mut raster, &store.as_store());
+    });
     line_distances(&raster.as_raster(), st.lines)?;
     Ok(SceneReport {
         records,
         fill,
         light,
     })
+}
+
+/// Runs each of the scene's voxelizers, and its CSG object, once through
+/// `probe`, into a sink that only counts (what the stack measurement
+/// wraps: the voxelizer's own depth, through a `dyn VoxelSink`).
+pub fn voxelizer_probe(probe: &mut Probe<'_>) {
+    struct Count(u64);
+    impl VoxelSink for Count {
+        fn offer(&mut self, _: [u32; 3], _: rrt_core::voxelize::Surfel) {
+            self.0 += 1;
+        }
+    }
+    let Ok(e) = extent() else { return };
+    let names = [
+        (0, "cuboid::solid"),
+        (1, "sphere::surface"),
+        (2, "torus::surface"),
+        (3, "cone::capped"),
+        (4, "patch::surface"),
+        (5, "triangle::triangle"),
+        (9, "volume::boundary"),
+    ];
+    for (id, name) in names {
+        let mut c = Count(0);
+        probe(name, &mut || {
+            let _ = offer(id, e, &mut c);
+        });
+    }
+    let mut c = Count(0);
+    probe("csg::voxelize", &mut || {
+        let _ = with_cut_ball(|t| csg::voxelize(t, e, &mut IgnoreLeaf(&mut c)));
+    });
 }
 
 /// The camera: eye and the direction of pixel `(i, j)` (row `j` from the
