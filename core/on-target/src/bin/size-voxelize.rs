@@ -195,12 +195,12 @@ fn drive() {
     let raster = built.raster();
     let store = built.store();
     let ray = DiscreteRay::new(e, point_at(20), [i32_at(44), i32_at(48), i32_at(52)]);
-    if let Ok(Some(mut ray)) = ray {
-        if let Ok(Some(h)) = ray.first_hit(&raster, Connectivity::Adaptive) {
-            let c = raster.plane().get(h.index).copied().unwrap_or(0);
-            if let Some(rec) = store.get_hinted(h.voxel, c) {
-                sink(u64::from(rec.illum[0]));
-            }
+    if let Ok(Some(mut ray)) = ray
+        && let Ok(Some(h)) = ray.first_hit(&raster, Connectivity::Adaptive)
+    {
+        let c = raster.plane().get(h.index).copied().unwrap_or(0);
+        if let Some(rec) = store.get_hinted(h.voxel, c) {
+            sink(u64::from(rec.illum[0]));
         }
     }
 }
