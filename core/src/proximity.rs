@@ -343,6 +343,7 @@ mod tests {
     use super::*;
     use crate::raster::Extent;
     use crate::raster::line_count;
+    use crate::testkit::Rng;
 
     /// Chessboard distance to the nearest opaque voxel, by brute force.
     fn brute(e: Extent, opaque: &[[u32; 3]]) -> Vec<u8> {
@@ -366,13 +367,8 @@ mod tests {
 
     #[test]
     fn distance_field_is_the_exact_chessboard_distance() {
-        let mut seed = 0x1234_5678_9abc_def0u64;
-        let mut next = |m: u32| {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            u32::try_from(seed >> 33).unwrap() % m
-        };
+        let mut rng = Rng(0x1234_5678_9abc_def0u64);
+        let mut next = |m: u32| rng.below_u32(m);
         for case in 0..60 {
             let dims = [1 + next(20), 1 + next(20), 1 + next(20)];
             let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();

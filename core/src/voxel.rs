@@ -26,15 +26,15 @@
 //! the four grid points around the exact projection, the one whose decoded
 //! direction is nearest the input, all in integer arithmetic.
 //!
-//! **Angular error.** Over 200,000 seeded random directions plus the axes,
-//! diagonals and the fold of the octahedron, the worst angle between a
-//! normal and its encoded-then-decoded copy is 43.2 µrad (0.0025°, at the
-//! diagonal `(1, 1, 1)`, where the octahedron is most foreshortened); the
-//! test asserts below 50 µrad. It is
-//! measured in integer arithmetic by `voxel::tests::octahedral_error`
-//! (`|a × b| / (|a|·|b|)` with [`isqrt`](u128::isqrt)); the integration test
-//! `tests/voxel_record.rs` measures the same in degrees with floats. That is
-//! far below the direction error of a normal sampled at a voxel centre.
+//! **Angular error.** The angle between a normal and its
+//! encoded-then-decoded copy is below 50 µrad (0.003°); it is largest near
+//! the diagonals such as `(1, 1, 1)`, where the octahedron is most
+//! foreshortened. `voxel::tests::octahedral_error` checks the bound in
+//! integer arithmetic (`|a × b| / (|a|·|b|)` with [`isqrt`](u128::isqrt))
+//! over 200,000 seeded random directions plus the axes, diagonals and the
+//! fold of the octahedron; `tests/voxel_record.rs` checks it in degrees
+//! with floats. That is far below the direction error of a normal sampled
+//! at a voxel centre.
 //!
 //! # Key and overlap
 //! [`VoxelRecord::key`] holds the voxel's position inside its 8×8×8 brick

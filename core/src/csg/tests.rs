@@ -9,6 +9,7 @@ use super::*;
 use crate::discrete_ray::{Connectivity, DiscreteRay};
 use crate::raster::{Raster, RasterMut};
 use crate::store::{Counter, Limits, RecordStore, directory_len};
+use crate::testkit::Rng;
 use crate::voxel::{VoxelRecord, dot_unit};
 
 const V: i64 = VOXEL;
@@ -22,21 +23,6 @@ impl CsgSink for Collect {
             self.0.insert(voxel, (leaf, surfel)).is_none(),
             "{voxel:?} offered twice"
         );
-    }
-}
-
-/// SplitMix64.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn range(&mut self, lo: i64, hi: i64) -> i64 {
-        lo + (self.next() % (hi - lo + 1) as u64) as i64
     }
 }
 
@@ -203,7 +189,7 @@ fn boundary_layer_matches_brute_force_on_random_trees() {
         let mut solids: Vec<Box<dyn Solid>> = Vec::new();
         for _ in 0..3 {
             let c = [0; 3].map(|_: i64| rng.range(4 * V, 20 * V));
-            let solid: Box<dyn Solid> = match rng.next() % 4 {
+            let solid: Box<dyn Solid> = match rng.next_u64() % 4 {
                 0 => Box::new(Sphere {
                     centre: c,
                     radius: rng.range(2 * V, 9 * V),
@@ -245,8 +231,8 @@ fn boundary_layer_matches_brute_force_on_random_trees() {
             CsgNode::Leaf(0),
             CsgNode::Leaf(1),
             CsgNode::Leaf(2),
-            op(rng.next(), 0, 1),
-            op(rng.next(), 3, 2),
+            op(rng.next_u64(), 0, 1),
+            op(rng.next_u64(), 3, 2),
         ];
         let tree = CsgTree::new(&nodes, &leaves).unwrap();
         let mut got = Collect::default();

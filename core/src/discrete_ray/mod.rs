@@ -72,6 +72,8 @@
 //! ```
 
 mod params;
+pub(crate) mod rules;
+mod skip;
 mod step;
 #[cfg(test)]
 mod tests;
@@ -303,11 +305,17 @@ impl DiscreteRay {
         budget: u32,
         test: T,
     ) -> Result<WalkEnd, RayError> {
-        if raster.extent() != self.p.extent {
-            return Err(RayError::ExtentMismatch);
-        }
-        let plane = raster.plane();
+        let plane = self.plane_of(raster)?;
         Ok(self.run::<false, _, _>(mode, |i| plane.get(i).copied(), budget, test))
+    }
+
+    /// The plane of `raster`, which must have the ray's extent.
+    fn plane_of<'r>(&self, raster: &Raster<'r>) -> Result<&'r [u8], RayError> {
+        if raster.extent() == self.p.extent {
+            Ok(raster.plane())
+        } else {
+            Err(RayError::ExtentMismatch)
+        }
     }
 
     fn run<const SKIP: bool, C: Fn(usize) -> Option<u8> + Copy, T: FnMut(usize, u8) -> bool>(
@@ -319,12 +327,12 @@ impl DiscreteRay {
     ) -> WalkEnd {
         let (p, s) = (&self.p, &mut self.s);
         match mode {
-            Connectivity::Six => step::run::<{ step::SIX }, SKIP, C, T>(p, s, cells, budget, test),
+            Connectivity::Six => step::run::<{ rules::SIX }, SKIP, C, T>(p, s, cells, budget, test),
             Connectivity::TwentySix => {
-                step::run::<{ step::TWENTY_SIX }, SKIP, C, T>(p, s, cells, budget, test)
+                step::run::<{ rules::TWENTY_SIX }, SKIP, C, T>(p, s, cells, budget, test)
             }
             Connectivity::Adaptive => {
-                step::run::<{ step::ADAPTIVE }, SKIP, C, T>(p, s, cells, budget, test)
+                step::run::<{ rules::ADAPTIVE }, SKIP, C, T>(p, s, cells, budget, test)
             }
         }
     }
@@ -375,10 +383,7 @@ impl DiscreteRay {
         budget: u32,
         test: T,
     ) -> Result<WalkEnd, RayError> {
-        if raster.extent() != self.p.extent {
-            return Err(RayError::ExtentMismatch);
-        }
-        let plane = raster.plane();
+        let plane = self.plane_of(raster)?;
         let lines = raster.lines();
         Ok(if lines.is_empty() {
             self.run::<true, _, _>(mode, |i| plane.get(i).copied(), budget, test)
@@ -386,7 +391,7 @@ impl DiscreteRay {
             // A line's stand-in where the line is far from surfaces, else
             // the plane.
             let cells = |i: usize| match lines.get(i >> LINE_BITS) {
-                Some(&l) if l >= step::LINE_JUMP => Some(l),
+                Some(&l) if l >= skip::LINE_JUMP => Some(l),
                 _ => plane.get(i).copied(),
             };
             self.run::<true, _, _>(mode, cells, budget, test)
@@ -425,10 +430,8 @@ impl DiscreteRay {
         raster: &Raster<'_>,
         mode: Connectivity,
     ) -> Result<Option<Hit>, RayError> {
-        match self.walk_skipping(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)? {
-            WalkEnd::Hit => Ok(Some(self.hit())),
-            WalkEnd::Exit | WalkEnd::Budget => Ok(None),
-        }
+        let end = self.walk_skipping(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)?;
+        Ok(self.hit_after(end))
     }
 
     /// Walks to the first non-transparent ([`cell::OPAQUE`]) voxel, with no
@@ -442,10 +445,13 @@ impl DiscreteRay {
         raster: &Raster<'_>,
         mode: Connectivity,
     ) -> Result<Option<Hit>, RayError> {
-        match self.walk(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)? {
-            WalkEnd::Hit => Ok(Some(self.hit())),
-            WalkEnd::Exit | WalkEnd::Budget => Ok(None),
-        }
+        let end = self.walk(raster, mode, u32::MAX, |_, c| c & cell::OPAQUE != 0)?;
+        Ok(self.hit_after(end))
+    }
+
+    /// The hit after a walk that ended with `end`.
+    fn hit_after(&self, end: WalkEnd) -> Option<Hit> {
+        matches!(end, WalkEnd::Hit).then(|| self.hit())
     }
 
     /// The current voxel: after [`WalkEnd::Hit`] the hit voxel, after
@@ -471,9 +477,7 @@ impl DiscreteRay {
         raster: &'r Raster<'r>,
         mode: Connectivity,
     ) -> Result<Voxels<'r>, RayError> {
-        if raster.extent() != self.p.extent {
-            return Err(RayError::ExtentMismatch);
-        }
+        self.plane_of(raster)?;
         Ok(Voxels {
             ray: self,
             raster: *raster,

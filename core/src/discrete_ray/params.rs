@@ -77,7 +77,7 @@ struct Param {
 
 impl Param {
     /// `self < other`, exactly (products < 2^81, or < 2^62 in a
-    /// [`Narrow`] setup).
+    /// [`narrow`] setup).
     fn lt<W: Wide>(self, other: Self) -> bool {
         W::of(self.n).mul(W::of(other.d)) < W::of(other.n).mul(W::of(self.d))
     }
@@ -198,139 +198,20 @@ fn setup_in<W: Wide>(
     n: [u32; 3],
     size: [i64; 3],
 ) -> Result<Option<DiscreteRay>, RayError> {
+    let Some((t_in, t_out)) = clip::<W>(origin, dir, segment, size) else {
+        return Ok(None);
+    };
+    let Ends {
+        entry,
+        exit,
+        rem,
+        dist,
+    } = ends::<W>(origin, dir, n, t_in, t_out)?;
+
     let ad = dir.map(|v| i64::from(v.unsigned_abs()));
-
-    // Clip: t_in = max(0, near crossings), t_out = min(t_max, far crossings).
-    // `near - o` and `far - o` are below 2^48 + 2^32 in magnitude.
-    let mut t_in = End {
-        t: Param { n: 0, d: 1 },
-        face: None,
-    };
-    let mut t_out: Option<End> = segment.then_some(End {
-        t: Param { n: 1, d: 1 },
-        face: None,
-    });
-    for k in 0..3 {
-        let (o, sz) = (origin[k], size[k]);
-        if dir[k] == 0 {
-            // Parallel to both faces of this slab: inside iff 0 <= O < size
-            // (voxels are half-open, so the top face belongs to no voxel).
-            if o < 0 || o >= sz {
-                return Ok(None);
-            }
-            continue;
-        }
-        let (near, far) = if dir[k] > 0 { (0, sz) } else { (sz, 0) };
-        let sign = i64::from(dir[k].signum());
-        let tn = Param {
-            n: near.wrapping_sub(o).wrapping_mul(sign),
-            d: ad[k],
-        };
-        let tf = Param {
-            n: far.wrapping_sub(o).wrapping_mul(sign),
-            d: ad[k],
-        };
-        // `>=`: on a tie the later axis wins, matching the x-before-y-before-z
-        // order of simultaneous crossings (the last crossing names the face).
-        if !tn.lt::<W>(t_in.t) {
-            t_in = End {
-                t: tn,
-                face: Some(k),
-            };
-        }
-        if t_out.is_none_or(|e| tf.lt::<W>(e.t)) {
-            t_out = Some(End {
-                t: tf,
-                face: Some(k),
-            });
-        }
-    }
-    if let Some(e) = t_out
-        && !t_in.t.lt::<W>(e.t)
-    {
-        return Ok(None); // empty or single-point contact
-    }
-
-    // The voxel holding the ray on (t, t + ε) (entering) or (t − ε, t)
-    // (leaving): a point on a face belongs to the voxel the ray is on that
-    // side of it. Per axis, no division when the endpoint is the origin, a
-    // segment end, or on this axis's face.
-    let voxel_at = |end: End, k: usize, leaving: bool| -> Result<i64, RayError> {
-        let (o, d, nk) = (origin[k], dir[k], i64::from(n[k]));
-        if d == 0 {
-            return Ok(o >> FRAC_BITS);
-        }
-        // A point on a boundary belongs to the voxel below it when the ray
-        // comes from below and is leaving, or comes from above and is entering.
-        let below = (d > 0) == leaving;
-        if end.face == Some(k) {
-            return Ok(if below { nk.wrapping_sub(1) } else { 0 });
-        }
-        let t = end.t;
-        if t.d == 1 && (t.n == 0 || t.n == 1) {
-            // The origin (t = 0) or a segment's end (t = 1): an exact point.
-            let p = if t.n == 0 {
-                o
-            } else {
-                o.wrapping_add(i64::from(d))
-            };
-            return Ok(if below { p.wrapping_sub(1) } else { p } >> FRAC_BITS);
-        }
-        // P·den = O·den + num·D, exact in i128 (< 2^82).
-        let x = W::of(o)
-            .mul(W::of(t.d))
-            .add(W::of(t.n).mul(W::of(i64::from(d))));
-        let x = if below { x.sub(W::of(1)) } else { x };
-        Ok(x.floor_div(t.d)?.to_i64()? >> FRAC_BITS)
-    };
-
-    let mut entry = [0u32; 3];
-    let mut exit = [0u32; 3];
-    let mut rem = [0u32; 3];
-    let mut dist = [S; 3];
-    for k in 0..3 {
-        let vi = voxel_at(t_in, k, false)?;
-        let vo = match t_out {
-            Some(e) => voxel_at(e, k, true)?,
-            None => vi, // only when D = 0: the ray never moves
-        };
-        let lim = i64::from(n[k]);
-        if !(0..lim).contains(&vi) || !(0..lim).contains(&vo) {
-            return Err(RayError::Arithmetic);
-        }
-        let moves = vo.wrapping_sub(vi);
-        if moves != 0 && moves.signum() != i64::from(dir[k].signum()) {
-            return Err(RayError::Arithmetic);
-        }
-        entry[k] = u32::try_from(vi).map_err(|_| RayError::Arithmetic)?;
-        exit[k] = u32::try_from(vo).map_err(|_| RayError::Arithmetic)?;
-        rem[k] = u32::try_from(moves.unsigned_abs()).map_err(|_| RayError::Arithmetic)?;
-        // Distance (times 1) to the next boundary along the ray on this axis:
-        // t_k·|D_k|. Still axes keep a positive stand-in (|D| = 0 makes t = ∞).
-        if dir[k] != 0 {
-            let boundary = (if dir[k] > 0 { vi.wrapping_add(1) } else { vi }) << FRAC_BITS;
-            dist[k] = boundary
-                .wrapping_sub(origin[k])
-                .wrapping_mul(i64::from(dir[k].signum()));
-            if dist[k] <= 0 {
-                return Err(RayError::Arithmetic);
-            }
-        }
-    }
-
-    // Drive frame.
-    let a = if ad[1] > ad[0] {
-        if ad[2] > ad[1] { 2 } else { 1 }
-    } else if ad[2] > ad[0] {
-        2
-    } else {
-        0
-    };
-    let (b, c) = match a {
-        0 => (1, 2),
-        1 => (0, 2),
-        _ => (0, 1),
-    };
+    let (a, b, c) = drive_frame(ad);
+    // before(j, k) of the module notes: positive exactly when axis k crosses
+    // before axis j, ties going to the lower axis index.
     let before = |j: usize, k: usize| -> Result<i64, RayError> {
         let raw = W::of(dist[j])
             .mul(W::of(ad[k]))
@@ -379,7 +260,9 @@ fn setup_in<W: Wide>(
             diag,
             inc,
             thr: [if a < b { -2 } else { 0 }, if a < c { -2 } else { 0 }],
-            entry_face: t_in.face.map(|k| Face::entered(k, dir[k] > 0)),
+            entry_face: t_in
+                .face
+                .map(|k| Face::entered(k, dir.get(k).is_some_and(|&d| d > 0))),
             entry,
             exit,
         },
@@ -396,22 +279,211 @@ fn setup_in<W: Wide>(
     }))
 }
 
+/// Clips the ray to the raster box: `t_in = max(0, near crossings)`,
+/// `t_out = min(t_max, far crossings)` (`None` for a half-line parallel to
+/// every face it could leave through, which only a zero direction is).
+/// `None` when the clipped ray is empty or a single point.
+#[inline(always)]
+fn clip<W: Wide>(
+    origin: [i64; 3],
+    dir: [i32; 3],
+    segment: bool,
+    size: [i64; 3],
+) -> Option<(End, Option<End>)> {
+    // `near - o` and `far - o` are below 2^48 + 2^32 in magnitude.
+    let mut t_in = End {
+        t: Param { n: 0, d: 1 },
+        face: None,
+    };
+    let mut t_out: Option<End> = segment.then_some(End {
+        t: Param { n: 1, d: 1 },
+        face: None,
+    });
+    for k in 0..3 {
+        let (o, sz) = (origin[k], size[k]);
+        if dir[k] == 0 {
+            // Parallel to both faces of this slab: inside iff 0 <= O < size
+            // (voxels are half-open, so the top face belongs to no voxel).
+            if o < 0 || o >= sz {
+                return None;
+            }
+            continue;
+        }
+        let (near, far) = if dir[k] > 0 { (0, sz) } else { (sz, 0) };
+        let sign = i64::from(dir[k].signum());
+        let d = i64::from(dir[k].unsigned_abs());
+        let tn = Param {
+            n: near.wrapping_sub(o).wrapping_mul(sign),
+            d,
+        };
+        let tf = Param {
+            n: far.wrapping_sub(o).wrapping_mul(sign),
+            d,
+        };
+        // `>=`: on a tie the later axis wins, matching the x-before-y-before-z
+        // order of simultaneous crossings (the last crossing names the face).
+        if !tn.lt::<W>(t_in.t) {
+            t_in = End {
+                t: tn,
+                face: Some(k),
+            };
+        }
+        if t_out.is_none_or(|e| tf.lt::<W>(e.t)) {
+            t_out = Some(End {
+                t: tf,
+                face: Some(k),
+            });
+        }
+    }
+    if let Some(e) = t_out
+        && !t_in.t.lt::<W>(e.t)
+    {
+        return None; // empty or single-point contact
+    }
+    Some((t_in, t_out))
+}
+
+/// The clipped ray's voxels and counters, per real axis.
+struct Ends {
+    /// The voxel holding the ray just after its entry point.
+    entry: [u32; 3],
+    /// The voxel holding the ray just before its exit point.
+    exit: [u32; 3],
+    /// Boundary crossings between them.
+    rem: [u32; 3],
+    /// Distance (times 1) from the origin to the entry voxel's next
+    /// boundary along the ray, `t_k·|D_k|`; a positive stand-in (`S`) on
+    /// axes the ray does not move along.
+    dist: [i64; 3],
+}
+
+/// The entry and exit voxels, crossing counts and next-boundary distances
+/// of the ray clipped to `[t_in, t_out]`.
+///
+/// # Errors
+/// [`RayError::Arithmetic`] if an endpoint falls outside the raster or the
+/// ray would move against its direction: impossible for a ray inside the
+/// accepted range, and refused rather than stepped.
+#[inline(always)]
+fn ends<W: Wide>(
+    origin: [i64; 3],
+    dir: [i32; 3],
+    n: [u32; 3],
+    t_in: End,
+    t_out: Option<End>,
+) -> Result<Ends, RayError> {
+    let mut entry = [0u32; 3];
+    let mut exit = [0u32; 3];
+    let mut rem = [0u32; 3];
+    let mut dist = [S; 3];
+    for k in 0..3 {
+        let vi = voxel_at::<W>(origin, dir, n, t_in, k, false)?;
+        let vo = match t_out {
+            Some(e) => voxel_at::<W>(origin, dir, n, e, k, true)?,
+            None => vi, // only when D = 0: the ray never moves
+        };
+        let lim = i64::from(n[k]);
+        if !(0..lim).contains(&vi) || !(0..lim).contains(&vo) {
+            return Err(RayError::Arithmetic);
+        }
+        let moves = vo.wrapping_sub(vi);
+        if moves != 0 && moves.signum() != i64::from(dir[k].signum()) {
+            return Err(RayError::Arithmetic);
+        }
+        entry[k] = u32::try_from(vi).map_err(|_| RayError::Arithmetic)?;
+        exit[k] = u32::try_from(vo).map_err(|_| RayError::Arithmetic)?;
+        rem[k] = u32::try_from(moves.unsigned_abs()).map_err(|_| RayError::Arithmetic)?;
+        // Still axes keep the positive stand-in (|D| = 0 makes t = ∞).
+        if dir[k] != 0 {
+            let boundary = (if dir[k] > 0 { vi.wrapping_add(1) } else { vi }) << FRAC_BITS;
+            dist[k] = boundary
+                .wrapping_sub(origin[k])
+                .wrapping_mul(i64::from(dir[k].signum()));
+            if dist[k] <= 0 {
+                return Err(RayError::Arithmetic);
+            }
+        }
+    }
+    Ok(Ends {
+        entry,
+        exit,
+        rem,
+        dist,
+    })
+}
+
+/// Axis `k` of the voxel holding the ray on `(t, t + ε)` (entering) or
+/// `(t − ε, t)` (`leaving`) at endpoint `end`: a point on a face belongs to
+/// the voxel the ray is on that side of it. No division when the endpoint
+/// is the origin, a segment end, or on this axis's face.
+#[inline(always)]
+fn voxel_at<W: Wide>(
+    origin: [i64; 3],
+    dir: [i32; 3],
+    n: [u32; 3],
+    end: End,
+    k: usize,
+    leaving: bool,
+) -> Result<i64, RayError> {
+    let (o, d, nk) = (origin[k], dir[k], i64::from(n[k]));
+    if d == 0 {
+        return Ok(o >> FRAC_BITS);
+    }
+    // A point on a boundary belongs to the voxel below it when the ray
+    // comes from below and is leaving, or comes from above and is entering.
+    let below = (d > 0) == leaving;
+    if end.face == Some(k) {
+        return Ok(if below { nk.wrapping_sub(1) } else { 0 });
+    }
+    let t = end.t;
+    if t.d == 1 && (t.n == 0 || t.n == 1) {
+        // The origin (t = 0) or a segment's end (t = 1): an exact point.
+        let p = if t.n == 0 {
+            o
+        } else {
+            o.wrapping_add(i64::from(d))
+        };
+        return Ok(if below { p.wrapping_sub(1) } else { p } >> FRAC_BITS);
+    }
+    // P·den = O·den + num·D, exact in i128 (< 2^82).
+    let x = W::of(o)
+        .mul(W::of(t.d))
+        .add(W::of(t.n).mul(W::of(i64::from(d))));
+    let x = if below { x.sub(W::of(1)) } else { x };
+    Ok(x.floor_div(t.d)?.to_i64()? >> FRAC_BITS)
+}
+
+/// The drive frame `(a, b, c)`: the driving axis a (largest `|D|`, lowest
+/// index on ties) and the minor axes `b < c`.
+#[inline(always)]
+const fn drive_frame(ad: [i64; 3]) -> (usize, usize, usize) {
+    let a = if ad[1] > ad[0] {
+        if ad[2] > ad[1] { 2 } else { 1 }
+    } else if ad[2] > ad[0] {
+        2
+    } else {
+        0
+    };
+    let (b, c) = match a {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    (a, b, c)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testkit::Rng;
 
     /// The `i64` setup gives the very ray the `i128` setup gives, on
     /// random rays within its domain: rays from far outside, from inside,
     /// grazing faces, axis-parallel, and segments.
     #[test]
     fn narrow_setup_is_the_wide_setup() {
-        let mut x = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let mut next = move || rng.next_u64();
         let mut compared = 0u32;
         let mut some = 0u32;
         for _ in 0..200_000 {

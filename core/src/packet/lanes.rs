@@ -15,8 +15,13 @@
 // stepper relies on that (its scalar twin uses wrapping ops throughout), so
 // the operator uses below are allowed `arithmetic_side_effects`.
 
+use crate::discrete_ray::rules::{Flag, Term};
+
 /// Bit `l` of a lane bitmask stands for lane `l`.
 pub(crate) const LANES: usize = 8;
+
+/// Bit of each lane in a lane bitmask.
+pub(crate) const BIT: [u8; LANES] = [1, 2, 4, 8, 16, 32, 64, 128];
 
 /// A lane mask: every lane all ones (true) or all zeros (false).
 ///
@@ -198,7 +203,7 @@ mod backend {
     not(feature = "scalar-lanes")
 )))]
 mod backend {
-    use super::{LANES, Mask8};
+    use super::{BIT, LANES, Mask8};
 
     /// Eight `i64` lanes: a plain array (no SIMD on this target).
     #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -220,9 +225,6 @@ mod backend {
             f(a7, b7),
         ])
     }
-
-    /// Bit of each lane in a lane bitmask.
-    const BITS: [u8; LANES] = [1, 2, 4, 8, 16, 32, 64, 128];
 
     /// A lane of a mask.
     const fn m(t: bool) -> i64 {
@@ -312,7 +314,7 @@ mod backend {
         #[inline(always)]
         pub(crate) fn mask_bits(self) -> u8 {
             let mut out = 0u8;
-            for (&a, &bit) in self.0.iter().zip(BITS.iter()) {
+            for (&a, &bit) in self.0.iter().zip(BIT.iter()) {
                 if a < 0 {
                     out |= bit;
                 }
@@ -323,7 +325,7 @@ mod backend {
         /// The mask with lane `l` set iff bit `l` of `bits` is.
         #[inline(always)]
         pub(crate) fn mask_from_bits(bits: u8) -> Self {
-            Self(BITS.map(|bit| m(bits & bit != 0)))
+            Self(BIT.map(|bit| m(bits & bit != 0)))
         }
     }
 }
@@ -357,30 +359,6 @@ impl Mask8 {
         self.0.mask_bits()
     }
 
-    /// Lanes set in both.
-    #[inline(always)]
-    pub(crate) fn and(self, o: Self) -> Self {
-        Self(self.0.and(o.0))
-    }
-
-    /// Lanes set in either.
-    #[inline(always)]
-    pub(crate) fn or(self, o: Self) -> Self {
-        Self(self.0.or(o.0))
-    }
-
-    /// Lanes set in `o` but not in `self`.
-    #[inline(always)]
-    pub(crate) fn and_not(self, o: Self) -> Self {
-        Self(self.0.and_not(o.0))
-    }
-
-    /// Lanes not set.
-    #[inline(always)]
-    pub(crate) fn not(self) -> Self {
-        Self(self.0.not())
-    }
-
     /// `v` in set lanes, 0 elsewhere.
     #[inline(always)]
     pub(crate) fn keep(self, v: I64x8) -> I64x8 {
@@ -403,5 +381,55 @@ impl Mask8 {
     #[inline(always)]
     pub(crate) const fn as_minus_one(self) -> I64x8 {
         self.0
+    }
+}
+
+/// Lane masks as the stepper rules' flags.
+impl Flag for Mask8 {
+    const SET: Self = Self::ALL;
+    #[inline(always)]
+    fn and(self, o: Self) -> Self {
+        Self(self.0.and(o.0))
+    }
+    #[inline(always)]
+    fn or(self, o: Self) -> Self {
+        Self(self.0.or(o.0))
+    }
+    #[inline(always)]
+    fn and_not(self, o: Self) -> Self {
+        Self(self.0.and_not(o.0))
+    }
+    #[inline(always)]
+    fn not(self) -> Self {
+        Self(self.0.not())
+    }
+}
+
+/// Lanes as the stepper rules' terms: the rules run on eight rays at once.
+impl Term for I64x8 {
+    type Flag = Mask8;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self::add(self, o)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Self::sub(self, o)
+    }
+    #[inline(always)]
+    fn lt0(self) -> Mask8 {
+        Self::lt0(self)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> Mask8 {
+        Self::gt(self, o)
+    }
+    #[inline(always)]
+    fn is(self, v: i64) -> Mask8 {
+        self.eq_splat(v)
+    }
+    #[inline(always)]
+    fn keep(self, f: Mask8) -> Self {
+        f.keep(self)
     }
 }

@@ -56,11 +56,12 @@ mod tests;
 
 use core::fmt;
 
+use crate::discrete_ray::rules::{ADAPTIVE, SIX, TWENTY_SIX};
 use crate::discrete_ray::{Connectivity, DiscreteRay, Hit, WalkEnd};
 use crate::error::RayError;
 use crate::raster::{Extent, Raster, cell};
-use lanes::I64x8;
-use step::{ADAPTIVE, BIT, CellBits, Closure, SIX, TWENTY_SIX, lane_of};
+use lanes::{BIT, I64x8};
+use step::{CellBits, Closure, lane_of};
 
 /// Number of lanes of a [`RayPacket8`].
 pub const LANES: usize = lanes::LANES;

@@ -1,21 +1,21 @@
 //! The lockstep stepper: one iteration steps every live lane once, gathers
 //! eight plane cells and tests them.
 //
-// Implementation notes. This is `discrete_ray/step.rs` written once for
-// eight lanes. Each lane keeps its own drive frame, so the per-lane
-// constants (increments, offsets, thresholds) are vectors and lanes with
-// different driving axes or signs cost nothing extra. Every step is written
-// as "move frame axes A, B, C" with lane masks:
+// Implementation notes. This is the scalar stepper (`discrete_ray/step.rs`)
+// run for eight lanes, with the same rules (`discrete_ray/rules.rs`) on
+// lane terms and lane masks. Each lane keeps its own drive frame, so the
+// per-lane constants (increments, offsets, thresholds) are vectors and lanes
+// with different driving axes or signs cost nothing extra. Every step is
+// "move frame axes A, B, C" with lane masks: the terms change by
+// `rules::term_steps`, and
 //
-//     e1 += (A & inc_b) − (B & inc_a)      rem_a −= A     idx += (A & off_a)
-//     e2 += (A & inc_c) − (C & inc_a)      rem_b −= B          + (B & off_b)
-//     e3 += (B & inc_c) − (C & inc_b)      rem_c −= C          + (C & off_c)
+//     rem_a −= A     rem_b −= B     rem_c −= C
+//     idx += (A & off_a) + (B & off_b) + (C & off_c)
 //
-// A 6-step sets exactly one of A, B, C (the scalar's three branches); a
-// 26-step sets A and B = e1 > thr_b, C = e2 > thr_c (the scalar's `diag`
-// sums the same offsets). Adaptive selects per lane between the two by
-// `tie | PROXIMITY`. The formula reproduces the scalar updates term by term,
-// with the same wrapping two's-complement arithmetic.
+// A 6-step sets exactly one of A, B, C (`rules::six_moves`, the scalar's
+// three branches); a 26-step sets A and the minors of
+// `rules::twenty_six_moves` (the scalar's `diag` sums the same offsets).
+// Adaptive selects per lane between the two by `rules::takes_six`.
 //
 // Bit identity, and what each lane keeps:
 // * One visit per iteration for every live lane (a fresh lane visits its
@@ -40,30 +40,27 @@
 // * `last` (the moved frame axes) is the three move masks of each lane's
 //   latest step; `tie` is tracked per step only in Adaptive mode, where it
 //   decides the next step. In Six mode it is recomputed when a lane is
-//   written back, from the step it took and the terms after it (the updates
-//   are invertible); in TwentySix mode it is false after any step. In
-//   TwentySix mode `e3` is not stepped either: it is rebuilt at write-back
-//   from the minor crossings taken (the counters' decrease).
+//   written back (`rules::six_tie_after`); in TwentySix mode it is false
+//   after any step. In TwentySix mode `e3` is not stepped either: it is
+//   rebuilt at write-back from the minor crossings taken, the counters'
+//   decrease (`rules::e3_after`).
 // * Indices are `usize` values in 64-bit lanes: the offsets are the
 //   scalar's wrapping `usize` offsets sign-extended, so lane arithmetic
 //   modulo 2^64 truncated to `usize` is the scalar's wrapping arithmetic
 //   modulo 2^usize::BITS, on 32- and 64-bit targets alike. Crossing
 //   counters are `u32` in 64-bit lanes the same way.
 
-use super::lanes::{I64x8, LANES, Mask8};
+use super::lanes::{BIT, I64x8, LANES, Mask8};
 use super::{PacketEnd, RayPacket8};
 use crate::discrete_ray::State;
+use crate::discrete_ray::rules::{self, ADAPTIVE, Flag, SIX, TWENTY_SIX};
 use crate::raster::cell;
 
-/// Connectivity as a const parameter (as in the scalar stepper).
-pub(super) const SIX: u8 = 0;
-pub(super) const TWENTY_SIX: u8 = 1;
-pub(super) const ADAPTIVE: u8 = 2;
-/// TwentySix steps inside an Adaptive walk: `e3` is stepped too.
+/// TwentySix steps inside an Adaptive walk (`e3` is stepped too): a mode
+/// value of this stepper only, distinct from the three of `rules`.
 const TWENTY_SIX_KEEP_E3: u8 = 3;
-
-/// Bit of each lane in a lane bitmask.
-pub(super) const BIT: [u8; LANES] = [1, 2, 4, 8, 16, 32, 64, 128];
+const _: () = assert!(TWENTY_SIX_KEEP_E3 != SIX && TWENTY_SIX_KEEP_E3 != TWENTY_SIX);
+const _: () = assert!(TWENTY_SIX_KEEP_E3 != ADAPTIVE);
 
 /// A `usize` offset or index as a 64-bit lane value.
 #[allow(clippy::cast_possible_wrap)] // two's-complement reinterpretation, see the notes
@@ -220,40 +217,27 @@ struct Step {
 fn step<const MODE: u8>(v: &Lanes, k: &Consts, tie: u8, prox: u8) -> Step {
     let [e1, e2, e3] = v.e;
     let [ra, rb, rc] = v.rem;
-    let [inc_a, inc_b, inc_c] = k.inc;
     let [off_a, off_b, off_c] = k.off;
-    let [thr_b, thr_c] = k.thr;
-    // The scalar's three 6-step branches as masks. The terms are odd (±1
-    // plus even increments), never zero, so e1 > 0 is !(e1 < 0).
-    let six_moves = || {
-        let n1 = e1.lt0();
-        let a = n1.and(e2.lt0());
-        let b = n1.and_not(e3.lt0());
-        (a, b, a.or(b).not())
-    };
-    let (a, b, c, tie) = match MODE {
-        SIX => {
-            let (a, b, c) = six_moves();
-            (a, b, c, 0)
-        }
-        TWENTY_SIX | TWENTY_SIX_KEEP_E3 => (Mask8::ALL, e1.gt(thr_b), e2.gt(thr_c), 0),
+    let (moves, tie) = match MODE {
+        SIX => (rules::six_moves(v.e), 0),
+        TWENTY_SIX | TWENTY_SIX_KEEP_E3 => (rules::twenty_six_moves(e1, e2, k.thr), 0),
         _ => {
-            let six = Mask8::from_bits(tie | prox);
-            let (a6, b6, c6) = six_moves();
-            // The 6-step tie flags, from the terms before the step.
-            let t = a6
-                .and(e1.eq_splat(-1).or(e2.eq_splat(-1)))
-                .or(b6.and(e1.eq_splat(1).or(e3.eq_splat(-1))))
-                .or(c6.and(e2.eq_splat(1)))
-                .and(six);
+            let six = Mask8::from_bits(rules::takes_six(tie, prox));
+            let [a6, b6, c6] = rules::six_moves(v.e);
+            let [a26, b26, c26] = rules::twenty_six_moves(e1, e2, k.thr);
+            // The 6-step lanes' tie flags, from the terms before the step.
+            let t = rules::six_tie([a6, b6, c6], v.e).and(six);
             (
-                six.select_mask(a6, Mask8::ALL),
-                six.select_mask(b6, e1.gt(thr_b)),
-                six.select_mask(c6, e2.gt(thr_c)),
+                [
+                    six.select_mask(a6, a26),
+                    six.select_mask(b6, b26),
+                    six.select_mask(c6, c26),
+                ],
                 t.bits(),
             )
         }
     };
+    let [a, b, c] = moves;
     let rem = [
         ra.add(a.as_minus_one()),
         rb.add(b.as_minus_one()),
@@ -263,13 +247,15 @@ fn step<const MODE: u8>(v: &Lanes, k: &Consts, tie: u8, prox: u8) -> Step {
         TWENTY_SIX | TWENTY_SIX_KEEP_E3 => rem[0].lt0().bits(),
         _ => rem[0].or(rem[1]).or(rem[2]).lt0().bits(),
     };
+    let [s1, s2, s3] = rules::stepped(v.e, moves, k.inc);
     let next = Lanes {
+        // TwentySix does not step e3: write-back rebuilds it.
         e: [
-            e1.add(a.keep(inc_b)).sub(b.keep(inc_a)),
-            e2.add(a.keep(inc_c)).sub(c.keep(inc_a)),
+            s1,
+            s2,
             match MODE {
                 TWENTY_SIX => e3,
-                _ => e3.add(b.keep(inc_c)).sub(c.keep(inc_b)),
+                _ => s3,
             },
         ],
         rem,
@@ -281,23 +267,9 @@ fn step<const MODE: u8>(v: &Lanes, k: &Consts, tie: u8, prox: u8) -> Step {
     };
     Step {
         next,
-        moves: [a, b, c],
+        moves,
         tie,
         exits,
-    }
-}
-
-/// The tie flag a 6-step along the frame axis in `last` leaves, from the
-/// terms after it (`e`) and the ray's increments: the step's updates undone,
-/// then the scalar's test.
-fn six_tie(last: u8, e: [i64; 3], inc: [i64; 3]) -> bool {
-    let [e1, e2, e3] = e;
-    let [inc_a, inc_b, inc_c] = inc;
-    match last {
-        1 => e1.wrapping_sub(inc_b) == -1 || e2.wrapping_sub(inc_c) == -1,
-        2 => e1.wrapping_add(inc_a) == 1 || e3.wrapping_sub(inc_c) == -1,
-        4 => e2.wrapping_add(inc_a) == 1,
-        _ => false,
     }
 }
 
@@ -352,8 +324,7 @@ fn write_back<const MODE: u8>(
         let get = |a: &[i64; LANES]| a.get(lane).copied().unwrap_or(0);
         let stepped = stepped & bit != 0;
         let last = if stepped {
-            let [ma, mb, mc] = moved.map(|m| m & bit != 0);
-            u8::from(ma) | (u8::from(mb) << 1) | (u8::from(mc) << 2)
+            rules::last_of(moved.map(|m| m & bit != 0))
         } else {
             b.last.get(lane).copied().unwrap_or(0)
         };
@@ -363,17 +334,16 @@ fn write_back<const MODE: u8>(
         if MODE == TWENTY_SIX
             && let Some(e3) = err.get_mut(2)
         {
-            // Each b crossing added inc_c, each c crossing took inc_b.
+            // The minor crossings taken: the counters' decrease.
             let nb = get(&b.rb).wrapping_sub(rem[1]);
             let nc = get(&b.rc).wrapping_sub(rem[2]);
-            *e3 = get(&b.e3)
-                .wrapping_add(nb.wrapping_mul(inc[2]))
-                .wrapping_sub(nc.wrapping_mul(inc[1]));
+            *e3 = rules::e3_after(get(&b.e3), nb, nc, inc);
         }
         let tie = match MODE {
             ADAPTIVE => tie & bit != 0,
             _ if !stepped => b.tie & bit != 0,
-            SIX => six_tie(last, err, inc),
+            SIX => rules::six_tie_after(last, err, inc),
+            // 26-steps leave no tie pending.
             _ => false,
         };
         ray.set_state(State {
@@ -491,7 +461,7 @@ impl Walker<'_, '_> {
             // Where no lane is near a surface (or owes a tie), every lane of
             // an Adaptive walk takes a 26-step: the cheaper TwentySix step,
             // with e3 kept.
-            ADAPTIVE if (self.tie | self.prox) & stepping == 0 => {
+            ADAPTIVE if rules::takes_six(self.tie, self.prox) & stepping == 0 => {
                 step::<{ TWENTY_SIX_KEEP_E3 }>(&self.v, &self.k, 0, 0)
             }
             _ => step::<MODE>(&self.v, &self.k, self.tie, self.prox),

@@ -10,25 +10,7 @@ use crate::check_packet::{Walk, check_packet, check_packet_script};
 use crate::fixed::{VOXEL, voxel_centre};
 use crate::proximity::flag_neighbourhood;
 use crate::raster::RasterMut;
-
-/// SplitMix64, seeded per case.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-    fn range(&mut self, lo: i64, hi: i64) -> i64 {
-        lo + (self.next() % (hi - lo + 1) as u64) as i64
-    }
-}
+use crate::testkit::Rng;
 
 #[track_caller]
 fn check(raster: &Raster<'_>, packet: &RayPacket8, label: &str) {

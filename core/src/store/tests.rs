@@ -4,9 +4,15 @@ use std::collections::HashMap;
 use std::vec;
 use std::vec::Vec;
 
+use super::brick::{brick_of, brick_origin, voxel_at};
+use super::rank_hint::{HINT_SCALE, hint_window};
 use super::*;
 use crate::proximity::flag_neighbourhood;
+use crate::raster::{Extent, RasterMut, cell};
+use crate::testkit::Rng;
+use crate::voxel::{VoxelRecord, brick_position};
 use crate::voxelize::NORMAL_ONE;
+use crate::voxelize::{Surfel, VoxelSink};
 
 const UP: [i32; 3] = [0, 0, NORMAL_ONE];
 
@@ -14,21 +20,6 @@ fn surfel(distance: u32) -> Surfel {
     Surfel {
         normal: UP,
         distance,
-    }
-}
-
-/// SplitMix64.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u32) -> u32 {
-        (self.next() % u64::from(n)) as u32
     }
 }
 
@@ -43,8 +34,8 @@ fn random_script(extent: Extent, objects: usize, offers: usize, seed: u64) -> Sc
             (0..offers)
                 .map(|_| {
                     (
-                        [rng.below(nx), rng.below(ny), rng.below(nz)],
-                        rng.below(1 << 16),
+                        [rng.below_u32(nx), rng.below_u32(ny), rng.below_u32(nz)],
+                        rng.below_u32(1 << 16),
                     )
                 })
                 .collect()
@@ -134,9 +125,14 @@ fn geometry_of_bricks() {
 fn lookups_match_brute_force_on_random_sparse_rasters() {
     for seed in 0..20u64 {
         let mut rng = Rng(seed);
-        let extent = Extent::new(1 + rng.below(40), 1 + rng.below(40), 1 + rng.below(40)).unwrap();
-        let objects = 1 + rng.below(4) as usize;
-        let offers = rng.below(3000) as usize;
+        let extent = Extent::new(
+            1 + rng.below_u32(40),
+            1 + rng.below_u32(40),
+            1 + rng.below_u32(40),
+        )
+        .unwrap();
+        let objects = 1 + rng.below_u32(4) as usize;
+        let offers = rng.below_u32(3000) as usize;
         let script = random_script(extent, objects, offers, seed.wrapping_mul(77));
         let scene = build(extent, &script).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         let expect = brute_force(&script);
@@ -439,19 +435,19 @@ fn corrupt_directories_are_rejected() {
     for _ in 0..2000 {
         let mut dir = s.dir.clone();
         let mut recs = s.records.clone();
-        match rng.below(3) {
+        match rng.below_u32(3) {
             0 => {
-                let i = rng.below(dir.len() as u32) as usize;
-                dir[i] = rng.below(400);
+                let i = rng.below_u32(dir.len() as u32) as usize;
+                dir[i] = rng.below_u32(400);
             }
             1 => {
                 if !recs.is_empty() {
-                    let i = rng.below(recs.len() as u32) as usize;
-                    recs[i].key = rng.below(1 << 16) as u16;
+                    let i = rng.below_u32(recs.len() as u32) as usize;
+                    recs[i].key = rng.below_u32(1 << 16) as u16;
                 }
             }
             _ => {
-                recs.truncate(rng.below(recs.len() as u32 + 1) as usize);
+                recs.truncate(rng.below_u32(recs.len() as u32 + 1) as usize);
             }
         }
         if let Ok(st) = RecordStore::new(e, &dir, &recs) {
@@ -466,10 +462,15 @@ fn corrupt_directories_are_rejected() {
 fn proximity_after_build_is_the_26_neighbourhood() {
     for seed in 0..12u64 {
         let mut rng = Rng(seed + 100);
-        let extent = Extent::new(1 + rng.below(30), 1 + rng.below(30), 1 + rng.below(30)).unwrap();
+        let extent = Extent::new(
+            1 + rng.below_u32(30),
+            1 + rng.below_u32(30),
+            1 + rng.below_u32(30),
+        )
+        .unwrap();
         // Even seeds sparse (per-record pass), odd seeds dense (whole plane).
         let offers = if seed % 2 == 0 {
-            rng.below(200) as usize
+            rng.below_u32(200) as usize
         } else {
             extent.len() / 2
         };
@@ -527,9 +528,14 @@ fn store_mut_updates_in_place() {
 fn hinted_lookups_are_plain_lookups() {
     for seed in 0..12u64 {
         let mut rng = Rng(seed ^ 0xabcd);
-        let extent = Extent::new(1 + rng.below(40), 1 + rng.below(40), 1 + rng.below(40)).unwrap();
+        let extent = Extent::new(
+            1 + rng.below_u32(40),
+            1 + rng.below_u32(40),
+            1 + rng.below_u32(40),
+        )
+        .unwrap();
         // Dense enough that bricks hold well over 64 records.
-        let offers = rng.below(40_000) as usize;
+        let offers = rng.below_u32(40_000) as usize;
         let script = random_script(extent, 2, offers, seed.wrapping_mul(31));
         let mut scene = build(extent, &script).unwrap();
         let store = RecordStore::new(extent, &scene.dir, &scene.records).unwrap();
@@ -558,7 +564,7 @@ fn hinted_lookups_are_plain_lookups() {
                 assert!(to - from <= n.div_ceil(HINT_SCALE) + 1);
                 in_window += 1;
             }
-            for junk in [0u8, 0xff, cell::OPAQUE, rng.below(256) as u8] {
+            for junk in [0u8, 0xff, cell::OPAQUE, rng.below_u32(256) as u8] {
                 assert_eq!(
                     store.get_hinted(v, junk),
                     plain,

@@ -40,8 +40,10 @@
 //! constant per chord plus the triangles' voxels.
 
 use super::error::VoxelizeError;
-use super::fixmath::{H, centre, check_coord, check_point, dist_u32, isqrt, unit};
-use super::tessellate::{Emitter, circle, dot, frame, quarter_segments, round_div};
+use super::fixmath::{
+    H, bounds, centre, check_coord, check_point, dist_u32, dot, isqrt, sub, sub_along, unit,
+};
+use super::tessellate::{Emitter, circle, frame, quarter_segments, ring_point};
 use super::triangle::Tri;
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Cone;
@@ -97,7 +99,7 @@ impl Geo {
         }
         let r0 = check_coord(c.base_radius)?;
         let r1 = check_coord(c.apex_radius)?;
-        let axis = [0, 1, 2].map(|k| a[k].saturating_sub(b[k]));
+        let axis = sub(a, b);
         let frame = frame(axis).ok_or(VoxelizeError::Degenerate)?;
         let len = isqrt(dot(axis, axis));
         Ok(Self {
@@ -113,15 +115,8 @@ impl Geo {
 
     /// Point `j` of the circle of radius `r` around `c`.
     fn ring(&self, c: [i128; 3], r: i128, j: u32, m: u32) -> [i128; 3] {
-        let [cs, sn, d] = circle(j, m);
         let [u, v, _] = self.frame;
-        // r < 2^41, cs, sn < 2^21, u, v ≤ 2^30: products < 2^92.
-        [0, 1, 2].map(|k| {
-            let x = cs
-                .saturating_mul(u[k])
-                .saturating_add(sn.saturating_mul(v[k]));
-            c[k].saturating_add(round_div(r.saturating_mul(x), d.saturating_mul(1 << 30)))
-        })
+        ring_point(c, [u, v], r, circle(j, m))
     }
 
     /// Exact surfel of voxel `v`: nearest point on the lateral surface (and
@@ -129,10 +124,10 @@ impl Geo {
     pub(crate) fn surfel(&self, v: [u32; 3]) -> Surfel {
         let c = v.map(centre);
         let [u, _, w] = self.frame;
-        let p = [0, 1, 2].map(|k| c[k].saturating_sub(self.b[k]));
+        let p = sub(c, self.b);
         let t = dot(p, w) >> 30;
         let rho = isqrt(dot(p, p).saturating_sub(t.saturating_mul(t)).max(0));
-        let radial = [0, 1, 2].map(|k| p[k].saturating_sub(w[k].saturating_mul(t) >> 30));
+        let radial = sub_along(p, w, t);
         let rhat = unit(radial).map_or(u, |r| r.map(i128::from));
         // Lateral: 2D segment (0, r0) – (len, r1) in (t, rho).
         let (gt, gr) = (self.len, self.r1.saturating_sub(self.r0));
@@ -193,8 +188,7 @@ fn run<S: VoxelSink + ?Sized>(
     let mut em = Emitter::new(sep, extent, sink);
     // Whole-cone cull: the bounding box of both end discs.
     let reach = g.r0.max(g.r1).saturating_add(H);
-    let lo = [0, 1, 2].map(|k| g.b[k].min(g.a[k]));
-    let hi = [0, 1, 2].map(|k| g.b[k].max(g.a[k]));
+    let (lo, hi) = bounds(&[g.b, g.a]);
     if em.culled(lo, hi, reach) {
         return Ok(0);
     }
@@ -227,18 +221,8 @@ fn run<S: VoxelSink + ?Sized>(
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
+    use crate::testkit::Offers;
     use crate::voxelize::fixmath::V;
-    use std::collections::HashMap;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            let e = self.0.entry(v).or_insert(s);
-            if s.distance < e.distance {
-                *e = s;
-            }
-        }
-    }
 
     #[test]
     fn cylinder_shell_is_thin_and_surfels_are_exact() {
@@ -253,9 +237,9 @@ mod tests {
         let e = Extent::cube(21).unwrap();
         let one = i128::from(NORMAL_ONE);
         for sep in [Separation::Six, Separation::TwentySix] {
-            let mut col = Collect(HashMap::new());
+            let mut col = Offers::default();
             surface(&cyl, sep, e, &mut col).unwrap();
-            for (v, s) in &col.0 {
+            for (v, (s, _)) in &col.0 {
                 let z = centre(v[2]);
                 if !(2 * V..=18 * V).contains(&z) {
                     continue;
@@ -280,7 +264,7 @@ mod tests {
     #[test]
     fn bad_input() {
         let e = Extent::cube(4).unwrap();
-        let mut col = Collect(HashMap::new());
+        let mut col = Offers::default();
         let z = Cone {
             base: [0; 3],
             base_radius: 0,

@@ -34,7 +34,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, cell_floor, centre, centres_within, check_point, clip, dist_u32, length, split,
-    unit_fast,
+    sub, unit,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Cuboid;
@@ -261,10 +261,10 @@ pub fn contains(
 fn surfel(lo: [i128; 3], hi: [i128; 3], v: [u32; 3]) -> Surfel {
     let c = v.map(centre);
     let q = [0, 1, 2].map(|k| c[k].clamp(lo[k], hi[k]));
-    let w = [0, 1, 2].map(|k| c[k].saturating_sub(q[k]));
+    let w = sub(c, q);
     if w != [0; 3] {
         return Surfel {
-            normal: unit_fast(w).unwrap_or([0, 0, NORMAL_ONE]),
+            normal: unit(w).unwrap_or([0, 0, NORMAL_ONE]),
             distance: dist_u32(length(w)),
         };
     }
@@ -294,26 +294,14 @@ fn surfel(lo: [i128; 3], hi: [i128; 3], v: [u32; 3]) -> Surfel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use crate::testkit::{Offers, Rng};
     use std::vec::Vec;
-
-    struct Collect(HashMap<[u32; 3], (Surfel, u32)>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            self.0.entry(v).or_insert((s, 0)).1 += 1;
-        }
-    }
 
     #[test]
     fn scan_matches_membership() {
         let e = Extent::new(11, 10, 9).unwrap();
-        let mut seed = 11u64;
-        let mut next = |m: i64| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            i64::try_from(seed >> 33).unwrap() % m
-        };
+        let mut rng = Rng(11u64);
+        let mut next = |m: i64| rng.range(0, m - 1);
         for case in 0..120 {
             let mut lo = [0i64; 3];
             let mut hi = [0i64; 3];
@@ -330,7 +318,7 @@ mod tests {
             }
             let b = Cuboid { min: lo, max: hi };
             for sep in [Separation::Six, Separation::TwentySix] {
-                let mut c = Collect(HashMap::new());
+                let mut c = Offers::default();
                 surface(&b, sep, e, &mut c).unwrap();
                 assert!(c.0.values().all(|v| v.1 == 1));
                 let [nx, ny, nz] = e.dims();
@@ -351,7 +339,7 @@ mod tests {
                     );
                 }
                 assert_eq!(c.0.len(), want.len(), "case {case} {sep:?}");
-                let mut s = Collect(HashMap::new());
+                let mut s = Offers::default();
                 solid(&b, sep, e, &mut s).unwrap();
                 for (v, (sf, _)) in &s.0 {
                     if !c.0.contains_key(v) {
@@ -389,7 +377,7 @@ mod tests {
         );
         assert!(s.normal[0] < 0 && s.normal[1] < 0 && s.normal[2] == 0);
         let e = Extent::cube(4).unwrap();
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         let flat = Cuboid {
             min: [0; 3],
             max: [v, 0, v],

@@ -1,5 +1,6 @@
-//! Integer helpers shared by the voxelizers: exact floor/ceil divisions,
-//! square roots, cell ranges, clipping and unit vectors.
+//! Integer helpers shared by the voxelizers: exact floor/ceil/rounded
+//! divisions, square roots, cell ranges, clipping, `i128` vector arithmetic
+//! and unit vectors.
 //!
 //! Every function here is total: out-of-range input gives `None` or a
 //! saturated value, never a panic.
@@ -153,13 +154,6 @@ pub(crate) fn unit(v: [i128; 3]) -> Option<[i32; 3]> {
     normalize64(w.map(|c| i64::try_from(c).unwrap_or(0)))
 }
 
-/// [`unit`] (kept as a name for the call sites that know their vectors are
-/// small; both take the same 64-bit path).
-#[inline]
-pub(crate) fn unit_fast(v: [i128; 3]) -> Option<[i32; 3]> {
-    unit(v)
-}
-
 /// Unit vector of `w` with every `|w_k| < 2^31`.
 #[inline]
 fn normalize64(w: [i64; 3]) -> Option<[i32; 3]> {
@@ -182,7 +176,7 @@ fn normalize64(w: [i64; 3]) -> Option<[i32; 3]> {
 
 /// Length `floor(sqrt(v·v))` and unit direction of `v`. Vectors with a
 /// component in `[2^20, 2^31)` (the common case: more than 1/64 voxel) take
-/// one 64-bit square root for both; others go through [`unit_fast`].
+/// one 64-bit square root for both; others go through [`unit()`].
 #[inline]
 pub(crate) fn radial(v: [i128; 3]) -> (i128, Option<[i32; 3]>) {
     let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
@@ -200,17 +194,96 @@ pub(crate) fn radial(v: [i128; 3]) -> (i128, Option<[i32; 3]>) {
         }
         (i128::from(len), Some(out))
     } else {
-        (length(v), unit_fast(v))
+        (length(v), unit(v))
     }
 }
 
 /// Euclidean length `floor(sqrt(v·v))` (saturating for huge `v`).
 #[inline]
 pub(crate) fn length(v: [i128; 3]) -> i128 {
-    isqrt(
-        v.iter()
-            .fold(0i128, |a, c| a.saturating_add(c.saturating_mul(*c))),
-    )
+    isqrt(dot(v, v))
+}
+
+/// `a − b` per axis, saturating.
+#[inline]
+pub(crate) fn sub(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
+    [
+        a[0].saturating_sub(b[0]),
+        a[1].saturating_sub(b[1]),
+        a[2].saturating_sub(b[2]),
+    ]
+}
+
+/// `a + b` per axis, saturating.
+#[inline]
+pub(crate) fn add(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
+    [
+        a[0].saturating_add(b[0]),
+        a[1].saturating_add(b[1]),
+        a[2].saturating_add(b[2]),
+    ]
+}
+
+/// `a·b`, saturating (summed in axis order).
+#[inline]
+pub(crate) fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
+    a.iter()
+        .zip(b)
+        .fold(0i128, |s, (x, y)| s.saturating_add(x.saturating_mul(y)))
+}
+
+/// `a × b`, saturating.
+#[inline]
+pub(crate) fn cross(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
+    let m = |x: i128, y: i128| x.saturating_mul(y);
+    [
+        m(a[1], b[2]).saturating_sub(m(a[2], b[1])),
+        m(a[2], b[0]).saturating_sub(m(a[0], b[2])),
+        m(a[0], b[1]).saturating_sub(m(a[1], b[0])),
+    ]
+}
+
+/// `a × b`, or `None` if a product or difference overflows.
+#[inline]
+pub(crate) fn checked_cross(a: [i128; 3], b: [i128; 3]) -> Option<[i128; 3]> {
+    let c = |i: i128, j: i128, k: i128, l: i128| i.checked_mul(j)?.checked_sub(k.checked_mul(l)?);
+    Some([
+        c(a[1], b[2], a[2], b[1])?,
+        c(a[2], b[0], a[0], b[2])?,
+        c(a[0], b[1], a[1], b[0])?,
+    ])
+}
+
+/// `p − s·u`, where `u` is a [`NORMAL_ONE`]-scaled unit vector and `s` a
+/// length (each component's product floored by the scale), saturating.
+#[inline]
+pub(crate) fn sub_along(p: [i128; 3], u: [i128; 3], s: i128) -> [i128; 3] {
+    [0, 1, 2].map(|k| p[k].saturating_sub(u[k].saturating_mul(s) >> NORMAL_SHIFT))
+}
+
+/// Bits of [`NORMAL_ONE`].
+const NORMAL_SHIFT: u32 = NORMAL_ONE.trailing_zeros();
+
+/// The per-axis minimum and maximum of `points` (`[0; 3]` twice for none).
+#[inline]
+pub(crate) fn bounds<'a, I>(points: I) -> ([i128; 3], [i128; 3])
+where
+    I: IntoIterator<Item = &'a [i128; 3]>,
+    I::IntoIter: Clone,
+{
+    let it = points.into_iter();
+    let lo = [0, 1, 2].map(|k| it.clone().map(|p| p[k]).min().unwrap_or(0));
+    let hi = [0, 1, 2].map(|k| it.clone().map(|p| p[k]).max().unwrap_or(0));
+    (lo, hi)
+}
+
+/// `round(n / d)` (halves up) for `d > 0`; 0 otherwise.
+#[inline]
+pub(crate) fn round_div(n: i128, d: i128) -> i128 {
+    if d <= 0 {
+        return 0;
+    }
+    n.saturating_add(d >> 1).checked_div_euclid(d).unwrap_or(0)
 }
 
 /// Counts offers; saturating, so it never overflows.
@@ -271,7 +344,6 @@ mod tests {
         let u = unit([1 << 100, 1 << 100, 0]).unwrap();
         let len2: i128 = u.iter().map(|c| i128::from(*c) * i128::from(*c)).sum();
         assert!((len2 - one * one).abs() < one * 4);
-        assert_eq!(unit_fast([3, 4, 0]), unit([3, 4, 0]));
         // Tiny vectors are scaled up first: (1, 1, 1) is not (1, 1, 1)·2^30.
         // Fuzz regression: a zero-length segment at the origin gave the
         // centre offset (h, h, h), whose floored root (56755) left the
@@ -283,11 +355,7 @@ mod tests {
             [1 << 25, 1 << 25, 5],
             [32768, 32768, 32768],
         ] {
-            for u in [
-                unit(v).unwrap(),
-                unit_fast(v).unwrap(),
-                radial(v).1.unwrap(),
-            ] {
+            for u in [unit(v).unwrap(), radial(v).1.unwrap()] {
                 let l2: i128 = u.iter().map(|c| i128::from(*c).pow(2)).sum();
                 assert!(
                     (l2 - one * one).abs() < one * one / (1 << 18),

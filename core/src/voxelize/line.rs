@@ -39,7 +39,7 @@
 //! voxels offered (plus a logarithmic term for the 26-connected clip).
 
 use super::error::VoxelizeError;
-use super::fixmath::{Counter, H, V, centre, check_point, dist_u32, length, unit};
+use super::fixmath::{Counter, H, V, centre, check_point, cross, dist_u32, dot, length, sub, unit};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Segment;
 use crate::raster::Extent;
@@ -58,11 +58,7 @@ pub fn segment<S: VoxelSink + ?Sized>(
 ) -> Result<u64, VoxelizeError> {
     let a = check_point(segment.a)?;
     let b = check_point(segment.b)?;
-    let l = Line {
-        a,
-        b,
-        d: [0, 1, 2].map(|k| b[k].saturating_sub(a[k])),
-    };
+    let l = Line { a, b, d: sub(b, a) };
     let dims = extent.dims();
     let size = dims.map(super::fixmath::low);
     let mut n = Counter::default();
@@ -266,15 +262,9 @@ impl Line {
 
     fn surfel(&self, v: [u32; 3]) -> Surfel {
         let c = v.map(centre);
-        let w = [0, 1, 2].map(|k| c[k].saturating_sub(self.a[k]));
-        let dd = self
-            .d
-            .iter()
-            .fold(0i128, |s, x| s.saturating_add(x.saturating_mul(*x)))
-            .max(1);
-        let wd = [0, 1, 2].iter().fold(0i128, |s, &k| {
-            s.saturating_add(w[k].saturating_mul(self.d[k]))
-        });
+        let w = sub(c, self.a);
+        let dd = dot(self.d, self.d).max(1);
+        let wd = dot(w, self.d);
         let num = wd.clamp(0, dd);
         // Nearest point a + d·num/dd (d·num < 2^84).
         let r = [0, 1, 2].map(|k| {
@@ -292,15 +282,7 @@ impl Line {
                 } else {
                     [0, 0, 1]
                 };
-                let d = self.d;
-                unit([
-                    d[1].saturating_mul(e[2])
-                        .saturating_sub(d[2].saturating_mul(e[1])),
-                    d[2].saturating_mul(e[0])
-                        .saturating_sub(d[0].saturating_mul(e[2])),
-                    d[0].saturating_mul(e[1])
-                        .saturating_sub(d[1].saturating_mul(e[0])),
-                ])
+                unit(cross(self.d, e))
             })
             .unwrap_or([0, 0, NORMAL_ONE]);
         Surfel {
@@ -323,6 +305,7 @@ mod tests {
     use super::*;
     use crate::discrete_ray::{Connectivity, DiscreteRay};
     use crate::raster::Raster;
+    use crate::testkit::Rng;
     use std::vec::Vec;
 
     struct Collect(Vec<[u32; 3]>);
@@ -337,13 +320,8 @@ mod tests {
         let e = Extent::new(20, 17, 15).unwrap();
         let plane = std::vec![0u8; e.len()];
         let r = Raster::new(e, &plane).unwrap();
-        let mut seed = 5u64;
-        let mut next = |m: i64| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            i64::try_from(seed >> 33).unwrap() % m
-        };
+        let mut rng = Rng(5u64);
+        let mut next = |m: i64| rng.range(0, m - 1);
         for case in 0..400 {
             let snap = |x: i64| match case % 4 {
                 0 => x & !0xffff,

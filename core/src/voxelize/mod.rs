@@ -31,9 +31,10 @@
 //! (up to about 0.17 voxel for Six and 0.35 for TwentySix at radius ½ voxel,
 //! shrinking as 1/R²), which the probe rule does not. Ties (a face exactly
 //! on voxel faces or centres) are decided as if the object were shifted by
-//! an infinitesimal amount, so such faces get one layer, not two. Measured
-//! thickness stays within 0.94–1.04× of the minimum the separation needs
-//! (`tests/voxelize_thickness.rs`). Attributes (normal, colour) are sampled
+//! an infinitesimal amount, so such faces get one layer, not two.
+//! `tests/voxelize_thickness.rs` checks every voxelizer's thickness (voxels
+//! per unit area) against the minimum the separation needs: between 0.9×
+//! and 1.5× of it for every case of at least moderate size. Attributes (normal, colour) are sampled
 //! at the voxel centre, as the paper does.
 //!
 //! # Cost

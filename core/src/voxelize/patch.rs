@@ -47,8 +47,8 @@
 //! quads far from the raster are culled cheaply) plus the voxels offered.
 
 use super::error::VoxelizeError;
-use super::fixmath::{V, check_point, isqrt, unit};
-use super::tessellate::{Emitter, cross, round_div};
+use super::fixmath::{V, add, bounds, check_point, cross, isqrt, round_div, sub, unit};
+use super::tessellate::Emitter;
 use super::triangle::Tri;
 use super::{Separation, VoxelSink};
 use crate::geometry::{BezierPatch, UnitVector};
@@ -83,8 +83,7 @@ pub fn surface<S: VoxelSink + ?Sized>(
     }
     let n = steps(&p);
     let mut em = Emitter::new(separation, extent, sink);
-    let lo = [0, 1, 2].map(|k| p.iter().flatten().map(|q| q[k]).min().unwrap_or(0));
-    let hi = [0, 1, 2].map(|k| p.iter().flatten().map(|q| q[k]).max().unwrap_or(0));
+    let (lo, hi) = bounds(p.iter().flatten());
     if em.culled(lo, hi, V) {
         return Ok(0);
     }
@@ -112,8 +111,7 @@ pub fn surface<S: VoxelSink + ?Sized>(
             r1.step();
             let (b0, b1) = (vert(r0.value), vert(r1.value));
             let quad = [a0, b0, b1, a1];
-            let qlo = [0, 1, 2].map(|k| quad.iter().map(|q| q[k]).min().unwrap_or(0));
-            let qhi = [0, 1, 2].map(|k| quad.iter().map(|q| q[k]).max().unwrap_or(0));
+            let (qlo, qhi) = bounds(&quad);
             if !em.culled(qlo, qhi, TOLERANCE) {
                 let nrm = [
                     (i, j),
@@ -152,19 +150,9 @@ fn steps(p: &[[[i128; 3]; 4]; 4]) -> u32 {
             .fold(0i128, |s, x| s.saturating_add(x.saturating_abs()))
     };
     // a − 2b + c, and a − b − c + d.
-    let second = |a: [i128; 3], b: [i128; 3], c: [i128; 3]| {
-        [0, 1, 2].map(|k| {
-            a[k].saturating_sub(b[k].saturating_mul(2))
-                .saturating_add(c[k])
-        })
-    };
-    let twist = |a: [i128; 3], b: [i128; 3], c: [i128; 3], d: [i128; 3]| {
-        [0, 1, 2].map(|k| {
-            a[k].saturating_sub(b[k])
-                .saturating_sub(c[k])
-                .saturating_add(d[k])
-        })
-    };
+    let second =
+        |a: [i128; 3], b: [i128; 3], c: [i128; 3]| add(sub(a, b.map(|x| x.saturating_mul(2))), c);
+    let twist = |a: [i128; 3], b: [i128; 3], c: [i128; 3], d: [i128; 3]| add(sub(sub(a, b), c), d);
     let (mut duu, mut dvv, mut duv) = (0i128, 0i128, 0i128);
     for a in 0..4usize {
         for b in 0..4usize {
@@ -251,7 +239,6 @@ impl Fd {
                     .saturating_add(b[k].saturating_mul(wb))
             })
         };
-        let add = |a: [i128; 3], b: [i128; 3]| [0, 1, 2].map(|k| a[k].saturating_add(b[k]));
         Self {
             value: p0,
             d1: lin(p1, p0, 1, -1),
@@ -311,16 +298,8 @@ fn normal(p: &[[[i128; 3]; 4]; 4], i: u32, j: u32, n: u32) -> Option<UnitVector>
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
-    use crate::voxelize::Surfel;
+    use crate::testkit::Offers;
     use crate::voxelize::fixmath::centre;
-    use std::collections::HashMap;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            self.0.insert(v, s);
-        }
-    }
 
     /// `N⁶ · patch(a/N, b/N)`, exactly.
     fn eval(p: &[[[i128; 3]; 4]; 4], a: u32, b: u32, n: u32) -> [i128; 3] {
@@ -362,7 +341,7 @@ mod tests {
             }
         }
         let bp = BezierPatch { control };
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         surface(
             &bp,
             Separation::TwentySix,

@@ -63,7 +63,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, V, ceil_sqrt, cell_floor, cells_overlapping, centre, centres_within, check_point,
-    clip, dist_u32, isqrt, radial, split,
+    clip, dist_u32, isqrt, radial, split, sub,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Sphere;
@@ -133,7 +133,7 @@ pub fn contains(
 ) -> Result<bool, VoxelizeError> {
     let c = check_point(sphere.centre)?;
     let r = radius(sphere.radius)?;
-    let w = [0, 1, 2].map(|k| centre(v[k]).saturating_sub(c[k]));
+    let w = sub(v.map(centre), c);
     let r2 = r.saturating_mul(r);
     Ok(match separation {
         Separation::TwentySix => {
@@ -284,10 +284,15 @@ impl Ball {
         }
     }
 
-    /// Six shell, the voxels found along centre lines parallel to `k`.
-    fn six_axis<S: VoxelSink + ?Sized>(&self, k: usize, sink: &mut S, n: &mut Counter) {
-        let (ca, cb, ck) = pick(k, self.c);
-        let (na, nb, nk) = pick(k, self.dims);
+    /// Calls `f(ai, bi, da, db, d)` for every column of voxels along axis
+    /// `k` whose centre line meets the closed ball: `ai`, `bi` are its
+    /// coordinates on the other two axes (as [`pick`] orders them), `da`,
+    /// `db` its centre's offsets from the sphere's centre there, and
+    /// `d = R² − da² − db² ≥ 0`.
+    #[inline(always)]
+    fn centre_columns(&self, k: usize, mut f: impl FnMut(u32, u32, i128, i128, i128)) {
+        let (ca, cb, _) = pick(k, self.c);
+        let (na, nb, _) = pick(k, self.dims);
         let (bl, bh) = centres_within(cb.saturating_sub(self.r), cb.saturating_add(self.r));
         let Some((b0, b1)) = clip(bl, bh, nb) else {
             return;
@@ -306,45 +311,53 @@ impl Ball {
             for ai in a0..=a1 {
                 let da = centre(ai).wrapping_sub(ca);
                 let d = eb.saturating_sub(da.saturating_mul(da));
-                if d < 0 {
-                    continue;
-                }
-                let s = isqrt(d);
-                let exact = s.saturating_mul(s) == d;
-                // Up to four cells: each crossing's cell, and the cell below
-                // when the crossing lies exactly on a face.
-                let hi = ck.saturating_add(s);
-                let lo = if exact {
-                    ck.saturating_sub(s)
-                } else {
-                    ck.saturating_sub(s).saturating_sub(1)
-                };
-                let on_face = |p: i128| exact && p.rem_euclid(V) == 0;
-                let cells = [
-                    Some(cell_floor(hi)),
-                    on_face(hi).then(|| cell_floor(hi).saturating_sub(1)),
-                    Some(cell_floor(lo)),
-                    on_face(lo).then(|| cell_floor(lo).saturating_sub(1)),
-                ];
-                for (i, cell) in cells.iter().enumerate() {
-                    let Some(cell) = *cell else {
-                        continue;
-                    };
-                    if cells.iter().take(i).any(|c| *c == Some(cell)) {
-                        continue;
-                    }
-                    let Some((kc, _)) = clip(cell, cell, nk) else {
-                        continue;
-                    };
-                    let v = place(k, ai, bi, kc);
-                    let w = [0, 1, 2].map(|j| centre(v[j]).wrapping_sub(self.c[j]));
-                    if (0..k).any(|j| segment_meets(w, j, self.r2)) {
-                        continue;
-                    }
-                    self.offer(v, sink, n);
+                if d >= 0 {
+                    f(ai, bi, da, db, d);
                 }
             }
         }
+    }
+
+    /// Six shell, the voxels found along centre lines parallel to `k`.
+    fn six_axis<S: VoxelSink + ?Sized>(&self, k: usize, sink: &mut S, n: &mut Counter) {
+        let (_, _, ck) = pick(k, self.c);
+        let (_, _, nk) = pick(k, self.dims);
+        self.centre_columns(k, |ai, bi, _, _, d| {
+            let s = isqrt(d);
+            let exact = s.saturating_mul(s) == d;
+            // Up to four cells: each crossing's cell, and the cell below
+            // when the crossing lies exactly on a face.
+            let hi = ck.saturating_add(s);
+            let lo = if exact {
+                ck.saturating_sub(s)
+            } else {
+                ck.saturating_sub(s).saturating_sub(1)
+            };
+            let on_face = |p: i128| exact && p.rem_euclid(V) == 0;
+            let cells = [
+                Some(cell_floor(hi)),
+                on_face(hi).then(|| cell_floor(hi).saturating_sub(1)),
+                Some(cell_floor(lo)),
+                on_face(lo).then(|| cell_floor(lo).saturating_sub(1)),
+            ];
+            for (i, cell) in cells.iter().enumerate() {
+                let Some(cell) = *cell else {
+                    continue;
+                };
+                if cells.iter().take(i).any(|c| *c == Some(cell)) {
+                    continue;
+                }
+                let Some((kc, _)) = clip(cell, cell, nk) else {
+                    continue;
+                };
+                let v = place(k, ai, bi, kc);
+                let w = [0, 1, 2].map(|j| centre(v[j]).wrapping_sub(self.c[j]));
+                if (0..k).any(|j| segment_meets(w, j, self.r2)) {
+                    continue;
+                }
+                self.offer(v, sink, n);
+            }
+        });
     }
 
     /// Six solid: voxels with centre inside and no centre segment reaching
@@ -352,53 +365,32 @@ impl Ball {
     /// Columns run along x.
     fn six_interior<S: VoxelSink + ?Sized>(&self, sink: &mut S, n: &mut Counter) {
         const K: usize = 0;
-        let (ca, cb, ck) = pick(K, self.c);
-        let (na, nb, nk) = pick(K, self.dims);
-        let (bl, bh) = centres_within(cb.saturating_sub(self.r), cb.saturating_add(self.r));
-        let Some((b0, b1)) = clip(bl, bh, nb) else {
-            return;
-        };
-        for bi in b0..=b1 {
-            let db = centre(bi).wrapping_sub(cb);
-            let eb = self.r2.saturating_sub(db.saturating_mul(db));
-            if eb < 0 {
-                continue;
-            }
-            let sa = isqrt(eb);
-            let (al, ah) = centres_within(ca.saturating_sub(sa), ca.saturating_add(sa));
-            let Some((a0, a1)) = clip(al, ah, na) else {
-                continue;
+        let (_, _, ck) = pick(K, self.c);
+        let (_, _, nk) = pick(K, self.dims);
+        self.centre_columns(K, |ai, bi, da, db, ek| {
+            let sk = isqrt(ek);
+            let (kl, kh) = centres_within(ck.saturating_sub(sk), ck.saturating_add(sk));
+            let Some((k0, k1)) = clip(kl, kh, nk) else {
+                return;
             };
-            for ai in a0..=a1 {
-                let da = centre(ai).wrapping_sub(ca);
-                let ek = eb.saturating_sub(da.saturating_mul(da));
-                if ek < 0 {
-                    continue;
-                }
-                let sk = isqrt(ek);
-                let (kl, kh) = centres_within(ck.saturating_sub(sk), ck.saturating_add(sk));
-                let Some((k0, k1)) = clip(kl, kh, nk) else {
-                    continue;
-                };
-                for ki in k0..=k1 {
-                    let dk = centre(ki).wrapping_sub(ck);
-                    let m = da.abs().max(db.abs()).max(dk.abs());
-                    let w2 = da
-                        .saturating_mul(da)
-                        .saturating_add(db.saturating_mul(db))
-                        .saturating_add(dk.saturating_mul(dk));
-                    let reach = w2
-                        .saturating_add(m.saturating_mul(V))
-                        .saturating_add(H.saturating_mul(H));
-                    if reach < self.r2 {
-                        let v = place(K, ai, bi, ki);
-                        let s = self.surfel(v);
-                        sink.offer(v, Surfel { distance: 0, ..s });
-                        n.bump();
-                    }
+            for ki in k0..=k1 {
+                let dk = centre(ki).wrapping_sub(ck);
+                let m = da.abs().max(db.abs()).max(dk.abs());
+                let w2 = da
+                    .saturating_mul(da)
+                    .saturating_add(db.saturating_mul(db))
+                    .saturating_add(dk.saturating_mul(dk));
+                let reach = w2
+                    .saturating_add(m.saturating_mul(V))
+                    .saturating_add(H.saturating_mul(H));
+                if reach < self.r2 {
+                    let v = place(K, ai, bi, ki);
+                    let s = self.surfel(v);
+                    sink.offer(v, Surfel { distance: 0, ..s });
+                    n.bump();
                 }
             }
-        }
+        });
     }
 }
 
@@ -445,15 +437,8 @@ fn near_far(c: i128, i: u32) -> (i128, i128) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use crate::testkit::{Offers, Rng};
     use std::vec::Vec;
-
-    struct Collect(HashMap<[u32; 3], (Surfel, u32)>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            self.0.entry(v).or_insert((s, 0)).1 += 1;
-        }
-    }
 
     fn brute(s: &Sphere, sep: Separation, e: Extent) -> Vec<[u32; 3]> {
         let [nx, ny, nz] = e.dims();
@@ -473,13 +458,8 @@ mod tests {
     #[test]
     fn scan_matches_membership_and_offers_once() {
         let e = Extent::new(14, 13, 12).unwrap();
-        let mut seed = 7u64;
-        let mut next = |m: i64| {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            i64::try_from(seed >> 33).unwrap() % m
-        };
+        let mut rng = Rng(7u64);
+        let mut next = |m: i64| rng.range(0, m - 1);
         for case in 0..60 {
             // Centres on lattice points, centres, faces and random points;
             // some partly outside the raster.
@@ -504,7 +484,7 @@ mod tests {
             };
             for sep in [Separation::Six, Separation::TwentySix] {
                 for solid_too in [false, true] {
-                    let mut c = Collect(HashMap::new());
+                    let mut c = Offers::default();
                     let offers = if solid_too {
                         solid(&s, sep, e, &mut c).unwrap()
                     } else {
@@ -560,7 +540,7 @@ mod tests {
     #[test]
     fn bad_input() {
         let e = Extent::cube(4).unwrap();
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         let z = Sphere {
             centre: [0; 3],
             radius: 0,

@@ -10,7 +10,7 @@
 //! [`super::triangle`] makes its voxelization tunnel-free.
 
 use super::error::VoxelizeError;
-use super::fixmath::{Counter, V, isqrt, unit};
+use super::fixmath::{Counter, V, bounds, cross, isqrt, round_div, unit};
 use super::triangle::Tri;
 use super::{Separation, Surfel, VoxelSink};
 use crate::geometry::UnitVector;
@@ -77,29 +77,18 @@ pub(crate) fn frame(axis: [i128; 3]) -> Option<[[i128; 3]; 3]> {
     Some([u, v, w])
 }
 
-/// `a × b`, saturating (operands below 2^62 here).
-pub(crate) fn cross(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
-    let m = |x: i128, y: i128| x.saturating_mul(y);
-    [
-        m(a[1], b[2]).saturating_sub(m(a[2], b[1])),
-        m(a[2], b[0]).saturating_sub(m(a[0], b[2])),
-        m(a[0], b[1]).saturating_sub(m(a[1], b[0])),
-    ]
-}
-
-/// `a·b`, saturating.
-pub(crate) fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
-    a.iter()
-        .zip(b)
-        .fold(0i128, |s, (x, y)| s.saturating_add(x.saturating_mul(y)))
-}
-
-/// `round(n / d)` for `d > 0`.
-pub(crate) fn round_div(n: i128, d: i128) -> i128 {
-    if d <= 0 {
-        return 0;
-    }
-    n.saturating_add(d >> 1).checked_div_euclid(d).unwrap_or(0)
+/// The point at angle `p = circle(j, m)` on the circle of radius `r`
+/// around `c` in the plane of the frame vectors `u`, `v` (`2^30`-scaled):
+/// `c + r·(cos·u + sin·v)`, each component rounded.
+pub(crate) fn ring_point(c: [i128; 3], [u, v]: [[i128; 3]; 2], r: i128, p: [i128; 3]) -> [i128; 3] {
+    let [cs, sn, d] = p;
+    // r < 2^41, cs, sn < 2^21, u, v ≤ 2^30: products < 2^92.
+    [0, 1, 2].map(|k| {
+        let x = cs
+            .saturating_mul(u[k])
+            .saturating_add(sn.saturating_mul(v[k]));
+        c[k].saturating_add(round_div(r.saturating_mul(x), d.saturating_mul(1 << 30)))
+    })
 }
 
 /// Voxelizes triangles of a tessellation into a sink.
@@ -147,8 +136,7 @@ impl<'a, S: VoxelSink + ?Sized> Emitter<'a, S> {
     where
         F: Fn(&Tri, [u32; 3]) -> Surfel,
     {
-        let lo = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).min().unwrap_or(0));
-        let hi = [0, 1, 2].map(|k| p.iter().map(|v| v[k]).max().unwrap_or(0));
+        let (lo, hi) = bounds(&p);
         if self.culled(lo, hi, 0) {
             return Ok(());
         }
@@ -182,6 +170,7 @@ impl<'a, S: VoxelSink + ?Sized> Emitter<'a, S> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::voxelize::fixmath::dot;
 
     #[test]
     fn circle_points_are_on_the_circle_and_close() {

@@ -34,8 +34,11 @@
 //! raster plus the voxels offered.
 
 use super::error::VoxelizeError;
-use super::fixmath::{V, centre, check_coord, check_point, dist_u32, isqrt, unit};
-use super::tessellate::{Emitter, circle, dot, frame, quarter_segments, round_div};
+use super::fixmath::{
+    V, bounds, centre, check_coord, check_point, dist_u32, dot, isqrt, round_div, sub, sub_along,
+    unit,
+};
+use super::tessellate::{Emitter, circle, frame, quarter_segments, ring_point};
 use super::triangle::Tri;
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Torus;
@@ -79,22 +82,16 @@ pub fn surface<S: VoxelSink + ?Sized>(
     };
     let dir = |i: u32| circle(i, m1);
     let point = |i: u32, j: u32| -> [i128; 3] {
-        let [cs, sn, d] = dir(i);
         let (rho, z) = minor(j);
-        [0, 1, 2].map(|k| {
-            let x = cs
-                .saturating_mul(u[k])
-                .saturating_add(sn.saturating_mul(v[k]));
-            c[k].saturating_add(round_div(rho.saturating_mul(x), d.saturating_mul(1 << 30)))
-                .saturating_add(round_div(z.saturating_mul(w[k]), 1 << 30))
-        })
+        let p = ring_point(c, [u, v], rho, dir(i));
+        [0, 1, 2].map(|k| p[k].saturating_add(round_div(z.saturating_mul(w[k]), 1 << 30)))
     };
     let surfel = |_: &Tri, vx: [u32; 3]| -> Surfel {
-        let p = [0, 1, 2].map(|k| centre(vx[k]).saturating_sub(c[k]));
+        let p = sub(vx.map(centre), c);
         let h = dot(p, w) >> 30;
-        let radial = [0, 1, 2].map(|k| p[k].saturating_sub(w[k].saturating_mul(h) >> 30));
+        let radial = sub_along(p, w, h);
         let rhat = unit(radial).map_or(u, |x| x.map(i128::from));
-        let d = [0, 1, 2].map(|k| p[k].saturating_sub(big.saturating_mul(rhat[k]) >> 30));
+        let d = sub_along(p, rhat, big);
         let len = isqrt(dot(d, d));
         Surfel {
             normal: unit(d).unwrap_or_else(|| rhat.map(|x| i32::try_from(x).unwrap_or(NORMAL_ONE))),
@@ -122,16 +119,8 @@ pub fn surface<S: VoxelSink + ?Sized>(
         .saturating_add(V);
     for i in 0..n1 {
         let i1 = next(i, n1);
-        let ends = [dir(i), dir(i1)].map(|[cs, sn, d]| {
-            [0, 1, 2].map(|k| {
-                let x = cs
-                    .saturating_mul(u[k])
-                    .saturating_add(sn.saturating_mul(v[k]));
-                c[k].saturating_add(round_div(big.saturating_mul(x), d.saturating_mul(1 << 30)))
-            })
-        });
-        let lo = [0, 1, 2].map(|k| ends[0][k].min(ends[1][k]));
-        let hi = [0, 1, 2].map(|k| ends[0][k].max(ends[1][k]));
+        let ends = [dir(i), dir(i1)].map(|p| ring_point(c, [u, v], big, p));
+        let (lo, hi) = bounds(&ends);
         if em.culled(lo, hi, reach) {
             continue;
         }
@@ -151,14 +140,7 @@ pub fn surface<S: VoxelSink + ?Sized>(
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
-    use std::collections::HashMap;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            self.0.insert(v, s);
-        }
-    }
+    use crate::testkit::Offers;
 
     #[test]
     fn surfels_match_the_true_torus() {
@@ -169,7 +151,7 @@ mod tests {
             major: 7 * VOXEL,
             minor: 3 * VOXEL + 99,
         };
-        let mut col = Collect(HashMap::new());
+        let mut col = Offers::default();
         surface(
             &t,
             Separation::TwentySix,
@@ -177,7 +159,7 @@ mod tests {
             &mut col,
         )
         .unwrap();
-        for (v, s) in &col.0 {
+        for (v, (s, _)) in &col.0 {
             let p = [0, 1, 2].map(|k| centre(v[k]) - i128::from(c));
             let rho = isqrt(p[0] * p[0] + p[1] * p[1]);
             let d = isqrt((rho - 7 * V).pow(2) + p[2] * p[2]) - (3 * V + 99);
@@ -194,7 +176,7 @@ mod tests {
     #[test]
     fn bad_input() {
         let e = Extent::cube(4).unwrap();
-        let mut col = Collect(HashMap::new());
+        let mut col = Offers::default();
         let base = Torus {
             centre: [0; 3],
             axis: [0, 0, NORMAL_ONE],

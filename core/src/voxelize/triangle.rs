@@ -70,7 +70,8 @@
 
 use super::error::VoxelizeError;
 use super::fixmath::{
-    Counter, H, IncDiv, V, ceil_div, centre, check_point, clip, dist_u32, floor_div, isqrt, unit,
+    Counter, H, IncDiv, V, ceil_div, centre, check_point, checked_cross, clip, dist_u32, dot,
+    floor_div, isqrt, sub, unit,
 };
 use super::sphere::{pick, place};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
@@ -160,7 +161,7 @@ pub fn polygon<S: VoxelSink + ?Sized>(
                 .get(i.wrapping_add(1).checked_rem(m).unwrap_or(0))
                 .unwrap_or(v),
         )?;
-        let c = cross(a, b).ok_or(VoxelizeError::Arithmetic)?;
+        let c = checked_cross(a, b).ok_or(VoxelizeError::Arithmetic)?;
         for (s, x) in newell.iter_mut().zip(c) {
             *s = s.checked_add(x).ok_or(VoxelizeError::Arithmetic)?;
         }
@@ -312,31 +313,6 @@ pub fn mesh<S: VoxelSink + ?Sized>(
 /// The next vertex of a triangle, cyclically.
 const NEXT: [usize; 3] = [1, 2, 0];
 
-/// `a·b` saturating (operands stay far below the limit for accepted input).
-#[inline]
-fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
-    a[0].saturating_mul(b[0])
-        .saturating_add(a[1].saturating_mul(b[1]))
-        .saturating_add(a[2].saturating_mul(b[2]))
-}
-
-fn cross(a: [i128; 3], b: [i128; 3]) -> Option<[i128; 3]> {
-    let c = |i: i128, j: i128, k: i128, l: i128| i.checked_mul(j)?.checked_sub(k.checked_mul(l)?);
-    Some([
-        c(a[1], b[2], a[2], b[1])?,
-        c(a[2], b[0], a[0], b[2])?,
-        c(a[0], b[1], a[1], b[0])?,
-    ])
-}
-
-fn sub(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
-    [
-        a[0].saturating_sub(b[0]),
-        a[1].saturating_sub(b[1]),
-        a[2].saturating_sub(b[2]),
-    ]
-}
-
 /// The axis of the largest `|n_k|` (lowest on ties).
 fn dominant(n: [i128; 3]) -> usize {
     let a = n.map(i128::unsigned_abs);
@@ -396,7 +372,7 @@ impl Tri {
         normals: Option<[UnitVector; 3]>,
     ) -> Result<Self, VoxelizeError> {
         let e = [sub(v[1], v[0]), sub(v[2], v[1]), sub(v[0], v[2])];
-        let n = cross(e[0], sub(v[2], v[0])).ok_or(VoxelizeError::Arithmetic)?;
+        let n = checked_cross(e[0], sub(v[2], v[0])).ok_or(VoxelizeError::Arithmetic)?;
         if n == [0; 3] {
             return Err(VoxelizeError::Degenerate);
         }
@@ -463,10 +439,10 @@ impl Tri {
         };
         for e in &self.e {
             for d in dirs {
-                add(cross(*e, *d).ok_or(VoxelizeError::Arithmetic)?)?;
+                add(checked_cross(*e, *d).ok_or(VoxelizeError::Arithmetic)?)?;
             }
             // The column's own 2D bound: e × k̂.
-            add(cross(*e, place(k, 0, 0, 1)).ok_or(VoxelizeError::Arithmetic)?)?;
+            add(checked_cross(*e, place(k, 0, 0, 1)).ok_or(VoxelizeError::Arithmetic)?)?;
         }
         match sep {
             Separation::TwentySix => {
@@ -635,7 +611,7 @@ impl Tri {
         let a = [0, 1, 2].map(|i| {
             let p = sub(self.v[NEXT[i]], c);
             let q = sub(self.v[NEXT[NEXT[i]]], c);
-            cross(p, q).map_or(0, |x| dot(x, self.n_small))
+            checked_cross(p, q).map_or(0, |x| dot(x, self.n_small))
         });
         if a.iter().all(|x| *x >= 0) {
             // Inside: the plane distance along the unit normal.
@@ -719,32 +695,18 @@ fn centre_range(p: i128, q: i128, lo: i128, hi: i128) -> Option<(i128, i128)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use crate::testkit::{Offers, Rng};
     use std::vec::Vec;
-
-    struct Collect(HashMap<[u32; 3], u32>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], _: Surfel) {
-            *self.0.entry(v).or_insert(0) += 1;
-        }
-    }
-
-    fn rng(seed: &mut u64, m: i64) -> i64 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        i64::try_from(*seed >> 33).unwrap() % m
-    }
 
     #[test]
     fn scan_matches_membership() {
         let e = Extent::new(12, 11, 10).unwrap();
-        let mut seed = 3u64;
+        let mut rng = Rng(3);
         for case in 0..150 {
             let mut vs = [[0i64; 3]; 3];
             for v in &mut vs {
                 for c in v.iter_mut() {
-                    let x = rng(&mut seed, 14 * 65536) - 65536;
+                    let x = rng.range(0, 14 * 65536 - 1) - 65536;
                     *c = match case % 4 {
                         0 => x & !0x7fff,
                         1 => x & !0xffff,
@@ -767,9 +729,9 @@ mod tests {
                 continue;
             }
             for sep in [Separation::Six, Separation::TwentySix] {
-                let mut c = Collect(HashMap::new());
+                let mut c = Offers::default();
                 triangle(&t, sep, e, &mut c).unwrap();
-                assert!(c.0.values().all(|n| *n == 1), "case {case}: offered twice");
+                assert!(c.0.values().all(|o| o.1 == 1), "case {case}: offered twice");
                 let [nx, ny, nz] = e.dims();
                 let mut want = Vec::new();
                 for z in 0..nz {
@@ -847,14 +809,14 @@ mod tests {
             [v, 9 * v, z],
         ];
         let e = Extent::cube(12).unwrap();
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         polygon(&l, Separation::Six, e, &mut c).unwrap();
         // The notch (6..8, 6..8) stays empty; the arms are covered.
         assert!(!c.0.contains_key(&[6, 6, 2]));
         assert!(c.0.contains_key(&[2, 7, 2]) && c.0.contains_key(&[7, 2, 2]));
         let mut rev = l;
         rev.reverse();
-        let mut c2 = Collect(HashMap::new());
+        let mut c2 = Offers::default();
         polygon(&rev, Separation::Six, e, &mut c2).unwrap();
         let mut a: Vec<_> = c.0.keys().collect();
         let mut b: Vec<_> = c2.0.keys().collect();

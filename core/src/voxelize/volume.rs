@@ -45,7 +45,7 @@
 //! constant per sample.
 
 use super::error::{COORD_LIMIT, VoxelizeError};
-use super::fixmath::{Counter, V, dist_u32, isqrt, unit};
+use super::fixmath::{Counter, V, dist_u32, dot, isqrt, unit};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::raster::Extent;
 
@@ -234,9 +234,7 @@ impl<T: Copy + Into<i64>> Grid<'_, T> {
             };
         };
         // |∇f| per voxel = |grad| / (2·1572); distance = (f − thr)/|∇f|.
-        let g2 = grad
-            .iter()
-            .fold(0i128, |s, x| s.saturating_add(x.saturating_mul(*x)));
+        let g2 = dot(grad, grad);
         let glen = isqrt(g2).max(1);
         let excess = i128::from(f.saturating_sub(thr));
         let d = excess
@@ -254,15 +252,8 @@ impl<T: Copy + Into<i64>> Grid<'_, T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use crate::testkit::Offers;
     use std::vec::Vec;
-
-    struct Collect(HashMap<[u32; 3], Surfel>);
-    impl VoxelSink for Collect {
-        fn offer(&mut self, v: [u32; 3], s: Surfel) {
-            assert!(self.0.insert(v, s).is_none());
-        }
-    }
 
     #[test]
     fn ball_boundary_and_normals() {
@@ -292,10 +283,11 @@ mod tests {
         let e = Extent::cube(24).unwrap();
         let one = i128::from(NORMAL_ONE);
         for sep in [Separation::Six, Separation::TwentySix] {
-            let mut c = Collect(HashMap::new());
+            let mut c = Offers::default();
             boundary(&b, 1500u16, sep, e, &mut c).unwrap();
             assert!(c.0.len() > 100);
-            for (v, sf) in &c.0 {
+            assert!(c.0.values().all(|o| o.1 == 1), "a voxel offered twice");
+            for (v, (sf, _)) in &c.0 {
                 let p = [v[0] + 2, v[1] - 3, v[2]];
                 let w = p.map(|c| i128::from(2 * i64::from(c) - 15));
                 let len2: i128 = w.iter().map(|x| x * x).sum();
@@ -316,7 +308,7 @@ mod tests {
             dims: [n; 3],
             offset: [-10, -10, -10],
         };
-        let mut c = Collect(HashMap::new());
+        let mut c = Offers::default();
         boundary(
             &b,
             1500u16,

@@ -1,0 +1,161 @@
+//! Why a store is refused or a scene cannot be built.
+
+use core::fmt;
+
+/// Why a directory and record array do not form a valid store.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum StoreError {
+    /// The raster has more bricks than `usize` can count.
+    TooManyBricks,
+    /// The directory does not have one entry per brick plus one.
+    DirectoryLength {
+        /// Bricks + 1.
+        expected: usize,
+        /// The slice length given.
+        found: usize,
+    },
+    /// The first entry is not 0.
+    DirectoryStart,
+    /// An entry is smaller than the one before it, or a brick holds more
+    /// records than it has voxels.
+    DirectoryOrder {
+        /// The brick whose range is wrong.
+        brick: usize,
+    },
+    /// The last entry is not the number of records.
+    DirectoryEnd {
+        /// The last entry.
+        last: u32,
+        /// The number of records.
+        records: usize,
+    },
+    /// A brick's records are not sorted by position, repeat a position, or
+    /// name a voxel outside the raster.
+    BadKey {
+        /// Index of the offending record.
+        record: usize,
+    },
+}
+
+impl fmt::Display for StoreError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::TooManyBricks => f.write_str("raster has too many bricks to address"),
+            Self::DirectoryLength { expected, found } => write!(
+                f,
+                "brick directory has {found} entries, expected {expected} (bricks + 1)"
+            ),
+            Self::DirectoryStart => f.write_str("brick directory does not start at 0"),
+            Self::DirectoryOrder { brick } => {
+                write!(f, "brick directory entry {brick} is out of order")
+            }
+            Self::DirectoryEnd { last, records } => write!(
+                f,
+                "brick directory ends at {last}, but there are {records} records"
+            ),
+            Self::BadKey { record } => write!(
+                f,
+                "record {record} has a position that is unsorted, repeated or outside the raster"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for StoreError {}
+
+/// Why a scene could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum BuildError {
+    /// The directory slice does not have one entry per brick plus one.
+    DirectoryLength {
+        /// Bricks + 1 (or `usize::MAX` if even that overflows).
+        expected: usize,
+        /// The slice length given.
+        found: usize,
+    },
+    /// More non-transparent voxels than a `u32` directory can address.
+    TooManyRecords,
+    /// The record slice is smaller than the count pass found.
+    RecordStorage {
+        /// Records needed.
+        needed: usize,
+        /// Records given.
+        found: usize,
+    },
+    /// [`ObjectAttrs::object`](super::ObjectAttrs::object) is not below
+    /// [`Limits::objects`](super::Limits::objects).
+    ObjectOutOfRange {
+        /// The object id.
+        object: u32,
+        /// The limit.
+        limit: u32,
+    },
+    /// [`ObjectAttrs::material`](super::ObjectAttrs::material) is not below
+    /// [`Limits::materials`](super::Limits::materials).
+    MaterialOutOfRange {
+        /// The material index.
+        material: u16,
+        /// The limit.
+        limit: u32,
+    },
+    /// The fill pass offered voxels before any
+    /// [`Filler::begin_object`](super::Filler::begin_object).
+    OfferWithoutObject {
+        /// How many offers.
+        offers: u64,
+    },
+    /// The fill pass offered voxels the count pass did not: the two passes
+    /// did not voxelize the same scene.
+    PassMismatch {
+        /// How many such offers.
+        uncounted: u64,
+    },
+    /// The fill pass left counted voxels without a record.
+    FillIncomplete {
+        /// Records written.
+        filled: usize,
+        /// Records counted.
+        expected: usize,
+    },
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::DirectoryLength { expected, found } => write!(
+                f,
+                "brick directory has {found} entries, expected {expected} (bricks + 1)"
+            ),
+            Self::TooManyRecords => {
+                f.write_str("more non-transparent voxels than a u32 directory addresses")
+            }
+            Self::RecordStorage { needed, found } => {
+                write!(
+                    f,
+                    "record storage holds {found} records, the scene needs {needed}"
+                )
+            }
+            Self::ObjectOutOfRange { object, limit } => {
+                write!(f, "object id {object} is not below the table size {limit}")
+            }
+            Self::MaterialOutOfRange { material, limit } => {
+                write!(f, "material {material} is not below the table size {limit}")
+            }
+            Self::OfferWithoutObject { offers } => {
+                write!(f, "{offers} voxels offered before any begin_object")
+            }
+            Self::PassMismatch { uncounted } => write!(
+                f,
+                "the fill pass offered {uncounted} voxels the count pass did not"
+            ),
+            Self::FillIncomplete { filled, expected } => write!(
+                f,
+                "the fill pass wrote {filled} records, the count pass found {expected}"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for BuildError {}
