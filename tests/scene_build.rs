@@ -146,7 +146,7 @@ fn lone_sphere_lit_by_spd_lights_has_no_acne() {
                 })
                 .unwrap();
             let mut storage = [Object::UNUSED; 1];
-            let mut table = ObjectTable::new(&mut storage);
+            let mut table = ObjectTable::new(&mut storage, &mut []);
             table
                 .push(Object {
                     shape: Shape::Sphere(Sphere {
@@ -339,7 +339,7 @@ fn bad_input_is_refused_or_clipped_never_a_panic() {
     assert!(lights.push(Light::default()).is_err());
     // More objects than the table holds.
     let mut storage = vec![Object::UNUSED; 2];
-    let mut table = ObjectTable::new(&mut storage);
+    let mut table = ObjectTable::new(&mut storage, &mut []);
     let obj = Object {
         shape: Shape::Voxels,
         material: 0,

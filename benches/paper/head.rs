@@ -122,7 +122,7 @@ pub fn build(
         shape: Shape::Voxels,
         material: 0,
     }];
-    let table = ObjectTable::new(&mut storage);
+    let table = ObjectTable::new(&mut storage, &mut []);
     let mut mats: Box<Materials<MAX_MATERIALS>> = Box::default();
     let _ = mats.push(core_mat);
     let intensity = scalar(light_intensity(1));

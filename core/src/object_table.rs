@@ -3,11 +3,13 @@
 //!
 //! * [`ObjectTable`]: per object its geometric definition in fixed point
 //!   ([`Shape`]) and its material, indexed by [`VoxelRecord::object`]. The
-//!   light pass reads whether each object is closed. Its storage is a
-//!   caller-provided slice, like the raster plane: a million objects do
-//!   not fit on a stack, so the table borrows `&mut [Object]` and
-//!   [`ObjectTable::push`] hands the object back when the slice is full,
-//!   as `heapless::Vec::push` does.
+//!   host's *intersection verification* (the paper's remedy for false hits)
+//!   reads it. Its storage is a caller-provided slice, like the raster
+//!   plane: a million objects do not fit on a stack, so the table borrows
+//!   `&mut [Object]` and [`ObjectTable::push`] hands the object back when
+//!   the slice is full, as `heapless::Vec::push` does. Bézier patches
+//!   (384 bytes each) live in a second slice and objects refer to them by
+//!   index, which keeps [`Object`] at 128 bytes.
 //! * [`Materials`]: NFF `f` entries in fixed point, capacity a const
 //!   generic (a `heapless::Vec`), indexed by [`VoxelRecord::material`].
 //! * [`Lights`]: up to [`MAX_LIGHTS`] point lights (the record keeps 2
@@ -19,13 +21,23 @@
 //! [`VoxelRecord::object`]: crate::voxel::VoxelRecord::object
 //! [`VoxelRecord::material`]: crate::voxel::VoxelRecord::material
 
-use crate::geometry::{Cone, Point, Sphere, Torus, Triangle};
+use crate::geometry::{BezierPatch, Cone, Cuboid, Point, Sphere, Torus, Triangle};
 pub use crate::voxel::MAX_LIGHTS;
 
 /// Fractional bits of the fixed-point scalars of this module.
 pub const SCALAR_BITS: u32 = 16;
 /// 1.0 in the fixed-point scalars of this module.
 pub const SCALAR_ONE: u32 = 1 << SCALAR_BITS;
+
+/// A reference to a sampled volume (the volumes issue owns the data): the
+/// host's index of the volume and the box it fills in raster coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct VolumeRef {
+    /// The host's index of the volume data.
+    pub volume: u32,
+    /// The box the volume fills.
+    pub bounds: Cuboid,
+}
 
 /// The geometric definition of one object, in fixed point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -36,33 +48,39 @@ pub enum Shape {
     Triangle(Triangle),
     /// An open cone or cylinder (NFF `c`: no caps).
     Cone(Cone),
+    /// An axis-aligned box (closed).
+    Cuboid(Cuboid),
     /// A torus (closed).
     Torus(Torus),
-    /// No continuous definition: the voxels are the object (sampled
-    /// volumes, voxel models, CSG results, whose surface no single
-    /// primitive describes); closed: its voxels bound a solid.
-    /// Intersection verification accepts the discrete hit as it is.
+    /// A bicubic Bézier patch: index into the table's patch storage (open).
+    Patch(u32),
+    /// A sampled volume (closed: its voxels bound a solid).
+    Volume(VolumeRef),
+    /// No continuous definition: the voxels are the object (CSG results,
+    /// whose surface no single primitive describes). Intersection
+    /// verification accepts the discrete hit as it is.
     Voxels,
 }
 
 impl Shape {
     /// Whether the shape bounds a solid, so that its back side is never lit
     /// (the light pass classifies a light the stored normal faces away
-    /// from as occluded). Open shapes (triangles, open cones) can be seen
-    /// and lit from both sides.
+    /// from as occluded). Open shapes (triangles, patches, open cones) can be
+    /// seen and lit from both sides.
     ///
     /// ```
-    /// use rrt_core::geometry::{Cone, Sphere};
+    /// use rrt_core::geometry::Sphere;
     /// use rrt_core::object_table::Shape;
     /// assert!(Shape::Sphere(Sphere { centre: [0; 3], radius: 1 }).is_closed());
-    /// let c = Cone { base: [0; 3], base_radius: 1, apex: [0, 0, 9], apex_radius: 1 };
-    /// assert!(!Shape::Cone(c).is_closed());
+    /// assert!(!Shape::Patch(0).is_closed());
     /// ```
     #[must_use]
     pub const fn is_closed(&self) -> bool {
         match self {
-            Self::Sphere(_) | Self::Torus(_) | Self::Voxels => true,
-            Self::Triangle(_) | Self::Cone(_) => false,
+            Self::Sphere(_) | Self::Cuboid(_) | Self::Torus(_) | Self::Volume(_) | Self::Voxels => {
+                true
+            }
+            Self::Triangle(_) | Self::Cone(_) | Self::Patch(_) => false,
         }
     }
 }
@@ -82,7 +100,7 @@ impl Object {
     /// ```
     /// use rrt_core::object_table::{Object, ObjectTable};
     /// let mut storage = [Object::UNUSED; 4];
-    /// let table = ObjectTable::new(&mut storage);
+    /// let table = ObjectTable::new(&mut storage, &mut []);
     /// assert_eq!(table.len(), 0);
     /// ```
     pub const UNUSED: Self = Self {
@@ -103,6 +121,9 @@ impl<'a, T: Copy> SliceVec<'a, T> {
     fn new(buf: &'a mut [T]) -> Self {
         Self { buf, len: 0 }
     }
+    fn is_full(&self) -> bool {
+        self.len >= self.buf.len()
+    }
     fn push(&mut self, item: T) -> Result<usize, T> {
         match self.buf.get_mut(self.len) {
             Some(slot) => {
@@ -120,14 +141,14 @@ impl<'a, T: Copy> SliceVec<'a, T> {
     }
 }
 
-/// The object table: [`Object`]s in caller-provided storage, indexed by
-/// object id.
+/// The object table: [`Object`]s (and the Bézier patches they refer to)
+/// in caller-provided storage, indexed by object id.
 ///
 /// ```
 /// use rrt_core::geometry::Sphere;
 /// use rrt_core::object_table::{Object, ObjectTable, Shape};
 /// let mut storage = [Object::UNUSED; 1];
-/// let mut table = ObjectTable::new(&mut storage);
+/// let mut table = ObjectTable::new(&mut storage, &mut []);
 /// let s = Object { shape: Shape::Sphere(Sphere { centre: [0; 3], radius: 5 }), material: 0 };
 /// assert_eq!(table.push(s), Ok(0));
 /// assert_eq!(table.push(s), Err(s)); // full: the object comes back
@@ -136,14 +157,16 @@ impl<'a, T: Copy> SliceVec<'a, T> {
 #[derive(Debug)]
 pub struct ObjectTable<'a> {
     objects: SliceVec<'a, Object>,
+    patches: SliceVec<'a, BezierPatch>,
 }
 
 impl<'a> ObjectTable<'a> {
-    /// An empty table over `objects` (its contents are overwritten as
-    /// entries are pushed).
-    pub fn new(objects: &'a mut [Object]) -> Self {
+    /// An empty table over `objects` and `patches` (their contents are
+    /// overwritten as entries are pushed).
+    pub fn new(objects: &'a mut [Object], patches: &'a mut [BezierPatch]) -> Self {
         Self {
             objects: SliceVec::new(objects),
+            patches: SliceVec::new(patches),
         }
     }
 
@@ -151,8 +174,14 @@ impl<'a> ObjectTable<'a> {
     ///
     /// # Errors
     /// Gives `object` back when the table is full, or when the id would not
-    /// fit the record's `u32`.
+    /// fit the record's `u32`, or when it is a [`Shape::Patch`] whose index
+    /// is not a stored patch (use [`ObjectTable::push_patch`]).
     pub fn push(&mut self, object: Object) -> Result<u32, Object> {
+        if let Shape::Patch(p) = object.shape
+            && usize::try_from(p).map_or(true, |p| p >= self.patches.len)
+        {
+            return Err(object);
+        }
         if u32::try_from(self.objects.len).is_err() {
             return Err(object);
         }
@@ -160,10 +189,36 @@ impl<'a> ObjectTable<'a> {
         u32::try_from(i).map_err(|_| object)
     }
 
+    /// Stores a Bézier patch and appends an object referring to it; returns
+    /// the object id.
+    ///
+    /// # Errors
+    /// Gives the patch back when either the object or the patch storage is
+    /// full.
+    #[allow(clippy::result_large_err)] // the patch comes back, as heapless::Vec::push does
+    pub fn push_patch(&mut self, patch: BezierPatch, material: u16) -> Result<u32, BezierPatch> {
+        if self.objects.is_full() || self.patches.is_full() {
+            return Err(patch);
+        }
+        let p = self.patches.push(patch)?;
+        let p = u32::try_from(p).map_err(|_| patch)?;
+        self.push(Object {
+            shape: Shape::Patch(p),
+            material,
+        })
+        .map_err(|_| patch)
+    }
+
     /// The object with id `id`.
     #[must_use]
     pub fn get(&self, id: u32) -> Option<&Object> {
         self.objects.as_slice().get(usize::try_from(id).ok()?)
+    }
+
+    /// The Bézier patch of a [`Shape::Patch`] index.
+    #[must_use]
+    pub fn patch(&self, index: u32) -> Option<&BezierPatch> {
+        self.patches.as_slice().get(usize::try_from(index).ok()?)
     }
 
     /// The objects pushed so far, in id order.
@@ -380,24 +435,33 @@ mod tests {
     #[test]
     fn object_size_stays_small() {
         assert!(core::mem::size_of::<Object>() <= 128);
+        assert_eq!(core::mem::size_of::<BezierPatch>(), 384);
     }
 
     #[test]
     fn table_capacity_errors_give_the_item_back() {
         let mut objs = [Object::UNUSED; 3];
-        let mut t = ObjectTable::new(&mut objs);
+        let mut patches = [BezierPatch {
+            control: [[[0; 3]; 4]; 4],
+        }; 1];
+        let mut t = ObjectTable::new(&mut objs, &mut patches);
         assert!(t.is_empty());
         assert_eq!(t.capacity(), 3);
         assert_eq!(t.push(sphere(1)), Ok(0));
-        let tri = Object {
-            shape: Shape::Triangle(Triangle {
-                vertices: [[0; 3], [1, 0, 0], [0, 1, 0]],
-                normals: None,
-            }),
-            material: 2,
+        // A patch reference that is not stored is refused.
+        let dangling = Object {
+            shape: Shape::Patch(0),
+            material: 0,
         };
-        assert_eq!(t.push(tri), Ok(1));
-        assert_eq!(t.get(1), Some(&tri));
+        assert_eq!(t.push(dangling), Err(dangling));
+        let p = BezierPatch {
+            control: [[[7; 3]; 4]; 4],
+        };
+        assert_eq!(t.push_patch(p, 2), Ok(1));
+        assert_eq!(t.get(1).unwrap().shape, Shape::Patch(0));
+        assert_eq!(t.patch(0), Some(&p));
+        // Patch storage full.
+        assert_eq!(t.push_patch(p, 2), Err(p));
         assert_eq!(t.push(sphere(2)), Ok(2));
         // Object storage full.
         assert_eq!(t.push(sphere(3)), Err(sphere(3)));
@@ -409,7 +473,7 @@ mod tests {
 
     #[test]
     fn empty_storage_is_a_full_table() {
-        let mut t = ObjectTable::new(&mut []);
+        let mut t = ObjectTable::new(&mut [], &mut []);
         assert_eq!(t.push(sphere(1)), Err(sphere(1)));
         assert_eq!(t.get(0), None);
     }
@@ -444,14 +508,18 @@ mod tests {
 
     #[test]
     fn shapes_open_and_closed() {
-        let t = Torus {
-            centre: [0; 3],
-            axis: [0, 0, 1 << 30],
-            major: 2,
-            minor: 1,
+        let c = Cuboid {
+            min: [0; 3],
+            max: [1; 3],
         };
-        assert!(Shape::Torus(t).is_closed());
-        assert!(Shape::Voxels.is_closed());
+        assert!(Shape::Cuboid(c).is_closed());
+        assert!(
+            Shape::Volume(VolumeRef {
+                volume: 0,
+                bounds: c
+            })
+            .is_closed()
+        );
         assert!(
             !Shape::Cone(Cone {
                 base: [0; 3],

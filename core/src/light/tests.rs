@@ -6,7 +6,7 @@ use std::vec::Vec;
 
 use super::*;
 use crate::fixed::VOXEL;
-use crate::geometry::{Sphere, Torus, Triangle};
+use crate::geometry::{Cuboid, Sphere, Torus, Triangle};
 use crate::object_table::{Light, Material, Object, SCALAR_ONE, Shape};
 use crate::store::{Limits, ObjectAttrs, RecordStore, RecordStoreMut};
 use crate::testkit::{self, Scene};
@@ -66,7 +66,7 @@ impl World {
 
     fn run_with(&mut self, scene: &mut Scene, params: &LightParams) -> LightReport {
         let mut storage = vec![Object::UNUSED; self.objects.len()];
-        let mut table = ObjectTable::new(&mut storage);
+        let mut table = ObjectTable::new(&mut storage, &mut []);
         for o in &self.objects {
             table.push(*o).unwrap();
         }
@@ -347,9 +347,9 @@ fn open_surfaces_lit_from_behind_see_the_light_from_their_back() {
     assert_eq!(shadowed.light(0), LightVisibility::Occluded);
     // A closed shape facing away is occluded without a ray.
     let cube = Object {
-        shape: Shape::Sphere(Sphere {
-            centre: [0; 3],
-            radius: VOXEL,
+        shape: Shape::Cuboid(Cuboid {
+            min: [0; 3],
+            max: [1; 3],
         }),
         material: 0,
     };
@@ -494,7 +494,7 @@ fn missing_tables_and_extent_mismatch() {
     let raster = Raster::new(other, &plane).unwrap();
     let mut store = RecordStoreMut::new(e, &scene.dir, &mut scene.records).unwrap();
     let mut objs = [Object::UNUSED; 1];
-    let table = ObjectTable::new(&mut objs);
+    let table = ObjectTable::new(&mut objs, &mut []);
     assert_eq!(
         illuminate(
             &raster,
@@ -548,7 +548,7 @@ fn runs_in_any_order_equal_the_serial_pass() {
     let serial = scene.records.clone();
 
     let mut storage = vec![Object::UNUSED; w.objects.len()];
-    let mut table = ObjectTable::new(&mut storage);
+    let mut table = ObjectTable::new(&mut storage, &mut []);
     for o in &w.objects {
         table.push(*o).unwrap();
     }

@@ -280,7 +280,7 @@ pub fn voxelize(
         table::Shape::Cone(c) => Cone::voxelize(c, separation, extent, sink),
         table::Shape::Triangle(t) => Triangle::voxelize(t, separation, extent, sink),
         table::Shape::Torus(t) => Torus::voxelize(t, separation, extent, sink),
-        table::Shape::Voxels => Ok(0),
+        _ => Ok(0),
     }
 }
 

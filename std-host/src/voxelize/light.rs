@@ -78,7 +78,7 @@ impl LightScene {
         threads: usize,
     ) -> Result<(Vec<VoxelRecord>, LightReport), BuildError> {
         let mut storage = vec![Object::UNUSED; self.entries.len()];
-        let mut table = ObjectTable::new(&mut storage);
+        let mut table = ObjectTable::new(&mut storage, &mut []);
         for o in &self.entries {
             // The storage holds exactly these objects: no push fails.
             let _ = table.push(*o);
