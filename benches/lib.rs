@@ -10,45 +10,29 @@ use rrt_core::discrete_ray::DiscreteRay;
 use rrt_core::fixed::VOXEL;
 use rrt_core::raster::{Extent, cell};
 
-/// SplitMix64, the generator of `dda_bench` (same default seed), so the
-/// random-sphere raster and the random rays match the C peer's.
-#[derive(Clone, Debug)]
-pub struct SplitMix(pub u64);
+pub use rrt_core::rng::Rng;
 
-impl Default for SplitMix {
-    fn default() -> Self {
-        Self(0x9E37_79B9_7F4A_7C15)
-    }
+/// The seed of `dda_bench`'s generator (SplitMix64, as [`Rng`]), so the
+/// random-sphere raster and the random rays match the C peer's.
+pub const DDA_BENCH_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// Uniform in [0, 1): the top 53 bits of the next draw.
+pub fn unit(rng: &mut Rng) -> f64 {
+    (rng.next_u64() >> 11) as f64 * (1.0 / 9_007_199_254_740_992.0)
 }
 
-impl SplitMix {
-    /// Next 64 bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / 9_007_199_254_740_992.0)
-    }
-
-    /// Uniform direction (rejection sampling in the unit ball).
-    pub fn direction(&mut self) -> [f64; 3] {
-        loop {
-            let v = [
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-                2.0 * self.unit() - 1.0,
-            ];
-            let l = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-            if l > 1e-6 && l <= 1.0 {
-                let l = l.sqrt();
-                return v.map(|c| c / l);
-            }
+/// Uniform direction (rejection sampling in the unit ball).
+pub fn direction(rng: &mut Rng) -> [f64; 3] {
+    loop {
+        let v = [
+            2.0 * unit(rng) - 1.0,
+            2.0 * unit(rng) - 1.0,
+            2.0 * unit(rng) - 1.0,
+        ];
+        let l = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if l > 1e-6 && l <= 1.0 {
+            let l = l.sqrt();
+            return v.map(|c| c / l);
         }
     }
 }
@@ -69,14 +53,14 @@ impl BenchRaster {
     /// `10·n/256` voxels (a voxel belongs to a sphere when its centre is
     /// inside, and the voxel holding the centre is always set).
     #[must_use]
-    pub fn random_spheres(n: u32, count: usize, rng: &mut SplitMix) -> Self {
+    pub fn random_spheres(n: u32, count: usize, rng: &mut Rng) -> Self {
         let len = (n as usize).pow(3);
         let mut plane = vec![0u8; len];
         touch_every_page(&mut plane);
         let r = 10.0 * f64::from(n) / 256.0;
         let nn = f64::from(n);
         for _ in 0..count {
-            let c = [rng.unit() * nn, rng.unit() * nn, rng.unit() * nn];
+            let c = [unit(rng) * nn, unit(rng) * nn, unit(rng) * nn];
             fill_sphere(&mut plane, n, c, r);
         }
         let occupied = plane.iter().filter(|&&c| c & cell::OPAQUE != 0).count();
@@ -247,17 +231,17 @@ pub fn camera_rays(n: u32, res: u32) -> Vec<BenchRay> {
 /// `dda_bench`'s random set: origins uniform on a random face of the box,
 /// directions uniform over the inward hemisphere (incoherent).
 #[must_use]
-pub fn random_rays(n: u32, count: usize, rng: &mut SplitMix) -> Vec<BenchRay> {
+pub fn random_rays(n: u32, count: usize, rng: &mut Rng) -> Vec<BenchRay> {
     let nn = f64::from(n);
     (0..count)
         .map(|_| {
             let face = (rng.next_u64() % 6) as usize;
             let (ax, neg) = (face >> 1, face & 1 == 1);
-            let mut o = [rng.unit() * nn, rng.unit() * nn, rng.unit() * nn];
+            let mut o = [unit(rng) * nn, unit(rng) * nn, unit(rng) * nn];
             o[ax] = if neg { nn } else { 0.0 };
             let mut d;
             loop {
-                d = rng.direction();
+                d = direction(rng);
                 if d[ax].abs() >= 1e-3 {
                     break;
                 }

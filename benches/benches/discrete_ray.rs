@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput};
 use rrt_benches::{
-    BenchRaster, BenchRay, SplitMix, Trace, baseline, camera_rays, random_rays, rss_mib,
+    BenchRaster, BenchRay, DDA_BENCH_SEED, Rng, Trace, baseline, camera_rays, random_rays, rss_mib,
 };
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::proximity::distance_field;
@@ -220,7 +220,7 @@ struct Scene {
 }
 
 fn scene(n: u32) -> Scene {
-    let mut rng = SplitMix::default();
+    let mut rng = Rng::new(DDA_BENCH_SEED);
     let before = rss_mib().unwrap_or(0.0);
     let mut raster = BenchRaster::random_spheres(n, 1000, &mut rng);
     let extent = raster.extent();

@@ -29,6 +29,7 @@
 //! `RRT_BENCH_MODES=six,twenty-six,adaptive` limit what runs,
 //! `RRT_BENCH_TABLE_ONLY=1` skips criterion.
 
+use rrt_core::rng::Rng;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -203,30 +204,18 @@ fn camera_rays(scene: &Scene, w: u32, h: u32) -> Vec<([i64; 3], [i32; 3])> {
     rays
 }
 
-/// SplitMix64.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
-
 /// Random rays from random points of empty voxels in random directions.
 fn random_rays(scene: &Scene, count: usize, seed: u64) -> Vec<([i64; 3], [i32; 3])> {
     let mut rng = Rng(seed);
     let dims = scene.extent.dims();
     let mut rays = Vec::with_capacity(count);
     while rays.len() < count {
-        let o = dims.map(|n| (rng.next() % (u64::from(n) << 16)) as i64);
+        let o = dims.map(|n| (rng.next_u64() % (u64::from(n) << 16)) as i64);
         let v = o.map(|c| (c >> 16) as u32);
         if scene.plane[scene.extent.index(v).unwrap()] & cell::OPAQUE != 0 {
             continue;
         }
-        let d = [0; 3].map(|_| (rng.next() >> 33) as i32 - (1 << 30));
+        let d = [0; 3].map(|_| (rng.next_u64() >> 33) as i32 - (1 << 30));
         if d == [0; 3] {
             continue;
         }

@@ -13,6 +13,7 @@
 //! builder's first pass does. A summary (voxels, plane bytes, one timed run
 //! each) is printed before criterion runs, for the README.
 
+use rrt_core::rng::Rng;
 use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -66,26 +67,13 @@ impl VoxelSink for CountingSink<'_> {
     }
 }
 
-/// SplitMix64, as in tests/lib.rs.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
-
 /// `count` spheres of radius 10 voxels with centres uniform in the 256³
 /// raster (fully inside), seeded.
 fn random_spheres(count: usize) -> Vec<Sphere> {
     let mut rng = Rng(0x5eed_0000 + count as u64);
     (0..count)
         .map(|_| Sphere {
-            centre: [0; 3].map(|_| 11 * VOXEL + (rng.next() % (234 * VOXEL as u64)) as i64),
+            centre: [0; 3].map(|_| 11 * VOXEL + (rng.next_u64() % (234 * VOXEL as u64)) as i64),
             radius: 10 * VOXEL,
         })
         .collect()

@@ -76,6 +76,7 @@ pub mod object_table;
 pub mod packet;
 pub mod proximity;
 pub mod raster;
+pub mod rng;
 pub mod store;
 #[cfg(test)]
 mod testkit;

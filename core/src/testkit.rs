@@ -1,4 +1,5 @@
-//! Test-only helpers: the seeded generator of the unit tests, a sink that
+//! Test-only helpers: the seeded generator of the unit tests (the crate's
+//! [`Rng`]), a sink that
 //! records offers, shorthands over the real voxelizers and a scene builder
 //! over `Vec` storage.
 
@@ -13,34 +14,7 @@ use crate::store::{Counter, Limits, ObjectAttrs, directory_len};
 use crate::voxel::VoxelRecord;
 use crate::voxelize::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 
-/// SplitMix64: the one seeded generator of the core's unit tests.
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform-ish in `0..n` (`n > 0`).
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n
-    }
-
-    /// Uniform-ish in `0..n` (`n > 0`).
-    pub fn below_u32(&mut self, n: u32) -> u32 {
-        (self.next_u64() % u64::from(n)) as u32
-    }
-
-    /// Uniform-ish in `lo..=hi`.
-    pub fn range(&mut self, lo: i64, hi: i64) -> i64 {
-        lo + (self.next_u64() % (hi - lo + 1) as u64) as i64
-    }
-}
+pub use crate::rng::Rng;
 
 /// A sink that records every voxel offered: how often, and the offer
 /// nearest the surface (the first of equals).

@@ -565,15 +565,6 @@ mod tests {
         assert_eq!(r.distance(), 3);
     }
 
-    /// SplitMix64 for seeded test directions.
-    fn mix(state: &mut u64) -> u64 {
-        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = *state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
     /// sin of the angle between `a` and `b`, in nanoradians (small angles),
     /// computed as `|a × b| / (|a|·|b|)` in integers. Panics if they point
     /// more than 90° apart.
@@ -644,11 +635,11 @@ mod tests {
             }
         }
         // Seeded random directions, uniform in the ball (rejection).
-        let mut st = 42u64;
+        let mut rng = crate::rng::Rng::new(42);
         let mut n_done = 0;
         while n_done < 200_000 {
-            let r = |st: &mut u64| (mix(st) >> 33) as i64 - (1 << 30);
-            let v = [r(&mut st), r(&mut st), r(&mut st)];
+            let mut r = || (rng.next_u64() >> 33) as i64 - (1 << 30);
+            let v = [r(), r(), r()];
             let l2: i128 = v.iter().map(|c| i128::from(*c).pow(2)).sum();
             if !((1i128 << 40)..=(1i128 << 60)).contains(&l2) {
                 continue;
