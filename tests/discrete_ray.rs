@@ -23,7 +23,7 @@ fn random_dir(rng: &mut Rng) -> [i32; 3] {
         let mag = if bits == 0 {
             1
         } else {
-            rng.range_i64(0, (1i64 << bits) - 1)
+            rng.range(0, (1i64 << bits) - 1)
         };
         let v = if rng.chance(1, 2) { -mag } else { mag };
         *slot = v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
@@ -40,7 +40,7 @@ fn random_dir(rng: &mut Rng) -> [i32; 3] {
     }
     if kind == 3 {
         // Equal magnitudes: exact diagonals through edges and corners.
-        let m = rng.range_i64(1, 1 << 20) as i32;
+        let m = rng.range(1, 1 << 20) as i32;
         d = [0, 1, 2].map(|_| if rng.chance(1, 2) { m } else { -m });
     }
     d
@@ -49,10 +49,10 @@ fn random_dir(rng: &mut Rng) -> [i32; 3] {
 fn random_coord(rng: &mut Rng, n: u32) -> i64 {
     let size = i64::from(n) * VOXEL;
     match rng.below(6) {
-        0 => rng.range_i64(0, size - 1),             // inside, sub-voxel
-        1 => rng.range_i64(0, i64::from(n)) * VOXEL, // on a voxel face
+        0 => rng.range(0, size - 1),                       // inside, sub-voxel
+        1 => rng.range(0, i64::from(n)) * VOXEL,           // on a voxel face
         2 => voxel_centre(rng.below(u64::from(n)) as u32), // a voxel centre
-        3 => rng.range_i64(-3 * size, 4 * size),     // around the box
+        3 => rng.range(-3 * size, 4 * size),               // around the box
         4 => {
             if rng.chance(1, 2) {
                 0
@@ -60,7 +60,7 @@ fn random_coord(rng: &mut Rng, n: u32) -> i64 {
                 size
             }
         } // on the box faces
-        _ => rng.range_i64(-(1i64 << 40), 1i64 << 40), // far away
+        _ => rng.range(-(1i64 << 40), 1i64 << 40),         // far away
     }
 }
 
@@ -100,7 +100,7 @@ fn random_case(rng: &mut Rng) -> Case {
             *d = if rng.chance(1, 4) {
                 (random_coord(rng, dims[k]) - origin[k]).clamp(-span, span) as i32
             } else {
-                rng.range_i64(-span, span) as i32
+                rng.range(-span, span) as i32
             };
         }
         if rng.chance(1, 20) {
@@ -257,8 +257,8 @@ fn hard_cases() {
     }
     // Segments between lattice points, and of length zero.
     for _ in 0..2000 {
-        let a = [0, 1, 2].map(|k| rng.range_i64(0, i64::from(dims[k])) * VOXEL);
-        let b = [0, 1, 2].map(|k| rng.range_i64(0, i64::from(dims[k])) * VOXEL);
+        let a = [0, 1, 2].map(|k| rng.range(0, i64::from(dims[k])) * VOXEL);
+        let b = [0, 1, 2].map(|k| rng.range(0, i64::from(dims[k])) * VOXEL);
         let dir = [0, 1, 2].map(|k| (b[k] - a[k]) as i32);
         cases.push(Case {
             dims,

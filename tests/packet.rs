@@ -32,8 +32,8 @@ enum Bundle {
 fn coord(rng: &mut Rng, n: u32) -> i64 {
     let size = i64::from(n) * VOXEL;
     match rng.below(7) {
-        0 => rng.range_i64(0, size - 1),
-        1 => rng.range_i64(0, i64::from(n)) * VOXEL,
+        0 => rng.range(0, size - 1),
+        1 => rng.range(0, i64::from(n)) * VOXEL,
         2 => voxel_centre(rng.below(u64::from(n)) as u32),
         3 => {
             if rng.chance(1, 2) {
@@ -42,15 +42,15 @@ fn coord(rng: &mut Rng, n: u32) -> i64 {
                 size
             }
         }
-        4 => rng.range_i64(0, i64::from(n)) * VOXEL + rng.range_i64(-1, 1),
-        5 => rng.range_i64(-3 * size, 4 * size),
-        _ => rng.range_i64(-(1i64 << 40), 1i64 << 40),
+        4 => rng.range(0, i64::from(n)) * VOXEL + rng.range(-1, 1),
+        5 => rng.range(-3 * size, 4 * size),
+        _ => rng.range(-(1i64 << 40), 1i64 << 40),
     }
 }
 
 fn random_dir(rng: &mut Rng) -> [i32; 3] {
     let scale = [1u32, 8, 16, 24, 30][rng.below(5) as usize];
-    let mut d = [0; 3].map(|_| rng.range_i64(-(1i64 << scale), 1i64 << scale) as i32);
+    let mut d = [0; 3].map(|_| rng.range(-(1i64 << scale), 1i64 << scale) as i32);
     match rng.below(8) {
         0 => {
             // Axis-parallel.
@@ -62,7 +62,7 @@ fn random_dir(rng: &mut Rng) -> [i32; 3] {
         2 => d = [0; 3],                   // zero direction
         3 => {
             // Equal magnitudes: exact diagonals through edges and corners.
-            let m = rng.range_i64(1, 1 << 20) as i32;
+            let m = rng.range(1, 1 << 20) as i32;
             d = [0; 3].map(|_| if rng.chance(1, 2) { m } else { -m });
             if rng.chance(1, 3) {
                 d[rng.below(3) as usize] = 0;
@@ -182,9 +182,9 @@ fn random_packet(seed: u64) -> Packet {
                 let o = [0, 1, 2].map(|k| {
                     let n = i64::from(dims[k]);
                     match rng.below(3) {
-                        0 => rng.range_i64(0, n) * VOXEL,
+                        0 => rng.range(0, n) * VOXEL,
                         1 => voxel_centre(rng.below(dims[k] as u64) as u32),
-                        _ => rng.range_i64(-1, n + 1) * VOXEL,
+                        _ => rng.range(-1, n + 1) * VOXEL,
                     }
                 });
                 DiscreteRay::new(e, o, random_dir(&mut rng)).unwrap()
@@ -195,7 +195,7 @@ fn random_packet(seed: u64) -> Packet {
                 } else {
                     [0, 1, 2].map(|k| {
                         let span = i64::from(dims[k]) * VOXEL * 3;
-                        (origin[k] + rng.range_i64(-span, span)).clamp(-(1 << 47), 1 << 47)
+                        (origin[k] + rng.range(-span, span)).clamp(-(1 << 47), 1 << 47)
                     })
                 };
                 DiscreteRay::segment(e, origin, to).unwrap()

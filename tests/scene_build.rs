@@ -233,8 +233,8 @@ fn adaptive_rays_match_six_in_a_built_scene() {
     let raster = Raster::new(e, &scene.plane).unwrap();
     let mut rng = Rng::new(11);
     for i in 0..3000 {
-        let origin = [0; 3].map(|_| rng.range_i64(-20 * VOXEL, 100 * VOXEL));
-        let dir = [0; 3].map(|_| rng.range_i64(-(1 << 24), 1 << 24) as i32);
+        let origin = [0; 3].map(|_| rng.range(-20 * VOXEL, 100 * VOXEL));
+        let dir = [0; 3].map(|_| rng.range(-(1 << 24), 1 << 24) as i32);
         let Some(ray) = DiscreteRay::new(e, origin, dir).unwrap() else {
             continue;
         };

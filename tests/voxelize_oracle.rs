@@ -78,7 +78,7 @@ fn triangle_membership_matches_clipping() {
             1 => x / (VOXEL / 2) * (VOXEL / 2),
             _ => x,
         };
-        let vs = [0; 3].map(|_| [0; 3].map(|_| snap(rng.range_i64(VOXEL, 9 * VOXEL))));
+        let vs = [0; 3].map(|_| [0; 3].map(|_| snap(rng.range(VOXEL, 9 * VOXEL))));
         let t = Triangle {
             vertices: vs,
             normals: None,

@@ -16,6 +16,7 @@ use rrt_core::voxelize::volume::Block;
 use rrt_core::voxelize::{
     Separation, Surfel, VoxelSink, cone, cuboid, patch, sphere, torus, triangle, volume,
 };
+use rrt_tests::mesh::{fit, read_obj};
 
 /// Unique voxels and total offers.
 #[derive(Default)]
@@ -331,9 +332,10 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
     }
     // The bunny, when the shared data is there.
     if let Some(data) = rrt_tests::shared_data()
-        && let Ok(text) = std::fs::read_to_string(data.join("meshes/bunny.obj"))
+        && let path = data.join("meshes/bunny.obj")
+        && path.is_file()
     {
-        let (verts, faces) = read_obj(&text);
+        let (verts, faces) = read_obj(&path);
         let verts = fit(&verts, 160, 3);
         for sep in SEPS {
             let mut u = Unique::default();
@@ -367,38 +369,4 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
         println!("SKIPPED: bunny (../shared/data/meshes/bunny.obj not found)");
     }
     assert!(rep.rows.len() >= 18);
-}
-
-fn read_obj(text: &str) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut v = Vec::new();
-    let mut f = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).map(|x| x.parse().unwrap()).collect();
-                v.push([c[0], c[1], c[2]]);
-            }
-            Some("f") => {
-                let c: Vec<u32> = it
-                    .map(|x| x.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                    .collect();
-                for i in 1..c.len() - 1 {
-                    f.push([c[0], c[i], c[i + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    (v, f)
-}
-
-fn fit(v: &[[f64; 3]], n: u32, margin: u32) -> Vec<[i64; 3]> {
-    let lo = [0, 1, 2].map(|k| v.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
-    let hi = [0, 1, 2].map(|k| v.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-    let s = f64::from(n - 2 * margin) * VOXEL as f64 / size;
-    v.iter()
-        .map(|p| [0, 1, 2].map(|k| ((p[k] - lo[k]) * s + f64::from(margin) * VOXEL as f64) as i64))
-        .collect()
 }

@@ -6,129 +6,21 @@
 //! inside the shape towards every voxel corner, edge midpoint and face
 //! centre on a cube around the origin (so they pass straight through voxel
 //! corners and edges) plus random directions; every ray must hit a surface
-//! voxel before it leaves the raster. The shared checker is
-//! `rrt_core::check_voxelize`.
+//! voxel before it leaves the raster. The probes are
+//! `rrt_tests::tunnel::assert_tunnel_free`, over the checker
+//! `rrt_core::check_voxelize::check_closed`.
 //!
 //! Every case derives from a printed seed: `RRT_SEED=<seed>` replays one;
 //! `RRT_SCALE=<k>` runs k times as many cases.
 
-use rrt_core::check_voxelize::{PlaneSink, check_closed, probe_targets};
 use rrt_core::discrete_ray::Connectivity;
-use rrt_core::fixed::{VOXEL, voxel_centre};
+use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::{BezierPatch, Cone, Cuboid, Sphere, Torus, Triangle};
-use rrt_core::proximity::flag_neighbourhood;
-use rrt_core::raster::{Extent, Raster, RasterMut};
+use rrt_core::raster::{Extent, Raster};
 use rrt_core::voxelize::{NORMAL_ONE, Separation, cone, cuboid, patch, sphere, torus, triangle};
 use rrt_tests::Rng;
-
-/// Seeds to run: `RRT_SEED` alone if set, else `0..n` (times `RRT_SCALE`
-/// when set, for longer soak runs, e.g. `RRT_SCALE=20` in release mode).
-fn seeds(n: u64) -> Vec<u64> {
-    let scale: u64 = std::env::var("RRT_SCALE")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
-    match std::env::var("RRT_SEED") {
-        Ok(s) => vec![s.parse().expect("RRT_SEED is a number")],
-        Err(_) => (0..n * scale).collect(),
-    }
-}
-
-/// A closed shape voxelized into a fresh plane, with a predicate telling
-/// which voxel centres lie inside it.
-pub struct Voxelized {
-    pub extent: Extent,
-    pub plane: Vec<u8>,
-}
-
-impl Voxelized {
-    pub fn new(extent: Extent, fill: impl FnOnce(&mut PlaneSink<'_>)) -> Self {
-        let mut plane = vec![0u8; extent.len()];
-        let mut sink = PlaneSink::new(extent, &mut plane).unwrap();
-        fill(&mut sink);
-        assert_eq!(sink.outside, 0, "offer outside the raster");
-        Self { extent, plane }
-    }
-
-    /// Fires the probe rays from `origins` in the connectivities matching
-    /// `sep`, each ray only if the centre of its first voxel satisfies
-    /// `inside`; panics naming `what` on a tunnel. Returns the number of rays
-    /// fired.
-    #[track_caller]
-    pub fn check(
-        &mut self,
-        sep: Separation,
-        origins: &[[i64; 3]],
-        rng: &mut Rng,
-        inside: &dyn Fn([i64; 3]) -> bool,
-        what: &str,
-    ) -> u64 {
-        let modes: &[Connectivity] = match sep {
-            Separation::Six => &[Connectivity::Six, Connectivity::Adaptive],
-            Separation::TwentySix => &[Connectivity::TwentySix, Connectivity::Six],
-        };
-        let mut flagged = self.plane.clone();
-        flag_neighbourhood(&mut RasterMut::new(self.extent, &mut flagged).unwrap());
-        let raster = Raster::new(self.extent, &flagged).unwrap();
-        let mut fired = 0u64;
-        for &o in origins {
-            let random: Vec<[i64; 3]> = (0..64)
-                .map(|_| {
-                    let d = [0; 3].map(|_| rng.range_i64(-(1 << 24), 1 << 24));
-                    [o[0] + d[0], o[1] + d[1], o[2] + d[2]]
-                })
-                .collect();
-            for &mode in modes {
-                let targets = probe_targets(o, 3).chain(random.iter().copied());
-                let ok = |v: [u32; 3]| inside(v.map(voxel_centre));
-                match check_closed(&raster, o, mode, targets, ok) {
-                    Ok(n) => fired += u64::from(n),
-                    Err(v) => panic!("{what}: {sep:?} surface has a tunnel: {v:?}"),
-                }
-            }
-        }
-        fired
-    }
-}
-
-/// Up to `n` ray origins in voxels whose centre satisfies `inside`: voxel
-/// centres, low corners (whose rays start in a direction-dependent voxel,
-/// which `Voxelized::check` tests again) and random points.
-pub fn origins(
-    extent: Extent,
-    lo: [i64; 3],
-    hi: [i64; 3],
-    n: usize,
-    rng: &mut Rng,
-    inside: impl Fn([i64; 3]) -> bool,
-) -> Vec<[i64; 3]> {
-    let mut out = Vec::new();
-    let cell = |p: i64| p.div_euclid(VOXEL);
-    for attempt in 0..n * 40 {
-        if out.len() >= n {
-            break;
-        }
-        let p = [0, 1, 2].map(|k| rng.range_i64(lo[k], hi[k]));
-        let v = p.map(cell);
-        if v.iter()
-            .zip(extent.dims())
-            .any(|(&c, d)| c < 0 || c >= i64::from(d))
-        {
-            continue;
-        }
-        let centre = v.map(|c| voxel_centre(c as u32));
-        if !inside(centre) {
-            continue;
-        }
-        // Origin at the centre, at the voxel's low corner, or anywhere in it.
-        out.push(match attempt % 3 {
-            0 => centre,
-            1 => v.map(|c| c * VOXEL),
-            _ => p,
-        });
-    }
-    out
-}
+use rrt_tests::mesh::{box_mesh, fit, inside_mesh, read_obj};
+use rrt_tests::tunnel::{Voxelized, assert_tunnel_free_both, origins, seeds};
 
 #[test]
 fn spheres_are_tunnel_free() {
@@ -137,10 +29,10 @@ fn spheres_are_tunnel_free() {
         let mut rng = Rng::new(seed);
         // Radii from half a voxel to 14 voxels, some on exact lattice values.
         let r = match seed % 4 {
-            0 => rng.range_i64(VOXEL / 2, 3 * VOXEL),
-            1 => rng.range_i64(1, 14) * VOXEL,
-            2 => rng.range_i64(1, 28) * VOXEL / 2,
-            _ => rng.range_i64(3 * VOXEL, 14 * VOXEL),
+            0 => rng.range(VOXEL / 2, 3 * VOXEL),
+            1 => rng.range(1, 14) * VOXEL,
+            2 => rng.range(1, 28) * VOXEL / 2,
+            _ => rng.range(3 * VOXEL, 14 * VOXEL),
         };
         let n = u32::try_from(2 * (r / VOXEL) + 6).unwrap();
         let extent = Extent::cube(n).unwrap();
@@ -148,7 +40,7 @@ fn spheres_are_tunnel_free() {
         let jitter = |rng: &mut Rng| match seed % 3 {
             0 => mid,
             1 => mid + VOXEL / 2,
-            _ => mid + rng.range_i64(-VOXEL, VOXEL),
+            _ => mid + rng.range(-VOXEL, VOXEL),
         };
         let c = [jitter(&mut rng), jitter(&mut rng), jitter(&mut rng)];
         let s = Sphere {
@@ -162,49 +54,19 @@ fn spheres_are_tunnel_free() {
         let lo = c.map(|v| v - r);
         let hi = c.map(|v| v + r);
         let os = origins(extent, lo, hi, 4, &mut rng, inside);
-        for sep in [Separation::Six, Separation::TwentySix] {
-            let mut v = Voxelized::new(extent, |sink| {
+        rays += assert_tunnel_free_both(
+            extent,
+            &os,
+            &mut rng,
+            &inside,
+            &format!("seed {seed}: {s:?}"),
+            |sep, sink| {
                 sphere::surface(&s, sep, extent, sink).unwrap();
-            });
-            rays += v.check(sep, &os, &mut rng, &inside, &format!("seed {seed}: {s:?}"));
-        }
+            },
+        );
     }
     println!("spheres: {rays} rays, all hit");
     assert!(rays > 100_000);
-}
-
-/// Parity inside test for a closed triangle mesh (float, test-side only).
-pub fn inside_mesh(verts: &[[i64; 3]], faces: &[[u32; 3]], p: [i64; 3]) -> bool {
-    let d = [0.537_7_f64, 0.314_1, 0.782_9];
-    let o = p.map(|c| c as f64);
-    let mut hits = 0;
-    for f in faces {
-        let [a, b, c] = f.map(|i| verts[i as usize].map(|x| x as f64));
-        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let pv = [
-            d[1] * e2[2] - d[2] * e2[1],
-            d[2] * e2[0] - d[0] * e2[2],
-            d[0] * e2[1] - d[1] * e2[0],
-        ];
-        let det = e1[0] * pv[0] + e1[1] * pv[1] + e1[2] * pv[2];
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let t = [o[0] - a[0], o[1] - a[1], o[2] - a[2]];
-        let u = (t[0] * pv[0] + t[1] * pv[1] + t[2] * pv[2]) / det;
-        let q = [
-            t[1] * e1[2] - t[2] * e1[1],
-            t[2] * e1[0] - t[0] * e1[2],
-            t[0] * e1[1] - t[1] * e1[0],
-        ];
-        let v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
-        let s = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
-        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s > 0.0 {
-            hits += 1;
-        }
-    }
-    hits % 2 == 1
 }
 
 /// Unit icosahedron (vertices, outward faces) and octahedron.
@@ -275,28 +137,6 @@ fn platonic(ico: bool) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     }
 }
 
-/// An axis-aligned box as 12 triangles.
-pub fn box_mesh(lo: [i64; 3], hi: [i64; 3]) -> (Vec<[i64; 3]>, Vec<[u32; 3]>) {
-    let v: Vec<[i64; 3]> = (0..8)
-        .map(|i| [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] }))
-        .collect();
-    let f = vec![
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6], // z faces
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7], // y faces
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5], // x faces
-    ];
-    (v, f)
-}
-
 /// Voxelizes a closed mesh with both separations and fires the probes.
 fn check_mesh(
     verts: &[[i64; 3]],
@@ -309,15 +149,10 @@ fn check_mesh(
     let hi = [0, 1, 2].map(|k| verts.iter().map(|v| v[k]).max().unwrap());
     let inside = |p: [i64; 3]| inside_mesh(verts, faces, p);
     let os = origins(extent, lo, hi, 4, rng, inside);
-    let mut rays = 0;
-    for sep in [Separation::Six, Separation::TwentySix] {
-        let mut v = Voxelized::new(extent, |sink| {
-            let r = triangle::mesh(verts, None, faces, sep, extent, sink).unwrap();
-            assert_eq!(r.degenerate, 0);
-        });
-        rays += v.check(sep, &os, rng, &inside, what);
-    }
-    rays
+    assert_tunnel_free_both(extent, &os, rng, &inside, what, |sep, sink| {
+        let r = triangle::mesh(verts, None, faces, sep, extent, sink).unwrap();
+        assert_eq!(r.degenerate, 0);
+    })
 }
 
 #[test]
@@ -325,7 +160,7 @@ fn closed_meshes_are_tunnel_free() {
     let mut rays = 0u64;
     for seed in seeds(160) {
         let mut rng = Rng::new(1000 + seed);
-        let r = rng.range_i64(3 * VOXEL / 2, 14 * VOXEL) as f64;
+        let r = rng.range(3 * VOXEL / 2, 14 * VOXEL) as f64;
         let n = (2.0 * r / VOXEL as f64) as u32 + 6;
         let extent = Extent::cube(n).unwrap();
         let mid = f64::from(n) * VOXEL as f64 / 2.0;
@@ -333,7 +168,7 @@ fn closed_meshes_are_tunnel_free() {
         let verts: Vec<[i64; 3]> = unit
             .iter()
             .map(|u| {
-                let j = [0; 3].map(|_| 1.0 + rng.range_i64(-150, 150) as f64 / 1000.0);
+                let j = [0; 3].map(|_| 1.0 + rng.range(-150, 150) as f64 / 1000.0);
                 let p = [0, 1, 2].map(|k| mid + r * u[k] * j[k]);
                 match seed % 3 {
                     0 => p.map(|c| c as i64),
@@ -367,8 +202,8 @@ fn box_meshes_are_tunnel_free() {
             1 => x / VOXEL * VOXEL + VOXEL / 2,
             _ => x,
         };
-        let lo = [0; 3].map(|_| snap(rng.range_i64(2 * VOXEL, 8 * VOXEL)));
-        let hi = [0; 3].map(|_| snap(rng.range_i64(10 * VOXEL, 17 * VOXEL)));
+        let lo = [0; 3].map(|_| snap(rng.range(2 * VOXEL, 8 * VOXEL)));
+        let hi = [0; 3].map(|_| snap(rng.range(10 * VOXEL, 17 * VOXEL)));
         let (verts, faces) = box_mesh(lo, hi);
         rays += check_mesh(
             &verts,
@@ -382,53 +217,18 @@ fn box_meshes_are_tunnel_free() {
     assert!(rays > 10_000);
 }
 
-/// Reads `v` and `f` lines of an OBJ file (triangles only).
-pub fn read_obj(text: &str) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut v = Vec::new();
-    let mut f = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).map(|x| x.parse().unwrap()).collect();
-                v.push([c[0], c[1], c[2]]);
-            }
-            Some("f") => {
-                let c: Vec<u32> = it
-                    .map(|x| x.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                    .collect();
-                for i in 1..c.len() - 1 {
-                    f.push([c[0], c[i], c[i + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    (v, f)
-}
-
-/// Scales float vertices to fit `n − 2·margin` voxels along the longest axis.
-pub fn fit(v: &[[f64; 3]], n: u32, margin: u32) -> Vec<[i64; 3]> {
-    let lo = [0, 1, 2].map(|k| v.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min));
-    let hi = [0, 1, 2].map(|k| v.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max));
-    let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-    let s = f64::from(n - 2 * margin) * VOXEL as f64 / size;
-    v.iter()
-        .map(|p| [0, 1, 2].map(|k| ((p[k] - lo[k]) * s + f64::from(margin) * VOXEL as f64) as i64))
-        .collect()
-}
-
 #[test]
 fn bunny_is_tunnel_free() {
     let Some(data) = rrt_tests::shared_data() else {
         println!("SKIPPED: ../shared/data not found, bunny test not run");
         return;
     };
-    let Ok(text) = std::fs::read_to_string(data.join("meshes/bunny.obj")) else {
+    let path = data.join("meshes/bunny.obj");
+    if !path.is_file() {
         println!("SKIPPED: meshes/bunny.obj not found");
         return;
-    };
-    let (v, faces) = read_obj(&text);
+    }
+    let (v, faces) = read_obj(&path);
     let mut rays = 0;
     for (i, n) in [48u32, 96].into_iter().enumerate() {
         let verts = fit(&v, n, 3);
@@ -457,17 +257,21 @@ fn boxes_are_tunnel_free() {
             _ => x,
         };
         // Thin boxes too: down to a fraction of a voxel.
-        let lo = [0; 3].map(|_| snap(rng.range_i64(2 * VOXEL, 8 * VOXEL)));
-        let hi = [0, 1, 2].map(|k| lo[k] + 1 + snap(rng.range_i64(VOXEL / 4, 8 * VOXEL)));
+        let lo = [0; 3].map(|_| snap(rng.range(2 * VOXEL, 8 * VOXEL)));
+        let hi = [0, 1, 2].map(|k| lo[k] + 1 + snap(rng.range(VOXEL / 4, 8 * VOXEL)));
         let b = Cuboid { min: lo, max: hi };
         let inside = |p: [i64; 3]| (0..3).all(|k| p[k] > lo[k] && p[k] < hi[k]);
         let os = origins(extent, lo, hi, 4, &mut rng, inside);
-        for sep in [Separation::Six, Separation::TwentySix] {
-            let mut v = Voxelized::new(extent, |sink| {
+        rays += assert_tunnel_free_both(
+            extent,
+            &os,
+            &mut rng,
+            &inside,
+            &format!("seed {seed}: {b:?}"),
+            |sep, sink| {
                 cuboid::surface(&b, sep, extent, sink).unwrap();
-            });
-            rays += v.check(sep, &os, &mut rng, &inside, &format!("seed {seed}: {b:?}"));
-        }
+            },
+        );
     }
     println!("boxes: {rays} rays, all hit");
     assert!(rays > 50_000);
@@ -475,7 +279,7 @@ fn boxes_are_tunnel_free() {
 
 fn unit_axis(rng: &mut Rng) -> [f64; 3] {
     loop {
-        let a = [0; 3].map(|_| rng.range_i64(-1000, 1000) as f64);
+        let a = [0; 3].map(|_| rng.range(-1000, 1000) as f64);
         let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
         if l > 100.0 {
             return a.map(|c| c / l);
@@ -488,11 +292,11 @@ fn tori_are_tunnel_free() {
     let mut rays = 0u64;
     for seed in seeds(60) {
         let mut rng = Rng::new(5000 + seed);
-        let minor = rng.range_i64(VOXEL, 4 * VOXEL);
-        let major = minor + rng.range_i64(VOXEL / 2, 8 * VOXEL);
+        let minor = rng.range(VOXEL, 4 * VOXEL);
+        let major = minor + rng.range(VOXEL / 2, 8 * VOXEL);
         let n = u32::try_from(2 * (major + minor) / VOXEL + 6).unwrap();
         let extent = Extent::cube(n).unwrap();
-        let mid = i64::from(n) * VOXEL / 2 + rng.range_i64(-VOXEL, VOXEL);
+        let mid = i64::from(n) * VOXEL / 2 + rng.range(-VOXEL, VOXEL);
         let a = if seed % 3 == 0 {
             [0.0, 0.0, 1.0]
         } else {
@@ -515,12 +319,16 @@ fn tori_are_tunnel_free() {
         };
         let r = major + minor;
         let os = origins(extent, [mid - r; 3], [mid + r; 3], 5, &mut rng, inside);
-        for sep in [Separation::Six, Separation::TwentySix] {
-            let mut v = Voxelized::new(extent, |sink| {
+        rays += assert_tunnel_free_both(
+            extent,
+            &os,
+            &mut rng,
+            &inside,
+            &format!("seed {seed}: {t:?}"),
+            |sep, sink| {
                 torus::surface(&t, sep, extent, sink).unwrap();
-            });
-            rays += v.check(sep, &os, &mut rng, &inside, &format!("seed {seed}: {t:?}"));
-        }
+            },
+        );
     }
     println!("tori: {rays} rays, all hit");
     assert!(rays > 50_000);
@@ -533,13 +341,13 @@ fn capped_cones_are_tunnel_free() {
         let mut rng = Rng::new(6000 + seed);
         let n = 24u32;
         let extent = Extent::cube(n).unwrap();
-        let pt = |rng: &mut Rng| [0; 3].map(|_| rng.range_i64(7 * VOXEL, 17 * VOXEL));
+        let pt = |rng: &mut Rng| [0; 3].map(|_| rng.range(7 * VOXEL, 17 * VOXEL));
         let (b, a) = (pt(&mut rng), pt(&mut rng));
-        let r0 = rng.range_i64(if seed % 4 == 0 { 0 } else { VOXEL / 2 }, 6 * VOXEL);
+        let r0 = rng.range(if seed % 4 == 0 { 0 } else { VOXEL / 2 }, 6 * VOXEL);
         let r1 = if seed % 5 == 0 {
             r0
         } else {
-            rng.range_i64(VOXEL / 2, 6 * VOXEL)
+            rng.range(VOXEL / 2, 6 * VOXEL)
         };
         let c = Cone {
             base: b,
@@ -569,12 +377,16 @@ fn capped_cones_are_tunnel_free() {
             &mut rng,
             inside,
         );
-        for sep in [Separation::Six, Separation::TwentySix] {
-            let mut v = Voxelized::new(extent, |sink| {
+        rays += assert_tunnel_free_both(
+            extent,
+            &os,
+            &mut rng,
+            &inside,
+            &format!("seed {seed}: {c:?}"),
+            |sep, sink| {
                 cone::capped(&c, sep, extent, sink).unwrap();
-            });
-            rays += v.check(sep, &os, &mut rng, &inside, &format!("seed {seed}: {c:?}"));
-        }
+            },
+        );
     }
     println!("capped cones: {rays} rays, all hit");
     assert!(rays > 50_000);
@@ -620,7 +432,7 @@ fn open_triangles_are_hit_away_from_their_boundary() {
         let mut rng = Rng::new(7000 + seed);
         let n = 32u32;
         let extent = Extent::cube(n).unwrap();
-        let pt = |rng: &mut Rng| [0; 3].map(|_| rng.range_i64(6 * VOXEL, 26 * VOXEL));
+        let pt = |rng: &mut Rng| [0; 3].map(|_| rng.range(6 * VOXEL, 26 * VOXEL));
         let vs = [pt(&mut rng), pt(&mut rng), pt(&mut rng)];
         let f = vs.map(|v| v.map(|c| c as f64));
         let e1 = [0, 1, 2].map(|k| f[1][k] - f[0][k]);
@@ -640,11 +452,10 @@ fn open_triangles_are_hit_away_from_their_boundary() {
             normals: None,
         };
         for sep in [Separation::Six, Separation::TwentySix] {
-            let mut v = Voxelized::new(extent, |sink| {
+            let v = Voxelized::new(extent, |sink| {
                 triangle::triangle(&t, sep, extent, sink).unwrap();
             });
-            let mut flagged = v.plane.clone();
-            flag_neighbourhood(&mut RasterMut::new(extent, &mut flagged).unwrap());
+            let flagged = v.flagged();
             let r = Raster::new(extent, &flagged).unwrap();
             let modes: &[Connectivity] = match sep {
                 Separation::Six => &[Connectivity::Six, Connectivity::Adaptive],
@@ -653,8 +464,8 @@ fn open_triangles_are_hit_away_from_their_boundary() {
             for _ in 0..20 {
                 // A point at least 1.25 voxels (> √3/2 / sin 45°) from every edge.
                 let (a, b) = (
-                    rng.range_i64(0, 1000) as f64 / 1000.0,
-                    rng.range_i64(0, 1000) as f64 / 1000.0,
+                    rng.range(0, 1000) as f64 / 1000.0,
+                    rng.range(0, 1000) as f64 / 1000.0,
                 );
                 let (a, b) = if a + b > 1.0 {
                     (1.0 - a, 1.0 - b)
@@ -687,7 +498,6 @@ fn open_triangles_are_hit_away_from_their_boundary() {
                     );
                 }
             }
-            v.plane.clear();
         }
     }
     println!("open triangles: {rays} rays, all hit");
@@ -705,9 +515,9 @@ fn patches_are_hit_away_from_their_boundary() {
         for (i, row) in control.iter_mut().enumerate() {
             for (j, q) in row.iter_mut().enumerate() {
                 *q = [
-                    (6 + 6 * i as i64) * VOXEL + rng.range_i64(-VOXEL, VOXEL),
-                    (6 + 6 * j as i64) * VOXEL + rng.range_i64(-VOXEL, VOXEL),
-                    16 * VOXEL + rng.range_i64(-4 * VOXEL, 4 * VOXEL),
+                    (6 + 6 * i as i64) * VOXEL + rng.range(-VOXEL, VOXEL),
+                    (6 + 6 * j as i64) * VOXEL + rng.range(-VOXEL, VOXEL),
+                    16 * VOXEL + rng.range(-4 * VOXEL, 4 * VOXEL),
                 ];
             }
         }
@@ -736,8 +546,7 @@ fn patches_are_hit_away_from_their_boundary() {
             let v = Voxelized::new(extent, |sink| {
                 patch::surface(&bp, sep, extent, sink).unwrap();
             });
-            let mut flagged = v.plane.clone();
-            flag_neighbourhood(&mut RasterMut::new(extent, &mut flagged).unwrap());
+            let flagged = v.flagged();
             let r = Raster::new(extent, &flagged).unwrap();
             let modes: &[Connectivity] = match sep {
                 Separation::Six => &[Connectivity::Six, Connectivity::Adaptive],
@@ -745,8 +554,8 @@ fn patches_are_hit_away_from_their_boundary() {
             };
             for _ in 0..20 {
                 let (u, w) = (
-                    rng.range_i64(25, 75) as f64 / 100.0,
-                    rng.range_i64(25, 75) as f64 / 100.0,
+                    rng.range(25, 75) as f64 / 100.0,
+                    rng.range(25, 75) as f64 / 100.0,
                 );
                 let p = eval(u, w);
                 let h = 1e-4;
