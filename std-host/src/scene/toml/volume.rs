@@ -56,12 +56,12 @@ impl Builder<'_> {
                 "uint8" | "u8" => SampleType::U8,
                 "int16" | "i16" => SampleType::I16,
                 "uint16" | "u16" => SampleType::U16,
-                "float" | "f32" => SampleType::F32,
+                "float" | "float32" | "f32" => SampleType::F32,
                 _ => {
                     return Err(self.err(
                         s,
                         &key("raw.type"),
-                        "expected uint8, int16, uint16 or float",
+                        "expected uint8 (u8), int16 (i16), uint16 (u16) or float (float32, f32)",
                     ));
                 }
             };
