@@ -573,3 +573,31 @@ fn an_unknown_key_inside_an_inline_table_names_its_table() {
         "{msg}"
     );
 }
+
+#[test]
+fn an_opacity_ramp_alone_classifies_a_volume() {
+    let volume = |class: &str| {
+        format!(
+            "{CAMERA}[material.m]\n[volume.v]\nmetaballs = {{ dims = [8, 8, 8], min = [-1, -1, -1], max = [1, 1, 1], balls = [[0, 0, 0, 1.0, 1.0]] }}\n{class}\n[[object]]\nmaterial = \"m\"\nvolume = \"v\"\n"
+        )
+    };
+    let d = temp_dir("opacity");
+    let p = d.join("ok.toml");
+    std::fs::write(&p, volume("opacity = [[0.2, 0], [0.6, 1]]")).unwrap();
+    let scene = Scene::load(&p).unwrap();
+    let c = &scene.volumes[0].data.classifier;
+    for (v, opaque) in [
+        (-5.0, false),
+        (0.1, false),
+        (0.39, false),
+        (0.41, true),
+        (3.0, true),
+    ] {
+        assert_eq!(c.is_opaque(v), opaque, "{v}");
+    }
+    let msg = error_of("noiso", &volume("colours = [[0, 1, 1, 1], [1, 0, 0, 0]]"));
+    assert!(
+        msg.contains("bad.toml:") && msg.contains("volume.v.iso: missing"),
+        "{msg}"
+    );
+}

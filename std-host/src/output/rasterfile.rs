@@ -676,16 +676,21 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
     Ok(m)
 }
 
+/// Opens `path` for reading.
+fn open(path: &Path) -> Result<File, RasterFileError> {
+    File::open(path).map_err(|source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot open",
+        source,
+    })
+}
+
 /// The header and meta section of a raster file.
 ///
 /// # Errors
 /// As [`load`], for the header and meta section.
 pub fn info(path: &Path) -> Result<Info, RasterFileError> {
-    let mut file = File::open(path).map_err(|source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot open",
-        source,
-    })?;
+    let mut file = open(path)?;
     let h = read_header(&mut file, path)?;
     let m = read_meta(&mut file, path, &h)?;
     Ok(Info {
@@ -720,11 +725,7 @@ pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError
         what: "cannot read",
         source,
     };
-    let mut file = File::open(path).map_err(|source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot open",
-        source,
-    })?;
+    let mut file = open(path)?;
     let h = read_header(&mut file, path)?;
     progress.set_length(h.file_len);
     progress.set_position(0);
@@ -782,11 +783,7 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         path: path.to_path_buf(),
         what,
     };
-    let mut file = File::open(path).map_err(|source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot open",
-        source,
-    })?;
+    let mut file = open(path)?;
     let h = read_header(&mut file, path)?;
     let m = read_meta(&mut file, path, &h)?;
     let extent =
