@@ -32,25 +32,26 @@ impl Unit {
                 "{msg:26} [{bar:32}] {human_pos}/{human_len} objects {elapsed} eta {eta}"
             }
             Self::Voxels => {
-                "{msg:26} [{bar:32}] {human_pos}/{human_len} voxels ({per_sec}) {elapsed} eta {eta}"
+                "{msg:26} [{bar:32}] {human_pos}/{human_len} voxels {elapsed} eta {eta}"
             }
             Self::Tiles => "{msg:26} [{bar:32}] {human_pos}/{human_len} tiles {elapsed} eta {eta}",
         }
     }
 }
 
-/// Starts a phase on `bar`: its message, unit and length, position 0.
+/// Starts a phase on `bar`: its message, unit and length; position,
+/// elapsed time and ETA from zero.
 pub fn phase(bar: &ProgressBar, message: &'static str, unit: Unit, len: u64) {
     if bar.is_hidden() {
         return;
     }
+    // Position, elapsed time and ETA from zero for this phase.
+    bar.reset();
+    bar.set_length(len);
+    bar.set_message(message);
     if let Ok(style) = ProgressStyle::with_template(unit.template()) {
         bar.set_style(style.progress_chars("=> "));
     }
-    bar.set_message(message);
-    bar.set_length(len);
-    bar.set_position(0);
-    bar.reset_eta();
 }
 
 /// A phase whose length is unknown (reading a scene or a raster): a
