@@ -219,7 +219,7 @@ fn absurd_sizes_are_refused_up_front() {
     fails_with(&["render", s, "-o", o, "--raster", "70000"], "--raster");
     fails_with(
         &["render", s, "-o", o, "--width", "0"],
-        "width: expected 1 to 32768 pixels, found 0",
+        "--width <W>': must be positive, found 0",
     );
     fails_with(
         &["render", s, "-o", o, "--width", "100000"],
@@ -228,7 +228,7 @@ fn absurd_sizes_are_refused_up_front() {
     fails_with(&["render", s, "-o", o, "--height", "4000000000"], "height");
     fails_with(
         &["render", s, "-o", o, "--supersample", "0"],
-        "supersample: expected 1 to 16",
+        "--supersample <K>': must be positive, found 0",
     );
     fails_with(
         &["render", s, "-o", o, "--supersample", "17"],

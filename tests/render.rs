@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use indicatif::ProgressBar;
 use rrt_core::Connectivity;
+use rrt_host::output::encoding::{Codes, Encoding, codes};
 use rrt_host::output::png::png_bytes;
 use rrt_host::output::rasterfile;
 use rrt_host::render::camera::Camera;
@@ -113,6 +114,8 @@ fn png_is_identical_for_every_thread_count() {
                 png1,
                 "{threads} threads, verify {verify}, supersample {k}"
             );
+            // The linear values behind the sRGB, 16-bit and float outputs too.
+            assert_eq!(img.linear, one.linear, "{threads} threads");
             assert_eq!(s, s1);
         }
         // The scalar primary walk gives the same image as the packets.
@@ -218,7 +221,11 @@ fn saved_raster_renders_like_the_scene() {
         &ProgressBar::hidden(),
     )
     .unwrap();
-    assert_eq!(read_png(&moved).2, img.rgb);
+    // The CLI's default PNG is sRGB-encoded.
+    let Codes::Eight(srgb) = codes(&img, Encoding::default()) else {
+        panic!("8-bit codes expected");
+    };
+    assert_eq!(read_png(&moved).2, srgb);
 
     let info = cli(&["info", rrt.to_str().unwrap()]).unwrap();
     let d = loaded.extent().dims();

@@ -273,7 +273,7 @@ fn missing_file_is_named_with_its_line_and_key() {
             "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nmesh = {{ file = \"nowhere.obj\" }}\n"
         ),
     );
-    assert_located(&msg, 9, "object.mesh.file");
+    assert_located(&msg, 9, "object[0].mesh.file");
     assert!(msg.contains("nowhere.obj: no such file"), "{msg}");
 }
 
@@ -285,7 +285,7 @@ fn huge_volume_is_refused_before_allocating() {
             "{CAMERA}[material.m]\n[volume.v]\nmetaballs = {{ dims = [60000, 60000, 60000], min = [0,0,0], max = [1,1,1], balls = [] }}\niso = 1\n[[object]]\nmaterial = \"m\"\nvolume = \"v\"\n"
         ),
     );
-    assert_located(&msg, 7, "volume.v.metaballs");
+    assert_located(&msg, 8, "volume.v.metaballs");
 }
 
 #[test]
@@ -296,7 +296,7 @@ fn unknown_material_and_solid_are_named() {
             "{CAMERA}[[object]]\nmaterial = \"nope\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n"
         ),
     );
-    assert_located(&msg, 7, "object.material");
+    assert_located(&msg, 7, "object[0].material");
     assert!(msg.contains("no [material.nope]"), "{msg}");
     let msg = error_of(
         "solid",
@@ -304,7 +304,7 @@ fn unknown_material_and_solid_are_named() {
             "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\ncsg = {{ union = [\"a\", \"b\"] }}\n"
         ),
     );
-    assert_located(&msg, 9, "object.csg");
+    assert_located(&msg, 9, "object[0].csg");
     assert!(msg.contains("no [solid.a]"), "{msg}");
 }
 
@@ -487,4 +487,117 @@ torus = { centre = [0, 0, 0], axis = [0, 0, 1], major = 1.5, minor = 0.5 }
     let rrt = d.join("torus.rrt");
     rasterfile::save(&vs, &rrt).unwrap();
     assert_eq!(rasterfile::load(&rrt).unwrap().objects, vs.objects);
+}
+
+/// `msg` names `line:column` and the key path `key`.
+fn assert_at(msg: &str, line: u32, column: u32, key: &str) {
+    assert!(
+        msg.contains(&format!("bad.toml:{line}:{column}: {key}: ")),
+        "want {line}:{column} {key}: {msg}"
+    );
+}
+
+#[test]
+fn a_bad_value_is_located_at_itself_with_its_key_path() {
+    let sphere = |r: &str| {
+        format!(
+            "[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n[[object]]\nmaterial = \"m\"\n\nsphere = {{ centre = [0,0,0], radius = {r} }}\n"
+        )
+    };
+    // A primitive's value in an inline table, in the second object.
+    let msg = error_of("radius", &format!("{CAMERA}[material.m]\n{}", sphere("-2")));
+    assert_at(&msg, 13, 39, "object[1].sphere.radius");
+    assert!(msg.contains("expected a number > 0"), "{msg}");
+    // A camera value.
+    let msg = error_of(
+        "resolution",
+        &format!(
+            "[camera]\nfrom = [0, -5, 1]\nat = [0, 0, 0]\nangle = 40\nresolution = [0, 0]\n[material.m]\n{}",
+            sphere("1")
+        ),
+    );
+    assert_at(&msg, 5, 14, "camera.resolution");
+    let msg = error_of(
+        "angle",
+        &format!(
+            "[camera]\nfrom = [0, -5, 1]\nat = [0, 0, 0]\n  angle = 190\nresolution = [8, 8]\n[material.m]\n{}",
+            sphere("1")
+        ),
+    );
+    assert_at(&msg, 4, 11, "camera.angle");
+    // A material's value.
+    let msg = error_of(
+        "ks",
+        &format!("{CAMERA}[material.m]\nkd = 0.5\nks = -1\n{}", sphere("1")),
+    );
+    assert_at(&msg, 8, 6, "material.m.ks");
+    // A light's value, in the second light.
+    let msg = error_of(
+        "light",
+        &format!(
+            "{CAMERA}[[light]]\nposition = [1, 1, 1]\n[[light]]\nposition = [1, nan, 1]\n[material.m]\n{}",
+            sphere("1")
+        ),
+    );
+    assert_at(&msg, 9, 12, "light[1].position");
+    // A top-level value.
+    let msg = error_of(
+        "background",
+        &format!(
+            "background = [2, 0, 0]\n{CAMERA}[material.m]\n{}",
+            sphere("1")
+        ),
+    );
+    assert_at(&msg, 1, 14, "background");
+}
+
+#[test]
+fn an_unknown_key_inside_an_inline_table_names_its_table() {
+    let msg = error_of(
+        "inline",
+        &format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nbox = {{ min = [0,0,0], scale = 2 }}\n"
+        ),
+    );
+    assert_at(&msg, 9, 24, "object[0].box.scale");
+    assert!(msg.contains("unknown field `scale`"), "{msg}");
+    // A wrong type two inline tables deep.
+    let msg = error_of(
+        "deep",
+        &format!(
+            "{CAMERA}[material.m]\ntexture = {{ checker = {{ size = \"big\", colours = [[0,0,0],[1,1,1]] }} }}\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n"
+        ),
+    );
+    assert!(
+        msg.contains("bad.toml:7:") && msg.contains("material.m.texture.checker.size"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_opacity_ramp_alone_classifies_a_volume() {
+    let volume = |class: &str| {
+        format!(
+            "{CAMERA}[material.m]\n[volume.v]\nmetaballs = {{ dims = [8, 8, 8], min = [-1, -1, -1], max = [1, 1, 1], balls = [[0, 0, 0, 1.0, 1.0]] }}\n{class}\n[[object]]\nmaterial = \"m\"\nvolume = \"v\"\n"
+        )
+    };
+    let d = temp_dir("opacity");
+    let p = d.join("ok.toml");
+    std::fs::write(&p, volume("opacity = [[0.2, 0], [0.6, 1]]")).unwrap();
+    let scene = Scene::load(&p).unwrap();
+    let c = &scene.volumes[0].data.classifier;
+    for (v, opaque) in [
+        (-5.0, false),
+        (0.1, false),
+        (0.39, false),
+        (0.41, true),
+        (3.0, true),
+    ] {
+        assert_eq!(c.is_opaque(v), opaque, "{v}");
+    }
+    let msg = error_of("noiso", &volume("colours = [[0, 1, 1, 1], [1, 0, 0, 0]]"));
+    assert!(
+        msg.contains("bad.toml:") && msg.contains("volume.v.iso: missing"),
+        "{msg}"
+    );
 }

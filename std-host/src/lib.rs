@@ -6,7 +6,7 @@
 //!
 //! ```text
 //!  parse          fit              voxelize (+ light)        trace              render         output
-//!  scene::Scene ─▶ fit::Fitted ─▶ voxelize::VoxelScene ─▶ trace::Tracer ─▶ render::Image ─▶ output::png
+//!  scene::Scene ─▶ fit::Fitted ─▶ voxelize::VoxelScene ─▶ trace::Tracer ─▶ render::Image ─▶ output::image
 //!                                       │     ▲
 //!                                       ▼     │
 //!                                 output::rasterfile (save, load)
@@ -29,8 +29,10 @@
 //!   intersection verification, shading.
 //! * [`render`]: the camera, tiles on rayon's threads, 4×2 blocks of
 //!   primary rays, supersampling.
-//! * [`output`]: PNG, and saved rasters (versioned, checksummed), which are
-//!   read back to render a voxelized scene from any view.
+//! * [`output`]: images (PNG, PPM, OpenEXR, PFM), and saved rasters
+//!   (versioned, checksummed), which are read back to render a voxelized
+//!   scene from any view; every file through a temporary renamed over it.
+//! * [`progress`]: the phases' progress bars.
 //! * [`cli`]: the `rrt` command line; the binary only parses arguments.
 //! * [`world`] and [`frame`]: world-space bounds, rays and hits, and the
 //!   raster's frame, shared by the phases.
@@ -84,6 +86,7 @@ pub mod cli;
 pub mod fit;
 pub mod frame;
 pub mod output;
+pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod shape;

@@ -79,7 +79,8 @@ fn render_errors_exit_non_zero_with_one_message() {
             &["render", "-o", "/no/such/dir/out.png"][..],
             "cannot write /no/such/dir/out.png",
         ),
-        (&["render", "--width", "0"][..], "width: expected 1 to"),
+        (&["render", "--width", "0"][..], "must be positive"),
+        (&["render", "--width", "-5"][..], "must be positive"),
         (&["render", "--raster", "0"][..], "--raster"),
         (
             &["info", "/no/such/file.rrt"][..],
@@ -93,4 +94,121 @@ fn render_errors_exit_non_zero_with_one_message() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
         assert!(out.stdout.is_empty(), "{args:?}");
     }
+}
+
+#[test]
+fn help_says_what_is_accepted() {
+    let text = |args: &[&str]| String::from_utf8(rrt(args).stdout).unwrap();
+    let render = text(&["render", "--help"]);
+    // Help text is wrapped to the terminal: compare words.
+    let words = render.split_whitespace().collect::<Vec<_>>().join(" ");
+    for want in [
+        "An NFF or TOML scene",
+        ".png",
+        ".ppm",
+        ".exr",
+        ".pfm",
+        "--linear",
+        "--bits",
+        "5 to 65536",
+        "Vertical field of view",
+        "top and bottom pixel rows",
+    ] {
+        assert!(words.contains(want), "render --help lacks {want:?}");
+    }
+    // One default per option.
+    let threads = render
+        .split("--threads")
+        .nth(1)
+        .unwrap()
+        .split("\n  -")
+        .next()
+        .unwrap();
+    assert_eq!(threads.matches("default").count(), 1, "{threads}");
+    assert!(text(&["voxelize", "--help"]).contains("An NFF or TOML scene"));
+    let ray = text(&["ray", "--help"]);
+    assert!(ray.contains("--dims") && ray.contains("--raster"));
+}
+
+#[test]
+fn arguments_out_of_range_are_refused_as_the_help_says() {
+    for (args, expect) in [
+        (&["render", "--raster", "4"][..], "5..=65536"),
+        (&["render", "--supersample", "0"][..], "must be positive"),
+        (
+            &["ray", "--origin", "0,0,0", "--dir", "1,0,0"][..],
+            "give --dims NX,NY,NZ for a ray through an empty raster, or --raster",
+        ),
+        (
+            &[
+                "ray", "--dims", "4,4,4", "--origin", "0,0,0", "--dir", "0,0,0",
+            ][..],
+            "a ray needs a direction",
+        ),
+        (
+            &[
+                "ray",
+                "--dims",
+                "4,4,4",
+                "--origin",
+                "0,0,0",
+                "--dir",
+                "0.000001,0,0",
+            ][..],
+            "rounds to zero",
+        ),
+        (
+            &[
+                "render",
+                "-o",
+                "/tmp/rrt-never-written.png",
+                "--raster",
+                "32",
+                "--bounds",
+                "100,100,100,101,101,101",
+            ][..],
+            "contain no geometry",
+        ),
+    ] {
+        let out = rrt(args);
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(expect), "{args:?}: {err}");
+    }
+    assert!(!std::path::Path::new("/tmp/rrt-never-written.png").exists());
+}
+
+#[test]
+fn info_checks_every_checksum() {
+    let dir = std::env::temp_dir().join(format!("rrt-bin-{}-info", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("x.rrt");
+    let made = rrt(&[
+        "voxelize",
+        "-q",
+        "--raster",
+        "40",
+        "-o",
+        f.to_str().unwrap(),
+    ]);
+    assert!(made.status.success());
+    let good = rrt(&["info", f.to_str().unwrap()]);
+    assert!(good.status.success());
+    assert!(
+        String::from_utf8_lossy(&good.stdout).contains("checksums: header and all sections match")
+    );
+    // One flipped bit in the records (the middle of the file) or the plane.
+    let bytes = std::fs::read(&f).unwrap();
+    for at in [bytes.len() / 2, 300, bytes.len() - 10] {
+        let mut bad = bytes.clone();
+        bad[at] ^= 0x10;
+        std::fs::write(&f, &bad).unwrap();
+        let out = rrt(&["info", f.to_str().unwrap()]);
+        assert!(!out.status.success(), "flipped byte {at} not found");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("corrupt"), "{err}");
+        assert!(out.stdout.is_empty());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

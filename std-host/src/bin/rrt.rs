@@ -9,6 +9,13 @@ use rrt_host::cli::{Cli, CliError, run};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Ctrl-C or SIGTERM: remove the outputs' temporary files, keep the old
+    // outputs.
+    if let Err(e) = rrt_host::output::atomic::remove_on_interrupt() {
+        eprintln!(
+            "rrt: warning: cannot handle interruptions ({e}); an interrupted run may leave a temporary file"
+        );
+    }
     let stdout = io::stdout();
     let mut out = io::BufWriter::new(stdout.lock());
     let result = run(&cli, &mut out).and_then(|()| out.flush().map_err(CliError::from));

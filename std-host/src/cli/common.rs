@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 
 use super::CliError;
 use super::ray::ConnectivityArg;
@@ -20,14 +20,19 @@ use crate::world::Bounds;
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/balls2.nff");
 /// The name the built-in scene goes by in messages.
 pub const DEFAULT_SCENE_NAME: &str = "balls2.nff (built-in)";
+/// The smallest `--raster`: one voxel inside the margins.
+pub const MIN_RASTER: i64 = 2 * crate::fit::size::DEFAULT_MARGIN as i64 + 1;
+/// The largest `--raster`: the core's longest raster axis.
+pub const MAX_RASTER: i64 = rrt_core::raster::MAX_AXIS as i64;
 /// Voxels along the longest axis unless `--raster` says otherwise.
 pub const DEFAULT_RASTER: u32 = 1024;
 
 /// How to voxelize a scene.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RasterArgs {
-    /// Voxels along the scene's longest axis [default: 1024].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Voxels along the scene's longest axis, 5 to 65536 (two voxels of
+    /// margin on each side) [default: 1024].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(MIN_RASTER..=MAX_RASTER))]
     pub raster: Option<u32>,
     /// Connectivity of the discrete rays (the surfaces are voxelized thick
     /// enough for it).
@@ -142,7 +147,8 @@ pub struct ViewArgs {
     /// Up direction, `X,Y,Z`.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<DVec3>,
-    /// Angle in degrees between the centres of the outer pixel rows.
+    /// Vertical field of view in degrees: the angle between the centres
+    /// of the top and bottom pixel rows (overrides the scene's `angle`).
     #[arg(long, value_name = "DEGREES")]
     pub angle: Option<f64>,
 }
@@ -162,38 +168,37 @@ impl ViewArgs {
 }
 
 /// A progress bar on stderr when `show` and stderr is a terminal; hidden
-/// otherwise.
+/// otherwise. Each phase names itself and its unit ([`crate::progress`]).
 #[must_use]
 pub fn progress(show: bool) -> ProgressBar {
     if !show || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
-    let bar = ProgressBar::new(0);
-    if let Ok(style) =
-        ProgressStyle::with_template("{msg:24} [{bar:40}] {pos}/{len} {elapsed_precise}")
-    {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
+    ProgressBar::new(0)
 }
 
-/// Reads an NFF scene (the built-in one for `None`).
+/// Reads an NFF or TOML scene (the built-in one for `None`), with a
+/// spinner on `bar` while it parses.
 ///
 /// # Errors
 /// The parser's located error.
-pub fn read_scene(path: Option<&Path>) -> Result<(Scene, Duration), CliError> {
+pub fn read_scene(path: Option<&Path>, bar: &ProgressBar) -> Result<(Scene, Duration), CliError> {
     let t = Instant::now();
     let scene = match path {
-        Some(p) => Scene::load(p)?,
-        None => Scene::parse(DEFAULT_SCENE_NAME, DEFAULT_SCENE.as_bytes())?,
+        Some(p) => {
+            crate::progress::spinner(bar, format!("reading {}", p.display()));
+            Scene::load(p)
+        }
+        None => Scene::parse(DEFAULT_SCENE_NAME, DEFAULT_SCENE.as_bytes()),
     };
-    Ok((scene, t.elapsed()))
+    bar.disable_steady_tick();
+    Ok((scene?, t.elapsed()))
 }
 
 /// Where a render's scene comes from.
 #[derive(Debug)]
 pub enum Loaded {
-    /// Voxelized now from an NFF scene.
+    /// Voxelized now from a scene file.
     Built {
         /// The voxelized scene.
         scene: VoxelScene,
@@ -212,7 +217,8 @@ pub enum Loaded {
 }
 
 /// Loads `path` as a saved raster when it starts with the raster magic,
-/// else parses and voxelizes it as NFF (the built-in scene for `None`).
+/// else parses and voxelizes it as an NFF or TOML scene (the built-in
+/// scene for `None`).
 ///
 /// # Errors
 /// The parser's, builder's or raster file's error; `--raster` or
@@ -241,14 +247,24 @@ pub fn load_or_build(
             }
         }
         let t = Instant::now();
-        let scene = rasterfile::load(p)?;
+        let bar = progress(show_progress);
+        crate::progress::spinner(&bar, format!("loading {}", p.display()));
+        let scene = rasterfile::load(p);
+        bar.finish_and_clear();
+        let scene = scene?;
         return Ok(Loaded::Saved {
             scene,
             load: t.elapsed(),
         });
     }
-    let (scene, parse) = read_scene(path.map(PathBuf::as_path))?;
     let bar = progress(show_progress);
+    let (scene, parse) = match read_scene(path.map(PathBuf::as_path), &bar) {
+        Ok(r) => r,
+        Err(e) => {
+            bar.finish_and_clear();
+            return Err(e);
+        }
+    };
     let mut opts = raster.build_options();
     opts.threads = threads;
     let built = build(&scene, &opts, &bar);
@@ -293,7 +309,7 @@ mod tests {
 
     #[test]
     fn builtin_scene_parses() {
-        let (s, _) = read_scene(None).unwrap();
+        let (s, _) = read_scene(None, &ProgressBar::hidden()).unwrap();
         assert_eq!(s.spheres.len(), 91);
         assert_eq!(&*s.file, DEFAULT_SCENE_NAME);
     }

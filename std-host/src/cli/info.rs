@@ -13,14 +13,24 @@ use rrt_core::voxelize::Separation;
 pub struct InfoArgs {
     /// A raster saved by `rrt voxelize`.
     pub file: PathBuf,
+    /// No progress bar while the checksums are checked.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
-/// Runs `rrt info`, writing the report to `out`.
+/// Runs `rrt info`: checks every section's checksum, then writes the
+/// report to `out`.
 ///
 /// # Errors
-/// [`CliError`] for a file that is not a valid raster.
+/// [`CliError`] for a file that is not a valid raster or whose checksums
+/// do not match.
 pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
     let i = rasterfile::info(&args.file)?;
+    let bar = super::common::progress(!args.quiet);
+    crate::progress::phase(&bar, "checking", crate::progress::Unit::Bytes, 0);
+    let verified = rasterfile::verify(&args.file, &bar);
+    bar.finish_and_clear();
+    verified?;
     let [nx, ny, nz] = i.dims;
     let max =
         i.origin + glam::DVec3::new(f64::from(nx), f64::from(ny), f64::from(nz)) * i.voxel_size;
@@ -63,5 +73,6 @@ pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
         "memory: {} (plane, line level, brick directory, records)",
         Bytes(i.memory)
     )?;
+    writeln!(out, "checksums: header and all sections match")?;
     Ok(())
 }

@@ -22,15 +22,18 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, clap::Subcommand)]
 pub enum Command {
-    /// Render an NFF scene or a saved raster to a PNG (no scene: the
+    /// Render an NFF or TOML scene or a saved raster to an image: PNG,
+    /// PPM, OpenEXR or PFM by the output's extension (no scene: the
     /// built-in 91-sphereflake to rrt.png).
     Render(render::RenderArgs),
-    /// Voxelize an NFF scene once and save the raster, with light
+    /// Voxelize an NFF or TOML scene once and save the raster, with light
     /// visibility and precomputed illumination, for `rrt render`.
     Voxelize(voxelize::VoxelizeArgs),
-    /// Print what a saved raster holds.
+    /// Print what a saved raster holds, after checking every section's
+    /// checksum.
     Info(info::InfoArgs),
-    /// Trace one discrete ray and list its voxels, one `x y z` per line.
+    /// Trace one discrete ray and list its voxels, one `x y z` per line,
+    /// through an empty raster (`--dims`) or a saved one (`--raster`).
     Ray(ray::RayArgs),
 }
 
@@ -74,7 +77,7 @@ pub enum CliError {
     Render(#[from] crate::render::RenderError),
     /// Writing the image.
     #[error(transparent)]
-    Png(#[from] crate::output::png::OutputError),
+    Image(#[from] crate::output::image::OutputError),
     /// A saved raster.
     #[error(transparent)]
     RasterFile(#[from] crate::output::rasterfile::RasterFileError),

@@ -13,10 +13,11 @@ use super::num::{decimal_to_fixed, triple};
 #[derive(Debug, Clone, clap::Args)]
 pub struct RayArgs {
     /// Raster dimensions in voxels, `NX,NY,NZ` (each 1..=65536), for a ray
-    /// through an empty raster.
-    #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_dims, required_unless_present = "raster", conflicts_with = "raster")]
+    /// through an empty raster; one of --dims and --raster is needed.
+    #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_dims, conflicts_with = "raster")]
     pub dims: Option<[u32; 3]>,
-    /// A raster saved by `rrt voxelize`: walk the ray through its scene
+    /// A raster saved by `rrt voxelize` (instead of --dims): walk the ray
+    /// through its scene
     /// (origin and direction in its voxel units), report each hit voxel,
     /// its object id and whether intersection verification accepts it.
     #[arg(long, value_name = "FILE.rrt")]
@@ -24,7 +25,8 @@ pub struct RayArgs {
     /// Ray origin in voxel units (voxel i spans [i, i+1)); decimals allowed.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_origin, allow_hyphen_values = true)]
     pub origin: [i64; 3],
-    /// Ray direction in voxel units per unit of the ray parameter; decimals allowed.
+    /// Ray direction in voxel units per unit of the ray parameter, not
+    /// zero; decimals allowed.
     #[arg(long, value_name = "DX,DY,DZ", value_parser = parse_dir, allow_hyphen_values = true)]
     pub dir: [i32; 3],
     /// Connectivity of the discrete ray.
@@ -78,7 +80,7 @@ fn parse_origin(s: &str) -> Result<[i64; 3], String> {
 }
 
 fn parse_dir(s: &str) -> Result<[i32; 3], String> {
-    triple(s, |p| {
+    let d = triple(s, |p| {
         let v = decimal_to_fixed(p)?;
         i32::try_from(v).map_err(|_| {
             format!(
@@ -86,7 +88,14 @@ fn parse_dir(s: &str) -> Result<[i32; 3], String> {
                 1i64 << (31 - FRAC_BITS)
             )
         })
-    })
+    })?;
+    if d == [0; 3] {
+        return Err(format!(
+            "{s:?} is zero (or rounds to zero in fixed point, 1/{} voxel): a ray needs a direction",
+            1u32 << FRAC_BITS
+        ));
+    }
+    Ok(d)
 }
 
 /// Runs `rrt ray`, writing its report to `out`.
@@ -97,7 +106,12 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
     if let Some(path) = &args.raster {
         return run_saved(args, path, out);
     }
-    let [nx, ny, nz] = args.dims.unwrap_or([1, 1, 1]);
+    let Some([nx, ny, nz]) = args.dims else {
+        return Err(CliError::Arg {
+            arg: "--dims",
+            message: "give --dims NX,NY,NZ for a ray through an empty raster, or --raster FILE.rrt for one through a saved raster".into(),
+        });
+    };
     let extent = Extent::new(nx, ny, nz).map_err(|e| CliError::Arg {
         arg: "--dims",
         message: e.to_string(),

@@ -1,11 +1,11 @@
-//! `rrt render`: an NFF scene or a saved raster to a PNG.
+//! `rrt render`: an NFF or TOML scene or a saved raster to an image.
 
 use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
 use super::common::{Loaded, RasterArgs, ViewArgs, load_or_build, progress, secs};
-use crate::output::png::PngOutput;
+use crate::output::image::{Encoding, ImageOutput};
 use crate::render::camera::Camera;
 use crate::render::{RenderOptions, check_sizes, render};
 use crate::trace::{TraceOptions, Tracer};
@@ -13,17 +13,28 @@ use crate::trace::{TraceOptions, Tracer};
 /// Arguments of `rrt render`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RenderArgs {
-    /// An NFF scene or a raster saved by `rrt voxelize` [default: the
-    /// built-in 91-sphereflake, SPD balls2].
+    /// An NFF or TOML scene or a raster saved by `rrt voxelize`
+    /// [default: the built-in 91-sphereflake, SPD balls2].
     pub scene: Option<PathBuf>,
-    /// The PNG to write.
-    #[arg(short, long, value_name = "OUT.png", default_value = "rrt.png")]
+    /// The image to write; its extension chooses the format: .png (8-bit
+    /// sRGB by default), .ppm (binary), .exr or .pfm (32-bit float,
+    /// linear), or - for PNG on standard output.
+    #[arg(short, long, value_name = "OUT", default_value = "rrt.png")]
     pub output: PathBuf,
+    /// Bits per channel of .png and .ppm output: 8 or 16.
+    #[arg(long, value_name = "8|16", default_value_t = 8, value_parser = parse_bits)]
+    pub bits: u8,
+    /// Write the linear values to .png and .ppm instead of sRGB-encoded
+    /// ones, without a colour-space chunk (viewers show it too dark; for
+    /// comparisons with other renderers' linear output). .exr and .pfm
+    /// are always linear.
+    #[arg(long)]
+    pub linear: bool,
     /// Image width in pixels [default: the scene's resolution].
-    #[arg(long, value_name = "W")]
+    #[arg(long, value_name = "W", value_parser = parse_positive, allow_hyphen_values = true)]
     pub width: Option<u32>,
     /// Image height in pixels [default: the scene's resolution].
-    #[arg(long, value_name = "H")]
+    #[arg(long, value_name = "H", value_parser = parse_positive, allow_hyphen_values = true)]
     pub height: Option<u32>,
     /// Voxelization.
     #[command(flatten)]
@@ -41,9 +52,9 @@ pub struct RenderArgs {
     #[arg(long, requires = "verify")]
     pub exact_shadows: bool,
     /// K×K rays per pixel, box-filtered.
-    #[arg(long, value_name = "K", default_value_t = 1)]
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = parse_positive, allow_hyphen_values = true)]
     pub supersample: u32,
-    /// Threads for the light pass and the render [default: one per core].
+    /// Threads for the light pass and the render (0: one per core).
     #[arg(long, value_name = "T", default_value_t = 0)]
     pub threads: usize,
     /// Walk primary rays in 8-ray packets (4×2 pixel blocks) instead of
@@ -70,7 +81,13 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         args.height.unwrap_or(1),
         args.supersample,
     )?;
-    let png = PngOutput::create(&args.output)?;
+    let output = ImageOutput::create(
+        &args.output,
+        Encoding {
+            bits: args.bits,
+            linear: args.linear,
+        },
+    )?;
     let loaded = load_or_build(args.scene.as_ref(), &args.raster, args.threads, !args.quiet)?;
     let scene = match &loaded {
         Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
@@ -103,8 +120,12 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     );
     bar.finish_and_clear();
     let (image, stats, time) = rendered?;
-    png.write(&image)?;
+    let to_stdout = output.is_stdout();
+    output.write(&image, out)?;
     if !args.quiet {
+        // With the image on standard output, the summary goes to stderr.
+        let mut stderr = std::io::stderr();
+        let out: &mut dyn Write = if to_stdout { &mut stderr } else { out };
         let d = scene.extent().dims();
         let prep = match &loaded {
             Loaded::Built { report, parse, .. } => format!(
@@ -145,4 +166,24 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         )?;
     }
     Ok(())
+}
+
+/// Parses `--bits`: 8 or 16.
+fn parse_bits(s: &str) -> Result<u8, String> {
+    match s.trim() {
+        "8" => Ok(8),
+        "16" => Ok(16),
+        _ => Err(format!("expected 8 or 16, found {s:?}")),
+    }
+}
+
+/// Parses a positive whole number ("must be positive" for zero or a
+/// negative number).
+fn parse_positive(s: &str) -> Result<u32, String> {
+    let t = s.trim();
+    match t.parse::<i64>() {
+        Ok(v) if v <= 0 => Err(format!("must be positive, found {t}")),
+        Ok(v) => u32::try_from(v).map_err(|_| format!("{t} is too large")),
+        Err(_) => Err(format!("expected a whole number, found {s:?}")),
+    }
 }

@@ -1,17 +1,19 @@
-//! `rrt voxelize`: voxelize an NFF scene once and save the raster.
+//! `rrt voxelize`: voxelize an NFF or TOML scene once and save the raster.
 
 use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, RasterArgs, load_or_build, secs};
+use super::common::{Loaded, RasterArgs, load_or_build, progress, secs};
 use crate::fit::Bytes;
+use crate::output::atomic::AtomicFile;
 use crate::output::rasterfile;
+use crate::progress::Unit;
 
 /// Arguments of `rrt voxelize`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct VoxelizeArgs {
-    /// The NFF scene [default: the built-in 91-sphereflake].
+    /// An NFF or TOML scene [default: the built-in 91-sphereflake].
     pub scene: Option<PathBuf>,
     /// The raster file to write.
     #[arg(short, long, value_name = "FILE.rrt")]
@@ -19,7 +21,7 @@ pub struct VoxelizeArgs {
     /// Voxelization.
     #[command(flatten)]
     pub raster: RasterArgs,
-    /// Threads for the light pass [default: one per core].
+    /// Threads for the light pass (0: one per core).
     #[arg(long, value_name = "T", default_value_t = 0)]
     pub threads: usize,
     /// No progress bar and no summary line.
@@ -44,22 +46,14 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
             ),
         });
     }
-    // Fail on an unwritable output before voxelizing (and remove the empty
-    // file again if voxelizing fails).
-    let existed = args.output.exists();
-    std::fs::OpenOptions::new()
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&args.output)
-        .map_err(|source| CliError::Output {
-            path: args.output.clone(),
-            source,
-        })?;
+    // Fail on an unwritable output before voxelizing: the temporary file
+    // beside it is created now, renamed over it when the raster is
+    // complete, and removed on an error or an interruption.
+    let file = AtomicFile::create(&args.output).map_err(|source| CliError::Output {
+        path: args.output.clone(),
+        source,
+    })?;
     let loaded = load_or_build(args.scene.as_ref(), &args.raster, args.threads, !args.quiet);
-    if loaded.is_err() && !existed {
-        let _ = std::fs::remove_file(&args.output);
-    }
     let Loaded::Built {
         scene,
         report,
@@ -72,7 +66,11 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         });
     };
     let t = std::time::Instant::now();
-    let bytes = rasterfile::save(&scene, &args.output)?;
+    let bar = progress(!args.quiet);
+    crate::progress::phase(&bar, "saving", Unit::Bytes, 0);
+    let saved = rasterfile::save_to(&scene, file, &bar);
+    bar.finish_and_clear();
+    let bytes = saved?;
     if !args.quiet {
         let d = scene.extent().dims();
         writeln!(

@@ -47,6 +47,9 @@ use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
+use indicatif::ProgressBar;
+
+use super::atomic::AtomicFile;
 use rrt_core::object_table::MAX_LIGHTS;
 use rrt_core::raster::{Extent, LINE_CELLS};
 use rrt_core::store::{RecordStore, directory_len};
@@ -291,25 +294,49 @@ fn record_from(b: &[u8]) -> VoxelRecord {
 }
 
 /// A writer that checksums and counts what passes through.
-struct Checked<W: Write> {
+struct Checked<'a, W: Write> {
     inner: W,
     crc: crc32fast::Hasher,
     len: u64,
+    progress: &'a ProgressBar,
 }
 
-impl<W: Write> Checked<W> {
+impl<W: Write> Checked<'_, W> {
     fn put(&mut self, b: &[u8]) -> std::io::Result<()> {
         self.crc.update(b);
         self.len += b.len() as u64;
+        self.progress.inc(b.len() as u64);
         self.inner.write_all(b)
     }
 }
 
-/// Writes `scene` to `path` (module docs for the layout).
+/// Writes `scene` to `path` (module docs for the layout) through a
+/// temporary file renamed over `path` when complete
+/// ([`AtomicFile`]); returns the file's length.
 ///
 /// # Errors
 /// [`RasterFileError::Io`] naming the file.
 pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
+    let out = AtomicFile::create(path).map_err(|source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot create",
+        source,
+    })?;
+    save_to(scene, out, &ProgressBar::hidden())
+}
+
+/// Writes `scene` into `out`, opened earlier (so that an unwritable
+/// output is reported before voxelizing), and commits it over its target;
+/// returns the file's length. `progress` counts bytes.
+///
+/// # Errors
+/// [`RasterFileError::Io`] naming the target; the target is untouched.
+pub fn save_to(
+    scene: &VoxelScene,
+    mut out: AtomicFile,
+    progress: &ProgressBar,
+) -> Result<u64, RasterFileError> {
+    let path = &out.target().to_path_buf();
     let io = |what| {
         move |source| RasterFileError::Io {
             path: path.to_path_buf(),
@@ -317,10 +344,16 @@ pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
             source,
         }
     };
-    let mut file = File::create(path).map_err(io("cannot create"))?;
-    let mut w = BufWriter::with_capacity(1 << 20, &mut file);
+    let file = out.file();
+    let mut w = BufWriter::with_capacity(1 << 20, &mut *file);
     w.write_all(&[0u8; HEADER_LEN as usize])
         .map_err(io("cannot write"))?;
+    progress.set_length(
+        scene.plane.len() as u64
+            + scene.directory.len() as u64 * DIRECTORY_ENTRY_LEN
+            + scene.records.len() as u64 * RECORD_LEN,
+    );
+    progress.set_position(0);
     let mut table = Vec::with_capacity(SECTIONS);
     let mut offset = HEADER_LEN;
     for kind in 1..=SECTIONS as u32 {
@@ -328,6 +361,7 @@ pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
             inner: &mut w,
             crc: crc32fast::Hasher::new(),
             len: 0,
+            progress,
         };
         let r: std::io::Result<()> = match kind {
             1 => c.put(&meta_bytes(scene)),
@@ -385,7 +419,7 @@ pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
     h.extend_from_slice(&[0; 4]);
     file.seek(SeekFrom::Start(0)).map_err(io("cannot write"))?;
     file.write_all(&h).map_err(io("cannot write"))?;
-    file.sync_all().map_err(io("cannot write"))?;
+    out.commit().map_err(io("cannot write"))?;
     Ok(offset)
 }
 
@@ -642,16 +676,21 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
     Ok(m)
 }
 
+/// Opens `path` for reading.
+fn open(path: &Path) -> Result<File, RasterFileError> {
+    File::open(path).map_err(|source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot open",
+        source,
+    })
+}
+
 /// The header and meta section of a raster file.
 ///
 /// # Errors
 /// As [`load`], for the header and meta section.
 pub fn info(path: &Path) -> Result<Info, RasterFileError> {
-    let mut file = File::open(path).map_err(|source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot open",
-        source,
-    })?;
+    let mut file = open(path)?;
     let h = read_header(&mut file, path)?;
     let m = read_meta(&mut file, path, &h)?;
     Ok(Info {
@@ -671,6 +710,70 @@ pub fn info(path: &Path) -> Result<Info, RasterFileError> {
     })
 }
 
+/// Checks every section's checksum and that everything between and after
+/// the sections (the header's last word, the padding) is zero, reading
+/// the file once in 1 MiB pieces (nothing is kept); `progress` counts
+/// bytes.
+///
+/// # Errors
+/// As [`load`] for the header, then [`RasterFileError::Checksum`] naming
+/// the first section that does not match, or [`RasterFileError::Invalid`]
+/// for a non-zero padding byte.
+pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError> {
+    let io = |source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot read",
+        source,
+    };
+    let mut file = open(path)?;
+    let h = read_header(&mut file, path)?;
+    progress.set_length(h.file_len);
+    progress.set_position(0);
+    let mut order: Vec<usize> = (0..SECTIONS).collect();
+    order.sort_by_key(|&k| h.sections[k].1);
+    // The zero word after the header's checksum, then each section and
+    // the padding after it (to the next section or the end of the file).
+    let mut pieces = vec![(None, HEADER_LEN - 4, 4)];
+    for (n, &k) in order.iter().enumerate() {
+        let (_, off, len) = h.sections[k];
+        let end = off.saturating_add(len);
+        let next = order
+            .get(n + 1)
+            .map_or(h.file_len, |&j| h.sections[j].1)
+            .max(end);
+        pieces.push((Some(k), off, len));
+        pieces.push((None, end, next - end));
+    }
+    let mut buf = vec![0u8; 1 << 20];
+    for (section, off, len) in pieces {
+        file.seek(SeekFrom::Start(off)).map_err(io)?;
+        let mut hasher = crc32fast::Hasher::new();
+        let mut left = len;
+        while left > 0 {
+            let take = usize::try_from(left).map_or(buf.len(), |l| l.min(buf.len()));
+            file.read_exact(&mut buf[..take]).map_err(io)?;
+            if section.is_none() && buf[..take].iter().any(|&b| b != 0) {
+                return Err(RasterFileError::Invalid {
+                    path: path.to_path_buf(),
+                    what: format!("non-zero padding between bytes {off} and {}", off + len),
+                });
+            }
+            hasher.update(&buf[..take]);
+            left -= take as u64;
+            progress.inc(take as u64);
+        }
+        if let Some(k) = section
+            && hasher.finalize() != h.sections[k].0
+        {
+            return Err(RasterFileError::Checksum {
+                path: path.to_path_buf(),
+                section: NAMES[k],
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Loads a raster file (module docs).
 ///
 /// # Errors
@@ -680,11 +783,7 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         path: path.to_path_buf(),
         what,
     };
-    let mut file = File::open(path).map_err(|source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot open",
-        source,
-    })?;
+    let mut file = open(path)?;
     let h = read_header(&mut file, path)?;
     let m = read_meta(&mut file, path, &h)?;
     let extent =

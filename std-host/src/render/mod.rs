@@ -41,14 +41,20 @@ pub const MAX_SUPERSAMPLE: u32 = 16;
 pub const MAX_PRIMARY_RAYS: u64 = 1 << 32;
 
 /// An 8-bit RGB image, rows top to bottom.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Image {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// `3 · width · height` bytes, RGB.
+    /// `3 · width · height` bytes, RGB, rows top to bottom: the linear
+    /// colour clamped to `[0, 1]` and rounded to 8 bits
+    /// ([`shading::to_rgb8`]).
     pub rgb: Vec<u8>,
+    /// `3 · width · height` linear RGB values, unclamped (each pixel's
+    /// mean of its samples, as `f32`), for the sRGB, 16-bit and HDR
+    /// outputs.
+    pub linear: Vec<f32>,
 }
 
 /// How to render.
@@ -140,8 +146,7 @@ pub fn render(
     let tiles_x = w.div_ceil(TILE_W);
     let tiles_y = h.div_ceil(TILE_H);
     let tiles = u64::from(tiles_x) * u64::from(tiles_y);
-    progress.set_length(tiles);
-    progress.set_message("rendering");
+    crate::progress::phase(progress, "rendering", crate::progress::Unit::Tiles, tiles);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
@@ -170,6 +175,7 @@ pub fn render(
     let mut done: Vec<(u64, TileResult)> = per_thread.into_iter().flatten().collect();
     done.sort_unstable_by_key(|&(t, _)| t);
     let mut rgb = vec![0u8; 3 * w as usize * h as usize];
+    let mut linear = vec![0f32; 3 * w as usize * h as usize];
     let mut stats = RayStats::default();
     for (t, (pixels, s)) in &done {
         stats.add(s);
@@ -179,8 +185,9 @@ pub fn render(
         for (j, row) in pixels.chunks(tw as usize).enumerate() {
             let y = y0 as usize + j;
             let at = 3 * (y * w as usize + x0 as usize);
-            for (i, p) in row.iter().enumerate() {
+            for (i, (p, l)) in row.iter().enumerate() {
                 rgb[at + 3 * i..at + 3 * i + 3].copy_from_slice(p);
+                linear[at + 3 * i..at + 3 * i + 3].copy_from_slice(l);
             }
         }
     }
@@ -189,6 +196,7 @@ pub fn render(
             width: w,
             height: h,
             rgb,
+            linear,
         },
         stats,
         elapsed,
@@ -196,7 +204,7 @@ pub fn render(
 }
 
 /// One tile's pixels, row by row, and its ray counts.
-type TileResult = (Vec<[u8; 3]>, RayStats);
+type TileResult = (Vec<([u8; 3], [f32; 3])>, RayStats);
 
 /// Renders the tile whose top left pixel is `(x0, y0)`.
 fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, x0: u32, y0: u32) -> TileResult {
@@ -230,7 +238,12 @@ fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, x0: u32, y0: u32) -
     }
     let n = f64::from(k * k);
     (
-        sums.iter().map(|s| shading::to_rgb8(*s / n)).collect(),
+        sums.iter()
+            .map(|s| {
+                let c = *s / n;
+                (shading::to_rgb8(c), c.as_vec3().to_array())
+            })
+            .collect(),
         stats,
     )
 }

@@ -10,6 +10,7 @@
 //! into a copy of the records (one more record array while the pass
 //! runs), since the store they read must stay whole.
 
+use indicatif::ProgressBar;
 use rayon::prelude::*;
 use rrt_core::light::{LightError, LightParams, LightReport, illuminate_run};
 use rrt_core::object_table::{Light, Lights, Materials, Object, ObjectTable};
@@ -66,7 +67,8 @@ impl LightScene {
     }
 
     /// The lit copy of `store`'s records, computed on `threads` threads (0:
-    /// one per core), and the pass's counts.
+    /// one per core), and the pass's counts; `progress` counts records as
+    /// their runs finish.
     ///
     /// # Errors
     /// The core's [`LightError`]; threads that cannot be started.
@@ -76,6 +78,7 @@ impl LightScene {
         store: &RecordStore<'_>,
         params: &LightParams,
         threads: usize,
+        progress: &ProgressBar,
     ) -> Result<(Vec<VoxelRecord>, LightReport), BuildError> {
         let mut storage = vec![Object::UNUSED; self.entries.len()];
         let mut table = ObjectTable::new(&mut storage, &mut []);
@@ -92,7 +95,8 @@ impl LightScene {
             out.par_chunks_mut(LIGHT_RUN)
                 .enumerate()
                 .map(|(i, run)| {
-                    illuminate_run(
+                    let n = run.len() as u64;
+                    let r = illuminate_run(
                         raster,
                         store,
                         i * LIGHT_RUN,
@@ -101,7 +105,9 @@ impl LightScene {
                         &self.materials,
                         &self.lights,
                         params,
-                    )
+                    );
+                    progress.inc(n);
+                    r
                 })
                 .collect()
         });

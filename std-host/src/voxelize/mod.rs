@@ -66,6 +66,7 @@ use self::plane::Plane;
 use self::texture::MaterialTextures;
 use crate::fit::{self, Bytes, FitError, FitOptions};
 use crate::frame::RasterFrame;
+use crate::progress::Unit;
 use crate::scene::{Scene, SourceLoc};
 
 /// How to build.
@@ -125,6 +126,17 @@ pub enum BuildError {
     /// The raster could not be fitted (size, bounds, memory estimate).
     #[error(transparent)]
     Fit(#[from] FitError),
+    /// The explicit bounds hold no surface voxel of any object.
+    #[error(
+        "{file}: the bounds [{}, {}, {}] to [{}, {}, {}] contain no geometry: the image would be empty",
+        bounds.min.x, bounds.min.y, bounds.min.z, bounds.max.x, bounds.max.y, bounds.max.z
+    )]
+    EmptyBounds {
+        /// The scene file.
+        file: String,
+        /// The bounds asked for.
+        bounds: crate::world::Bounds,
+    },
     /// More lights than the records have visibility bits for.
     #[error(
         "{loc}: light {index}: rrt supports at most {MAX_LIGHTS} lights (2 visibility bits each in a voxel record)"
@@ -242,7 +254,6 @@ pub fn build(
     let dir_len =
         directory_len(extent).ok_or_else(|| BuildError::Raster("too many bricks".into()))?;
     let mut directory = vec![0u32; dir_len];
-    progress.set_length(u64::try_from(2 * n).unwrap_or(u64::MAX));
 
     let (sizing, offers) = count_pass(
         &objects,
@@ -253,6 +264,14 @@ pub fn build(
         progress,
     )?;
     let records_n = sizing.records();
+    if let Some(bounds) = opts.fit.bounds
+        && records_n == 0
+    {
+        return Err(BuildError::EmptyBounds {
+            file: scene.file.to_string(),
+            bounds,
+        });
+    }
     let needed = u64::try_from(
         extent
             .len()
@@ -283,12 +302,13 @@ pub fn build(
     let voxelize = t0.elapsed();
 
     let t1 = Instant::now();
-    progress.set_message("light visibility");
+    crate::progress::phase(progress, "light visibility", Unit::Voxels, records_n as u64);
     let (lit, light_report) = LightScene::new(&objects, &materials, &fitted.lights).illuminate(
         &built.raster(),
         &built.store(),
         &opts.light,
         opts.threads,
+        progress,
     )?;
     records = lit;
     let lights_time = t1.elapsed();
@@ -350,7 +370,12 @@ fn count_pass<'p, 'd>(
     directory: &'d mut [u32],
     progress: &ProgressBar,
 ) -> Result<(Sizing<'p, 'd>, u64), BuildError> {
-    progress.set_message("voxelizing (count pass)");
+    crate::progress::phase(
+        progress,
+        "voxelizing (count pass)",
+        Unit::Objects,
+        objects.len() as u64,
+    );
     let raster =
         RasterMut::new(frame.extent, plane).map_err(|e| BuildError::Raster(e.to_string()))?;
     let mut counter = Counter::new(raster, directory)?;
@@ -376,7 +401,12 @@ fn fill_pass<'p, 'd, 'r>(
     textures: &MaterialTextures,
     progress: &ProgressBar,
 ) -> Result<Built<'p, 'd, 'r>, BuildError> {
-    progress.set_message("voxelizing (fill pass)");
+    crate::progress::phase(
+        progress,
+        "voxelizing (fill pass)",
+        Unit::Objects,
+        objects.len() as u64,
+    );
     let limits = Limits {
         objects: u32::try_from(objects.len()).unwrap_or(u32::MAX),
         materials: u32::try_from(materials.list.len()).unwrap_or(u32::MAX),

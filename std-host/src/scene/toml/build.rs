@@ -1,6 +1,7 @@
 //! The builder: a parsed TOML document into a [`Scene`], every value
 //! checked, every error located at its key.
 
+use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -10,6 +11,7 @@ use glam::DVec3;
 
 use super::Options;
 use super::schema::{Doc, V3};
+use super::spans::Spans;
 use crate::scene::error::SceneError;
 use crate::scene::loc::SourceLoc;
 use crate::scene::objects::SceneVolume;
@@ -19,6 +21,11 @@ use crate::scene::{Light, Material, Polygon, Scene, View};
 pub(super) struct Builder<'t> {
     pub(super) file: Arc<str>,
     pub(super) text: &'t str,
+    /// Where each value is, for the errors.
+    pub(super) spans: Spans<'t>,
+    /// The `[[object]]` or `[[light]]` being built and its index: keys
+    /// `object.…` in errors become `object[i].…`.
+    pub(super) entry: Cell<Option<(&'static str, usize)>>,
     pub(super) dir: PathBuf,
     pub(super) opts: Options,
     pub(super) materials: BTreeMap<String, usize>,
@@ -35,17 +42,33 @@ impl Builder<'_> {
         byte_loc(&self.file, self.text.as_bytes(), span.start)
     }
 
+    /// An error about the value at `key` (a dotted path; `object.…` and
+    /// `light.…` are the entry being built), located at the value itself
+    /// when the document has it, else at `span`.
     pub(super) fn err(
         &self,
         span: std::ops::Range<usize>,
         key: &str,
         msg: impl Into<String>,
     ) -> SceneError {
+        let key = self.full_key(key);
+        let at = self.spans.value(&key).unwrap_or(span);
         SceneError::Toml {
-            loc: self.loc(span),
-            key: key.to_owned(),
+            loc: self.loc(at),
+            key,
             msg: msg.into(),
         }
+    }
+
+    /// `key` with the index of the `[[object]]` or `[[light]]` being built.
+    fn full_key(&self, key: &str) -> String {
+        if let Some((list, i)) = self.entry.get()
+            && let Some(rest) = key.strip_prefix(list)
+            && (rest.is_empty() || rest.starts_with('.'))
+        {
+            return format!("{list}[{i}]{rest}");
+        }
+        key.to_owned()
     }
 
     pub(super) fn vec3(
@@ -108,7 +131,8 @@ impl Builder<'_> {
                     self.err(0..0, "background", "expected colour channels in [0, 1]")
                 })?;
         }
-        for l in &doc.light {
+        for (i, l) in doc.light.iter().enumerate() {
+            self.entry.set(Some(("light", i)));
             let s = l.span();
             let d = l.get_ref();
             scene.lights.push(Light {
@@ -127,9 +151,12 @@ impl Builder<'_> {
             let sv = self.volume(name, v)?;
             self.volumes.insert(name.clone(), sv);
         }
-        for o in &doc.object {
+        self.entry.set(None);
+        for (i, o) in doc.object.iter().enumerate() {
+            self.entry.set(Some(("object", i)));
             self.object(&mut scene, doc, o)?;
         }
+        self.entry.set(None);
         if scene.has_no_objects() {
             return Err(SceneError::NoObjects {
                 file: Arc::clone(&self.file),

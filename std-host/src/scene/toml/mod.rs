@@ -34,8 +34,10 @@
 //! # Errors
 //! Unknown keys (`deny_unknown_fields`), wrong types, missing keys, bad
 //! values and the errors of the files a scene refers to are
-//! [`SceneError::Toml`] naming the scene file, line and column (from
-//! toml's spans) and the key. Sizes are checked before anything is
+//! [`SceneError::Toml`] naming the scene file, the line and column of the
+//! value itself (from toml's spans) and its full key path
+//! (`object[2].sphere.radius`, arrays counted from 0), inside inline
+//! tables too. Sizes are checked before anything is
 //! allocated: file sizes against their readers' limits, volume and vox
 //! dimensions against [`Options`].
 
@@ -44,6 +46,7 @@ mod csg;
 mod material;
 mod object;
 mod schema;
+mod spans;
 mod volume;
 
 use std::collections::BTreeMap;
@@ -52,6 +55,7 @@ use std::sync::Arc;
 
 use self::build::Builder;
 use self::schema::Doc;
+use self::spans::Spans;
 use super::Scene;
 use super::error::SceneError;
 use super::text::{byte_loc, read_text};
@@ -107,15 +111,25 @@ pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene
     let file: Arc<str> = Arc::from(file);
     let doc: Doc = ::toml::from_str(text).map_err(|e| {
         let at = e.span().map_or(0, |s| s.start);
+        // The full path of the key at the error (an unknown key inside an
+        // inline table, a wrong-typed value); the key on the line for a
+        // document that does not parse.
+        let path = Spans::new(text).path_at(at);
         SceneError::Toml {
             loc: byte_loc(&file, text.as_bytes(), at),
-            key: key_before(text, at),
+            key: if path.is_empty() {
+                key_before(text, at)
+            } else {
+                path
+            },
             msg: e.message().trim().to_owned(),
         }
     })?;
     Builder {
         file,
         text,
+        spans: Spans::new(text),
+        entry: std::cell::Cell::new(None),
         dir: dir.to_path_buf(),
         opts: *opts,
         materials: BTreeMap::new(),

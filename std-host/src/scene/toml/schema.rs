@@ -166,7 +166,9 @@ pub(super) struct VolumeDef {
     pub(super) raw: Option<RawDef>,
     #[serde(default)]
     pub(super) metaballs: Option<MetaballsDef>,
-    pub(super) iso: f64,
+    /// Required unless `opacity` is given.
+    #[serde(default)]
+    pub(super) iso: Option<f64>,
     #[serde(default)]
     pub(super) opacity: Option<Vec<[f64; 2]>>,
     #[serde(default)]

@@ -56,12 +56,12 @@ impl Builder<'_> {
                 "uint8" | "u8" => SampleType::U8,
                 "int16" | "i16" => SampleType::I16,
                 "uint16" | "u16" => SampleType::U16,
-                "float" | "f32" => SampleType::F32,
+                "float" | "float32" | "f32" => SampleType::F32,
                 _ => {
                     return Err(self.err(
                         s,
                         &key("raw.type"),
-                        "expected uint8, int16, uint16 or float",
+                        "expected uint8 (u8), int16 (i16), uint16 (u16) or float (float32, f32)",
                     ));
                 }
             };
@@ -123,7 +123,19 @@ impl Builder<'_> {
         key: &dyn Fn(&str) -> String,
     ) -> Result<Classifier, SceneError> {
         let s = s.clone();
-        let mut classifier = Classifier::iso(d.iso);
+        // With an opacity ramp and no iso-value, the ramp alone decides.
+        let iso = match (d.iso, &d.opacity) {
+            (Some(iso), _) => iso,
+            (None, Some(_)) => f64::MIN,
+            (None, None) => {
+                return Err(self.err(
+                    s,
+                    &key("iso"),
+                    "missing: give an iso-value, an opacity ramp, or both",
+                ));
+            }
+        };
+        let mut classifier = Classifier::iso(iso);
         if let Some(o) = &d.opacity {
             let ramp = Ramp::new(o.iter().map(|p| (p[0], p[1])).collect())
                 .map_err(|e| self.err(s.clone(), &key("opacity"), e.to_string()))?;

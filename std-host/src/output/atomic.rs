@@ -1,0 +1,224 @@
+//! Outputs that are either complete or absent: a file is written under a
+//! temporary name in the target's own directory, flushed and synced, and
+//! renamed over the target only when complete.
+//!
+//! An [`AtomicFile`] that is dropped before [`AtomicFile::commit`] (an
+//! error on the way) removes its temporary file. [`remove_on_interrupt`]
+//! installs a SIGINT/SIGTERM (Ctrl-C) handler that removes every pending
+//! temporary file and exits with status 130, so an interrupted run leaves
+//! the old target untouched and nothing beside it. The rename is made
+//! under the same lock the handler takes, so an interruption sees either
+//! the old target or the complete new one.
+
+use std::fs::File;
+use std::io;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// Temporary files not yet renamed over their targets.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn pending() -> MutexGuard<'static, Vec<PathBuf>> {
+    PENDING
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// The exit status after an interruption (128 + SIGINT).
+pub const INTERRUPTED_EXIT: i32 = 130;
+
+/// Installs the SIGINT/SIGTERM handler (once per process; later calls do
+/// nothing): it removes the pending temporary files, says so on stderr
+/// and exits with [`INTERRUPTED_EXIT`].
+///
+/// # Errors
+/// The handler could not be installed.
+pub fn remove_on_interrupt() -> Result<(), ctrlc::Error> {
+    match ctrlc::set_handler(|| {
+        let files = pending();
+        for f in files.iter() {
+            let _ = std::fs::remove_file(f);
+        }
+        eprintln!("rrt: interrupted; no output written");
+        std::process::exit(INTERRUPTED_EXIT);
+    }) {
+        Err(ctrlc::Error::MultipleHandlers) => Ok(()),
+        r => r,
+    }
+}
+
+/// A file being written under a temporary name beside its target.
+#[derive(Debug)]
+pub struct AtomicFile {
+    target: PathBuf,
+    tmp: PathBuf,
+    file: Option<File>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file `NAME.PID-N.tmp` in `target`'s
+    /// directory (`N` counts the outputs of this process).
+    ///
+    /// # Errors
+    /// `target` is a directory or has no file name, or the temporary file
+    /// cannot be created (missing folder, no permission).
+    pub fn create(target: &Path) -> io::Result<Self> {
+        static COUNT: AtomicU64 = AtomicU64::new(0);
+        if target.is_dir() {
+            return Err(io::Error::new(
+                io::ErrorKind::IsADirectory,
+                "is a directory",
+            ));
+        }
+        let Some(name) = target.file_name() else {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "not a file name",
+            ));
+        };
+        let mut tmp_name = name.to_owned();
+        tmp_name.push(format!(
+            ".{}-{}.tmp",
+            std::process::id(),
+            COUNT.fetch_add(1, Ordering::Relaxed)
+        ));
+        let tmp = target.with_file_name(tmp_name);
+        // Registered before it exists, so an interruption between the two
+        // cannot leave it behind.
+        let mut list = pending();
+        list.push(tmp.clone());
+        let file = File::options().write(true).create_new(true).open(&tmp);
+        if file.is_err() {
+            list.retain(|p| *p != tmp);
+        }
+        drop(list);
+        Ok(Self {
+            target: target.to_path_buf(),
+            tmp,
+            file: Some(file?),
+        })
+    }
+
+    /// The target path.
+    #[must_use]
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// The temporary path being written.
+    #[must_use]
+    pub fn temporary(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// The open temporary file.
+    ///
+    /// # Panics
+    /// Never: the file is only taken by `commit`, which consumes `self`.
+    pub fn file(&mut self) -> &mut File {
+        self.file.as_mut().expect("open until committed")
+    }
+
+    /// Syncs the temporary file and renames it over the target (then
+    /// syncs the directory, where the platform allows).
+    ///
+    /// # Errors
+    /// Syncing or renaming failed; the temporary file is removed and the
+    /// target is untouched.
+    pub fn commit(mut self) -> io::Result<()> {
+        let file = self.file.take().expect("open until committed");
+        if let Err(e) = file.sync_all() {
+            self.discard();
+            return Err(e);
+        }
+        drop(file);
+        let mut list = pending();
+        let renamed = std::fs::rename(&self.tmp, &self.target);
+        if renamed.is_err() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+        list.retain(|p| *p != self.tmp);
+        drop(list);
+        renamed?;
+        #[cfg(unix)]
+        if let Some(dir) = self.target.parent() {
+            let dir = if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            };
+            if let Ok(d) = File::open(dir) {
+                let _ = d.sync_all();
+            }
+        }
+        Ok(())
+    }
+
+    fn discard(&mut self) {
+        self.file = None;
+        let mut list = pending();
+        let _ = std::fs::remove_file(&self.tmp);
+        list.retain(|p| *p != self.tmp);
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        // Not committed (an error on the way): remove the temporary file.
+        if self.file.is_some() {
+            self.discard();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("rrt-atomic-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn names(d: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn commit_replaces_the_target_and_drop_keeps_it() {
+        use std::io::Write;
+        let d = dir("commit");
+        let target = d.join("x.bin");
+        std::fs::write(&target, b"old").unwrap();
+        let mut f = AtomicFile::create(&target).unwrap();
+        f.file().write_all(b"half").unwrap();
+        assert_eq!(names(&d).len(), 2);
+        drop(f);
+        assert_eq!(std::fs::read(&target).unwrap(), b"old");
+        assert_eq!(names(&d), ["x.bin"]);
+        let mut f = AtomicFile::create(&target).unwrap();
+        f.file().write_all(b"new").unwrap();
+        f.commit().unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        assert_eq!(names(&d), ["x.bin"]);
+        assert!(pending().is_empty() || !pending().iter().any(|p| p.starts_with(&d)));
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn directories_and_missing_folders_are_refused() {
+        let d = dir("refuse");
+        assert!(AtomicFile::create(&d).is_err());
+        assert!(AtomicFile::create(&d.join("no/such/x.png")).is_err());
+        assert!(names(&d).is_empty());
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}
