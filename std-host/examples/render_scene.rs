@@ -7,7 +7,7 @@
 //! Without a scene it renders a small built-in one (a ball over a floor).
 
 use indicatif::ProgressBar;
-use rrt_host::output::png::PngOutput;
+use rrt_host::output::{encoding::Encoding, image::ImageOutput};
 use rrt_host::render::camera::Camera;
 use rrt_host::render::{RenderOptions, render};
 use rrt_host::scene::Scene;
@@ -40,7 +40,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let [w, h] = voxels.view.resolution;
     let camera = Camera::new(&voxels.view, w, h)?;
     let (image, stats, _) = render(&tracer, &camera, &RenderOptions::default(), &quiet)?;
-    PngOutput::create(out.as_ref())?.write(&image)?;
+    ImageOutput::create(out.as_ref(), Encoding::default())?
+        .write(&image, &mut std::io::stdout())?;
 
     println!(
         "{out}: {w}×{h}, {} surface voxels, {} rays",

@@ -15,7 +15,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use indicatif::ProgressBar;
 use rrt_host::assets::volume::{Classifier, ColorRamp, Grid, Placement, Samples, Volume};
-use rrt_host::output::png::PngOutput;
+use rrt_host::output::{encoding::Encoding, image::ImageOutput};
 use rrt_host::render::camera::Camera;
 use rrt_host::render::{RenderOptions, render};
 use rrt_host::scene::{Scene, SceneVolume, SourceLoc, VolumeObject};
@@ -81,7 +81,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let [w, h] = voxels.view.resolution;
     let camera = Camera::new(&voxels.view, w, h)?;
     let (image, _, _) = render(&tracer, &camera, &RenderOptions::default(), &quiet)?;
-    PngOutput::create(out.as_ref())?.write(&image)?;
+    ImageOutput::create(out.as_ref(), Encoding::default())?
+        .write(&image, &mut std::io::stdout())?;
     println!("{out}: {w}×{h}, {} surface voxels", report.records);
     Ok(())
 }
