@@ -140,7 +140,9 @@ pub fn build(extent: Extent, objects: &[Voxelize<'_>], limits: Limits) -> Scene 
     let sizing = counter.finish().unwrap();
     let mut records = vec![VoxelRecord::default(); sizing.records()];
     let mut lists = vec![0u32; sizing.list_entries()];
-    let mut filler = sizing.fill(&mut records, &mut lists, limits).unwrap();
+    let mut filler = sizing
+        .fill_with_lists(&mut records, &mut lists, limits)
+        .unwrap();
     for (attrs, f) in objects {
         filler.begin_object(*attrs).unwrap();
         f(&mut filler);

@@ -116,7 +116,7 @@ fn rays_from_outside_hit_the_cut() {
     let mut records = vec![VoxelRecord::default(); sizing.records()];
     let mut lists = vec![0u32; sizing.list_entries()];
     let mut filler = sizing
-        .fill(
+        .fill_with_lists(
             &mut records,
             &mut lists,
             Limits {

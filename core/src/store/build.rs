@@ -255,20 +255,45 @@ impl<'p, 'd> Sizing<'p, 'd> {
         usize::try_from(bound).unwrap_or(usize::MAX)
     }
 
-    /// Starts the fill pass into `records` (only its first
-    /// [`Sizing::records`] entries are used) and the object-list storage
-    /// `lists` (working space while the pass runs; the finished lists are
-    /// the front of it, [`Built::lists`]). [`Sizing::list_entries`] entries
-    /// always suffice; fewer may (the bound is loose), and when they do not,
-    /// [`Filler::finish`] says so.
+    /// Starts the paper's fill pass into `records` (only its first
+    /// [`Sizing::records`] entries are used): one object per voxel, its
+    /// owner (see *Overlap* in [`crate::store`]), and no object lists.
     ///
     /// # Errors
     /// [`BuildError::RecordStorage`] if `records` is too short.
-    pub fn fill<'r>(
+    pub fn fill(
+        self,
+        records: &mut [VoxelRecord],
+        limits: Limits,
+    ) -> Result<Filler<'p, 'd, '_>, BuildError> {
+        self.start_fill(records, &mut [], limits, false)
+    }
+
+    /// Starts the fill pass into `records` (as [`Sizing::fill`]) and the
+    /// object-list storage `lists` (working space while the pass runs; the
+    /// finished lists are the front of it, [`Built::lists`]): every voxel
+    /// several objects offered gets the list of all of them.
+    /// [`Sizing::list_entries`] entries always suffice; fewer may (the
+    /// bound is loose), and when they do not, [`Filler::finish`] says so
+    /// ([`BuildError::ListStorage`]).
+    ///
+    /// # Errors
+    /// [`BuildError::RecordStorage`] if `records` is too short.
+    pub fn fill_with_lists<'r>(
         self,
         records: &'r mut [VoxelRecord],
         lists: &'r mut [u32],
         limits: Limits,
+    ) -> Result<Filler<'p, 'd, 'r>, BuildError> {
+        self.start_fill(records, lists, limits, true)
+    }
+
+    fn start_fill<'r>(
+        self,
+        records: &'r mut [VoxelRecord],
+        lists: &'r mut [u32],
+        limits: Limits,
+        listing: bool,
     ) -> Result<Filler<'p, 'd, 'r>, BuildError> {
         let found = records.len();
         let records = records
@@ -292,6 +317,7 @@ impl<'p, 'd> Sizing<'p, 'd> {
             uncounted: 0,
             no_object: 0,
             unlisted: 0,
+            listing,
             slab: self.slab,
         })
     }
@@ -338,6 +364,9 @@ pub struct Filler<'p, 'd, 'r> {
     uncounted: u64,
     no_object: u64,
     unlisted: u64,
+    /// Whether voxels several objects offer get object lists
+    /// ([`Sizing::fill_with_lists`]) or keep their owner only.
+    listing: bool,
     slab: Option<u32>,
 }
 
@@ -498,7 +527,7 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
         let nearer = (key >> crate::voxel::KEY_DISTANCE_SHIFT) < r.distance();
         let owner = r.object;
         let mut head = chain_head(r);
-        if attrs.object != owner {
+        if self.listing && attrs.object != owner {
             // The chain holds every object of the voxel but its owner, once.
             let listed = chain(self.lists, head).find(|&(_, o)| o == attrs.object);
             let add = match (nearer, listed) {

@@ -116,7 +116,7 @@
 //! let sizing = counter.finish().unwrap();
 //! let mut records = vec![VoxelRecord::default(); sizing.records()];
 //! let mut lists = vec![0u32; sizing.list_entries()];
-//! let mut filler = sizing.fill(&mut records, &mut lists, Limits { objects: 1, materials: 1 }).unwrap();
+//! let mut filler = sizing.fill_with_lists(&mut records, &mut lists, Limits { objects: 1, materials: 1 }).unwrap();
 //! filler.begin_object(ObjectAttrs { object: 0, material: 0, color: [255, 0, 0] }).unwrap();
 //! row(&mut filler);
 //! let built = filler.finish().unwrap();

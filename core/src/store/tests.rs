@@ -87,7 +87,7 @@ fn build_with(
         objects: script.len() as u32,
         materials: 1,
     };
-    let mut filler = sizing.fill(&mut records, &mut lists, limits)?;
+    let mut filler = sizing.fill_with_lists(&mut records, &mut lists, limits)?;
     for (id, obj) in script.iter().enumerate() {
         filler.begin_object(ObjectAttrs {
             object: id as u32,
@@ -260,7 +260,6 @@ fn textured_fill_colours_from_centre_and_normal() {
     let mut f = sizing
         .fill(
             &mut recs,
-            &mut [],
             Limits {
                 objects: 1,
                 materials: 1,
@@ -321,10 +320,7 @@ fn build_errors() {
         materials: 3,
     };
     assert_eq!(
-        c.finish()
-            .unwrap()
-            .fill(&mut one, &mut [], lim)
-            .unwrap_err(),
+        c.finish().unwrap().fill(&mut one, lim).unwrap_err(),
         BuildError::RecordStorage {
             needed: 2,
             found: 1
@@ -340,9 +336,7 @@ fn build_errors() {
         c.offer([9, 1, 1], surfel(0));
         c.finish().unwrap()
     }
-    let mut f = start(e, &mut plane, &mut dir)
-        .fill(&mut recs, &mut [], lim)
-        .unwrap();
+    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
     let attrs = ObjectAttrs {
         object: 2,
         material: 0,
@@ -373,9 +367,7 @@ fn build_errors() {
         BuildError::OfferWithoutObject { offers: 1 }
     );
 
-    let mut f = start(e, &mut plane, &mut dir)
-        .fill(&mut recs, &mut [], lim)
-        .unwrap();
+    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
     f.begin_object(ObjectAttrs { object: 1, ..attrs }).unwrap();
     f.offer([1, 1, 1], surfel(0));
     f.offer([9, 1, 1], surfel(0));
@@ -385,9 +377,7 @@ fn build_errors() {
         BuildError::PassMismatch { uncounted: 1 }
     );
 
-    let mut f = start(e, &mut plane, &mut dir)
-        .fill(&mut recs, &mut [], lim)
-        .unwrap();
+    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
     f.begin_object(ObjectAttrs { object: 1, ..attrs }).unwrap();
     f.offer([1, 1, 1], surfel(0));
     assert_eq!(
