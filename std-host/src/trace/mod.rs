@@ -183,10 +183,9 @@ pub struct RayStats {
     /// Discrete hits that verification rejected: the continuous ray does
     /// not meet the voxel's object (the paper's false hits).
     pub false_hits: u64,
-    /// Discrete hits whose own object failed verification but an object
-    /// owning a neighbouring voxel passed it (see [`verify()`]'s use in the
-    /// module docs).
-    pub neighbour_hits: u64,
+    /// Verified hits in voxels that hold more than one object (found
+    /// through the voxel's object list).
+    pub shared_hits: u64,
     /// Rays (of any kind but shadow) that met at least one false hit.
     pub false_hit_rays: u64,
     /// Discrete hits whose object the continuous ray meets only farther
@@ -207,7 +206,7 @@ impl RayStats {
         self.hits += o.hits;
         self.false_hits += o.false_hits;
         self.deferred += o.deferred;
-        self.neighbour_hits += o.neighbour_hits;
+        self.shared_hits += o.shared_hits;
         self.false_hit_rays += o.false_hit_rays;
         self.missing += o.missing;
     }
@@ -223,12 +222,35 @@ impl RayStats {
 #[derive(Clone, Copy, Debug)]
 struct SurfaceHit {
     voxel: [u32; 3],
+    /// The attributes of the object hit (its record).
     rec: VoxelRecord,
+    /// The object hit.
+    object: u32,
+    /// The ray parameter of `point`.
+    t: f64,
     /// World point used for shading and secondary rays.
     point: DVec3,
     /// Unit normal (stored, or true under verification), not turned.
     normal: DVec3,
     verified: bool,
+}
+
+/// What a ray hits ([`Tracer::hit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayHit {
+    /// The object's id in the object table ([`VoxelScene::objects`]).
+    pub object: u32,
+    /// The ray parameter (world units along the unit direction).
+    pub t: f64,
+    /// The world point.
+    pub point: DVec3,
+    /// The unit normal there (the object's true normal when verified, the
+    /// stored one otherwise), not turned towards the ray.
+    pub normal: DVec3,
+    /// The voxel the hit was found from.
+    pub voxel: [u32; 3],
+    /// Verified against the object's exact geometry.
+    pub verified: bool,
 }
 
 /// The renderer over one voxelized scene.
@@ -320,8 +342,10 @@ impl<'s> Tracer<'s> {
         stats: &mut RayStats,
     ) -> DVec3 {
         let mut walk = match leave {
-            None => self.first_walk(ray),
-            Some(rule) => self.secondary_walk(ray, rule, stats),
+            Some(rule) if !self.opts.verify => self.secondary_walk(ray, rule, stats),
+            // Verification tests every object of every opaque voxel with
+            // t > tmin: no voxel is skipped by the acne rule on the way.
+            _ => self.first_walk(ray),
         };
         let tmin = if leave.is_some() {
             self.leaving_tmin()
@@ -374,6 +398,23 @@ impl<'s> Tracer<'s> {
                 self.shade(r, &h, 1, stats)
             }
         }
+    }
+
+    /// The surface a primary ray (unit direction) hits, resolved as the
+    /// renderer resolves it (the discrete hit, or under verification the
+    /// nearest exact intersection), without shading; `None` when it leaves
+    /// the raster. Counts go to `stats` as for a traced ray.
+    pub fn hit(&self, ray: &Ray, stats: &mut RayStats) -> Option<RayHit> {
+        let mut walk = self.first_walk(ray);
+        self.resolve(ray, &mut walk, 0.0, None, stats)
+            .map(|h| RayHit {
+                object: h.object,
+                t: h.t,
+                point: h.point,
+                normal: h.normal,
+                voxel: h.voxel,
+                verified: h.verified,
+            })
     }
 
     /// Traces one primary ray (unit direction) and returns its colour.

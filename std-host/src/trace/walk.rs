@@ -22,9 +22,9 @@ use crate::world::Ray;
 /// non-transparent voxel (`None`: the ray misses the raster).
 #[derive(Clone, Copy, Debug)]
 pub struct FirstWalk {
-    ray: Option<DiscreteRay>,
-    end: WalkEnd,
-    steps: u64,
+    pub(super) ray: Option<DiscreteRay>,
+    pub(super) end: WalkEnd,
+    pub(super) steps: u64,
     /// The record of the hit voxel when the walk's hit test already
     /// fetched it (index, record), so that resolving does not look it up
     /// again.
@@ -183,7 +183,8 @@ impl Tracer<'_> {
     }
 
     /// Resolves a ray's walk into its surface hit: checks the hit voxel
-    /// (record, verification) and resumes the walk past false hits.
+    /// (record, verification) and resumes the walk past false hits
+    /// (verification: [`Tracer::resolve_verified`]).
     pub(super) fn resolve(
         &self,
         ray: &Ray,
@@ -193,13 +194,18 @@ impl Tracer<'_> {
         stats: &mut RayStats,
     ) -> Option<SurfaceHit> {
         let before = stats.false_hits;
-        let hit = self.resolve_walk(ray, walk, tmin, leave, stats);
+        let hit = if self.opts.verify {
+            self.resolve_verified(ray, walk, tmin, leave, stats)
+        } else {
+            self.resolve_walk(ray, walk, tmin, leave, stats)
+        };
         if stats.false_hits > before {
             stats.false_hit_rays += 1;
         }
         hit
     }
 
+    /// The paper's raw mode: the first surface voxel is the hit.
     pub(super) fn resolve_walk(
         &self,
         ray: &Ray,
@@ -213,7 +219,6 @@ impl Tracer<'_> {
         let dray = walk.ray.as_mut()?;
         let mut end = walk.end;
         let o_r = self.frame.world_to_raster(ray.origin);
-        let vs = self.frame.voxel_size;
         loop {
             if end != WalkEnd::Hit {
                 return None;
@@ -226,15 +231,9 @@ impl Tracer<'_> {
                     self.store.get_hinted(h.voxel, c).copied()
                 }
             };
-            let accepted = match &rec {
-                None => {
-                    stats.missing += 1;
-                    None
-                }
-                Some(rec) => self.check_hit(ray, o_r, vs, h.voxel, rec, tmin, leave, stats),
-            };
-            if accepted.is_some() {
-                return accepted;
+            match &rec {
+                None => stats.missing += 1,
+                Some(rec) => return Some(self.discrete_hit(ray, o_r, h.voxel, rec, tmin)),
             }
             // Resume after this voxel.
             let before = dray.steps();
@@ -305,6 +304,6 @@ pub(super) fn surface_voxel<'s>(
         return None;
     };
     leave
-        .is_none_or(|l| !l.ignores_voxel(v, rec))
+        .is_none_or(|l| !l.ignores_voxel(store, v, rec))
         .then_some(rec)
 }
