@@ -3,12 +3,10 @@
 //! walk has reached accepted (module docs of [`crate::trace`]).
 
 use glam::DVec3;
-use rrt_core::discrete_ray::WalkEnd;
 use rrt_core::light::LeavingSurface;
 use rrt_core::raster::cell;
 use rrt_core::voxel::VoxelRecord;
 
-use super::walk::FirstWalk;
 use super::{RayStats, SurfaceHit, Tracer};
 use crate::frame::RasterFrame;
 use crate::voxelize::WorldObject;
@@ -125,7 +123,7 @@ pub const REACH_MARGIN: f64 = 1e-5;
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Candidate {
     /// World ray parameter.
-    t: f64,
+    pub(super) t: f64,
     /// The object.
     object: u32,
     /// Its true unit normal (exact objects).
@@ -312,59 +310,7 @@ impl Tracer<'_> {
         r
     }
 
-    /// Resolves a walk under verification (module docs, *Intersection
-    /// verification*): at each opaque voxel reached, its objects are tested
-    /// ([`Tracer::test_voxel`]); the nearest candidate is the hit as soon
-    /// as its `t` is within the part of the ray the walk has reached (up to
-    /// the continuous ray's exit from the current voxel, plus
-    /// [`REACH_MARGIN`]); otherwise the walk goes on. A walk that leaves the
-    /// raster with a candidate takes it.
-    pub(super) fn resolve_verified(
-        &self,
-        ray: &Ray,
-        walk: &mut FirstWalk,
-        tmin: f64,
-        leave: Option<&LeavingSurface>,
-        stats: &mut RayStats,
-    ) -> Option<SurfaceHit> {
-        stats.steps += walk.steps;
-        let dray = walk.ray.as_mut()?;
-        let mut end = walk.end;
-        let o_r = self.frame.world_to_raster(ray.origin);
-        let vs = self.frame.voxel_size;
-        let mut mail = Mailbox::default();
-        let mut best: Option<Candidate> = None;
-        loop {
-            if end != WalkEnd::Hit {
-                return best.map(|c| self.accept(ray, &c, stats));
-            }
-            let h = dray.hit();
-            let c = self.raster.plane().get(h.index).copied().unwrap_or(0);
-            match self.store.get_hinted(h.voxel, c) {
-                None => stats.missing += 1,
-                Some(rec) => {
-                    self.test_voxel(
-                        ray, o_r, h.voxel, h.index, rec, tmin, leave, &mut mail, &mut best,
-                    );
-                    let reach = (exit_param(o_r, ray.dir, h.voxel) + REACH_MARGIN) * vs;
-                    match &best {
-                        Some(b) if b.t <= reach => return Some(self.accept(ray, b, stats)),
-                        Some(_) => stats.deferred += 1,
-                        None => stats.false_hits += 1,
-                    }
-                }
-            }
-            let before = dray.steps();
-            end = dray
-                .walk_skipping(&self.raster, self.opts.connectivity, u32::MAX, |_, c| {
-                    c & cell::OPAQUE != 0
-                })
-                .unwrap_or(WalkEnd::Exit);
-            stats.steps += u64::from(dray.steps().saturating_sub(before));
-        }
-    }
-
-    fn accept(&self, ray: &Ray, c: &Candidate, stats: &mut RayStats) -> SurfaceHit {
+    pub(super) fn accept(&self, ray: &Ray, c: &Candidate, stats: &mut RayStats) -> SurfaceHit {
         if c.shared {
             stats.shared_hits += 1;
         }
