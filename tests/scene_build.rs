@@ -241,12 +241,15 @@ fn adaptive_rays_match_six_in_a_built_scene() {
         check_adaptive_matches_six(&raster, &ray)
             .unwrap_or_else(|v| panic!("ray {i}: {origin:?} {dir:?}: {v:?}"));
     }
-    // Every plane cell is OPAQUE exactly where a record is, PROXIMITY within
-    // chessboard distance 1 of one, and nothing else.
+    // Every plane cell is OPAQUE exactly where a record is; a transparent
+    // cell holds at most PROXIMITY (an opaque cell's distance bits carry its
+    // record's rank hint).
     let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
     for (i, c) in scene.plane.iter().enumerate() {
         assert_eq!(c & cell::OPAQUE != 0, store.get(i).is_some());
-        assert_eq!(c & !(cell::OPAQUE | cell::PROXIMITY), 0);
+        if c & cell::OPAQUE == 0 {
+            assert_eq!(c & !cell::PROXIMITY, 0);
+        }
     }
 }
 

@@ -166,7 +166,7 @@ pub fn build(
     records = lit;
     let lights_time = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let lines = finish_plane(extent, &mut plane, &directory, &records);
+    let lines = finish_plane(extent, &mut plane, &directory, &records, &[]);
     voxelize += t2.elapsed().as_secs_f64();
 
     let view = View {
@@ -184,6 +184,7 @@ pub fn build(
             plane,
             directory,
             records,
+            lists: Vec::new(),
             objects: Vec::new(),
             materials: vec![material],
             lights: vec![WorldLight {

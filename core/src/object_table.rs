@@ -174,15 +174,17 @@ impl<'a> ObjectTable<'a> {
     ///
     /// # Errors
     /// Gives `object` back when the table is full, or when the id would not
-    /// fit the record's `u32`, or when it is a [`Shape::Patch`] whose index
-    /// is not a stored patch (use [`ObjectTable::push_patch`]).
+    /// be below [`MAX_OBJECTS`](crate::voxel::MAX_OBJECTS) (the record's
+    /// object field keeps bit 31 for object lists), or when it is a
+    /// [`Shape::Patch`] whose index is not a stored patch (use
+    /// [`ObjectTable::push_patch`]).
     pub fn push(&mut self, object: Object) -> Result<u32, Object> {
         if let Shape::Patch(p) = object.shape
             && usize::try_from(p).map_or(true, |p| p >= self.patches.len)
         {
             return Err(object);
         }
-        if u32::try_from(self.objects.len).is_err() {
+        if u32::try_from(self.objects.len).map_or(true, |n| n >= crate::voxel::MAX_OBJECTS) {
             return Err(object);
         }
         let i = self.objects.push(object)?;
@@ -245,8 +247,8 @@ impl<'a> ObjectTable<'a> {
         self.objects.buf.len()
     }
 
-    /// The id bound for [`crate::store::Limits::objects`] (`len`,
-    /// saturating at `u32::MAX`).
+    /// The id bound for [`crate::store::Limits::objects`] (`len`, below
+    /// [`MAX_OBJECTS`](crate::voxel::MAX_OBJECTS) by construction).
     #[must_use]
     pub fn id_limit(&self) -> u32 {
         u32::try_from(self.objects.len).unwrap_or(u32::MAX)

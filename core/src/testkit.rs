@@ -89,6 +89,15 @@ pub struct Scene {
     pub plane: Vec<u8>,
     pub dir: Vec<u32>,
     pub records: Vec<VoxelRecord>,
+    pub lists: Vec<u32>,
+}
+
+impl Scene {
+    /// The built store.
+    pub fn store(&self) -> crate::store::RecordStore<'_> {
+        crate::store::RecordStore::with_lists(self.extent, &self.dir, &self.records, &self.lists)
+            .expect("built store")
+    }
 }
 
 /// One object to build: its attributes and its voxelizer.
@@ -104,16 +113,21 @@ pub fn build(extent: Extent, objects: &[Voxelize<'_>], limits: Limits) -> Scene 
     }
     let sizing = counter.finish().unwrap();
     let mut records = vec![VoxelRecord::default(); sizing.records()];
-    let mut filler = sizing.fill(&mut records, limits).unwrap();
+    let mut lists = vec![0u32; sizing.list_entries()];
+    let mut filler = sizing
+        .fill_with_lists(&mut records, &mut lists, limits)
+        .unwrap();
     for (attrs, f) in objects {
         filler.begin_object(*attrs).unwrap();
         f(&mut filler);
     }
-    filler.finish().unwrap();
+    let used = filler.finish().unwrap().lists().len();
+    lists.truncate(used);
     Scene {
         extent,
         plane,
         dir,
         records,
+        lists,
     }
 }

@@ -8,7 +8,7 @@
 //!
 //! ```text
 //!  offset  size  field     meaning
-//!       0     4  object    index into the object table (intersection verification)
+//!       0     4  object    object id, or (bit 31 set) the index of the voxel's object list
 //!       4     4  normal    octahedral unit normal, two snorm16 (see `encode_normal`)
 //!       8     3  color     linear RGB, texture already applied
 //!      11     3  illum     ambient + diffuse of the visible lights, linear, saturating
@@ -43,6 +43,19 @@
 //! quantized to 1/128 voxel and saturating at 127 (bits 9..16). Records of a
 //! brick are sorted by the position bits; the distance bits decide which of
 //! two objects offering the same voxel owns it (the nearer surface).
+//!
+//! # Owner and object list
+//! The record's attributes are its *owner's*: of all objects whose surface
+//! passes through the voxel, the one nearest the voxel centre. When only one
+//! object offered the voxel (almost every voxel), [`VoxelRecord::object`] is
+//! that object's id. When several did, bit 31 ([`OBJECT_LIST`]) is set and
+//! the low 31 bits index the store's *object list* array, where the voxel's
+//! list `[n, owner, others…]` names all `n ≥ 2` objects, the owner first,
+//! the others in increasing id order (see [`crate::store`]). Object ids are
+//! therefore below [`MAX_OBJECTS`] `= 2^31`. Read the owner and the list
+//! through [`RecordStore::owner`](crate::store::RecordStore::owner) and
+//! [`RecordStore::objects`](crate::store::RecordStore::objects), never from
+//! the field directly.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -60,7 +73,10 @@ use crate::voxelize::NORMAL_ONE;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Pod, Zeroable)]
 pub struct VoxelRecord {
-    /// Index into the object table ([`crate::object_table`]).
+    /// The owner's index into the object table ([`crate::object_table`]),
+    /// or, with bit 31 ([`OBJECT_LIST`]) set, the index of the voxel's
+    /// object list (see the module docs; read it through
+    /// [`RecordStore::owner`](crate::store::RecordStore::owner)).
     pub object: u32,
     /// The unit surface normal at the voxel centre, octahedral snorm16
     /// ([`encode_normal`] / [`decode_normal`]).
@@ -81,6 +97,14 @@ pub struct VoxelRecord {
     /// (bits 9..16); see the module docs.
     pub key: u16,
 }
+
+/// Bit of [`VoxelRecord::object`] marking an index into the store's object
+/// lists rather than an object id.
+pub const OBJECT_LIST: u32 = 1 << 31;
+
+/// Object ids are below this bound (the record's object field keeps bit 31
+/// for [`OBJECT_LIST`]).
+pub const MAX_OBJECTS: u32 = OBJECT_LIST;
 
 /// Bits of [`VoxelRecord::key`] that hold the position inside the brick.
 pub const KEY_POSITION_MASK: u16 = 0x1ff;

@@ -114,9 +114,11 @@ fn rays_from_outside_hit_the_cut() {
     voxelize(&tree, e, &mut IgnoreLeaf(&mut counter));
     let sizing = counter.finish().unwrap();
     let mut records = vec![VoxelRecord::default(); sizing.records()];
+    let mut lists = vec![0u32; sizing.list_entries()];
     let mut filler = sizing
-        .fill(
+        .fill_with_lists(
             &mut records,
+            &mut lists,
             Limits {
                 objects: 2,
                 materials: 2,
@@ -140,9 +142,9 @@ fn rays_from_outside_hit_the_cut() {
         voxelize(&tree, e, &mut sink);
         assert_eq!(sink.missing(), 0);
     }
-    filler.finish().unwrap();
+    let used = filler.finish().unwrap().lists().len();
     let raster = Raster::new(e, &plane).unwrap();
-    let store = RecordStore::new(e, &dir, &records).unwrap();
+    let store = RecordStore::with_lists(e, &dir, &records, &lists[..used]).unwrap();
 
     let mut rng = Rng(4);
     let mut fired = 0;
@@ -170,7 +172,12 @@ fn rays_from_outside_hit_the_cut() {
                 .unwrap()
                 .unwrap_or_else(|| panic!("{mode:?} ray {origin:?} -> {target:?} missed"));
             let r = store.get(hit.index).unwrap();
-            assert_eq!(r.object, 1, "{mode:?} hit {:?} not on the cut", hit.voxel);
+            assert_eq!(
+                store.owner(r),
+                1,
+                "{mode:?} hit {:?} not on the cut",
+                hit.voxel
+            );
             assert_eq!(r.color, [0, 0, 255]);
             assert!(dot_unit(r.normal_vector(), [NORMAL_ONE, 0, 0]) > NORMAL_ONE - 100);
             assert!((38..=39).contains(&hit.voxel[0]), "{:?}", hit.voxel);

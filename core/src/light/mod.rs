@@ -259,7 +259,8 @@ fn shade_record<const N: usize>(
     report: &mut LightReport,
 ) -> Result<VoxelRecord, LightError> {
     report.records = report.records.saturating_add(1);
-    let object = objects.get(rec.object);
+    let owner = view.owner(&rec);
+    let object = objects.get(owner);
     let material = materials.get(rec.material);
     if object.is_none() || material.is_none() {
         report.missing = report.missing.saturating_add(1);
@@ -300,7 +301,7 @@ fn shade_record<const N: usize>(
             light.position,
             side,
             rec.normal,
-            rec.object,
+            owner,
         )?;
         rec.set_light(i, vis);
         match vis {
@@ -392,7 +393,7 @@ fn shadow_ray<const N: usize>(
         let Some(b) = view.get(index) else {
             return true;
         };
-        if rule.ignores(extent, index, b) {
+        if rule.ignores(view, index, b) {
             return false;
         }
         if materials
@@ -478,7 +479,7 @@ pub struct LeavingSurface {
     /// [`VoxelRecord::normal`] (for the same-surface test; decoded only
     /// when a voxel of another object is met).
     pub stored: [i16; 2],
-    /// Object id of the voxel left.
+    /// The owner of the voxel left ([`RecordStore::owner`]).
     pub object: u32,
     /// Height above the tangent plane, fixed units, below which voxels of
     /// the same surface are ignored ([`LightParams::slab`]).
@@ -496,45 +497,51 @@ impl LeavingSurface {
     /// use rrt_core::raster::Extent;
     /// use rrt_core::voxel::{encode_normal, VoxelRecord};
     /// use rrt_core::voxelize::NORMAL_ONE;
+    /// use rrt_core::store::RecordStore;
     /// let e = Extent::cube(8).unwrap();
     /// let up = [0, 0, NORMAL_ONE];
     /// let rec = VoxelRecord { object: 3, normal: encode_normal(up), ..Default::default() };
-    /// let rule = LeavingSurface::new(e, [4, 4, 4], up, &rec, &LightParams::default());
+    /// let store = RecordStore::new(e, &[0, 0], &[]).unwrap();
+    /// let rule = LeavingSurface::new(&store, [4, 4, 4], up, &rec, &LightParams::default());
     /// // The neighbour in the same layer is the surface itself; one 3 voxels up is not.
-    /// assert!(rule.ignores(e, e.index([5, 4, 4]).unwrap(), &rec));
-    /// assert!(!rule.ignores(e, e.index([4, 4, 7]).unwrap(), &rec));
+    /// assert!(rule.ignores(&store, e.index([5, 4, 4]).unwrap(), &rec));
+    /// assert!(!rule.ignores(&store, e.index([4, 4, 7]).unwrap(), &rec));
     /// ```
     #[must_use]
     pub fn new(
-        extent: Extent,
+        store: &RecordStore<'_>,
         v: [u32; 3],
         side: [i32; 3],
         rec: &VoxelRecord,
         params: &LightParams,
     ) -> Self {
         Self {
-            start: extent.index(v),
+            start: store.extent().index(v),
             c0: v.map(voxel_centre),
             side,
             stored: rec.normal,
-            object: rec.object,
+            object: store.owner(rec),
             slab: params.slab,
             same_surface_cos: params.same_surface_cos,
         }
     }
 
-    /// Whether the opaque voxel at `index` with record `b` is part of the
-    /// surface being left, and so no hit: the start voxel itself, or a
-    /// voxel at most `slab` above the tangent plane that belongs to the
-    /// same object or to a surface oriented like this one.
+    /// Whether the opaque voxel at `index` with record `b` (of `store`) is
+    /// part of the surface being left, and so no hit: the start voxel
+    /// itself, or a voxel at most `slab` above the tangent plane whose owner
+    /// is the left voxel's owner or whose surface is oriented like this one.
+    /// The rule compares owners, not object lists: a voxel shared with
+    /// another object (a sphere's contact with the floor) keeps blocking the
+    /// other object's shadow rays.
     #[must_use]
-    pub fn ignores(&self, extent: Extent, index: usize, b: &VoxelRecord) -> bool {
+    pub fn ignores(&self, store: &RecordStore<'_>, index: usize, b: &VoxelRecord) -> bool {
         if Some(index) == self.start {
             return true;
         }
-        extent
+        store
+            .extent()
             .coord(index)
-            .is_some_and(|vb| self.ignores_voxel(vb, b))
+            .is_some_and(|vb| self.ignores_voxel(store, vb, b))
     }
 
     /// [`ignores`](Self::ignores) for a voxel given by its coordinates `vb`
@@ -542,7 +549,7 @@ impl LeavingSurface {
     /// [`Extent::coord`]); the start voxel is recognized by its index only,
     /// so a caller checks `Some(index) == self.start` first.
     #[must_use]
-    pub fn ignores_voxel(&self, vb: [u32; 3], b: &VoxelRecord) -> bool {
+    pub fn ignores_voxel(&self, store: &RecordStore<'_>, vb: [u32; 3], b: &VoxelRecord) -> bool {
         let d = sub(vb.map(voxel_centre), self.c0);
         // (c_b − c₀)·N₀ in fixed units: |d| < 2^33, |N| <= 2^30.
         let height = d
@@ -554,7 +561,7 @@ impl LeavingSurface {
         if height > i128::from(self.slab) {
             return false;
         }
-        b.object == self.object
+        store.owner(b) == self.object
             || dot_unit(b.normal_vector(), decode_normal(self.stored)) >= self.same_surface_cos
     }
 }

@@ -71,7 +71,9 @@ impl World {
             table.push(*o).unwrap();
         }
         let raster = Raster::new(scene.extent, &scene.plane).unwrap();
-        let mut store = RecordStoreMut::new(scene.extent, &scene.dir, &mut scene.records).unwrap();
+        let mut store =
+            RecordStoreMut::with_lists(scene.extent, &scene.dir, &mut scene.records, &scene.lists)
+                .unwrap();
         illuminate(
             &raster,
             &mut store,
@@ -124,7 +126,7 @@ fn lone_sphere_has_no_acne() {
             let mut w = World::new(&[light]);
             w.objects.push(sphere_obj([32, 32, 32], 20));
             let rep = w.run(&mut scene);
-            let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+            let store = scene.store();
             let (mut lit, mut dark, mut grazing) = (0, 0, 0);
             for (v, r) in store.iter() {
                 let c = v.map(voxel_centre);
@@ -214,11 +216,11 @@ fn a_small_sphere_shadows_a_big_one() {
             ..sphere_obj([32, 32, 45], 4)
         });
         w.run(&mut scene);
-        let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+        let store = scene.store();
         // The top of the big sphere lies in the small one's shadow.
         let top = (0..64)
             .rev()
-            .find_map(|z| store.get_voxel([32, 32, z]).filter(|r| r.object == 0))
+            .find_map(|z| store.get_voxel([32, 32, z]).filter(|r| store.owner(r) == 0))
             .unwrap();
         let want = if blocker_material == 0 {
             LightVisibility::Occluded
@@ -292,7 +294,7 @@ fn an_opaque_blocker_behind_a_translucent_one_occludes() {
     let mut w = World::new(&[light]);
     w.objects.extend([tri, Object { material: 1, ..tri }, tri]);
     w.run(&mut scene);
-    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    let store = scene.store();
     let at = |x, y| store.get_voxel([x, y, 10]).unwrap().light(0);
     assert_eq!(at(22, 22), LightVisibility::Visible);
     assert_eq!(at(29, 29), LightVisibility::Translucent);
@@ -338,7 +340,7 @@ fn open_surfaces_lit_from_behind_see_the_light_from_their_back() {
     w.objects.extend([tri, tri]);
     let rep = w.run(&mut scene);
     assert_eq!(rep.facing_away, 0);
-    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    let store = scene.store();
     let r = store.get_voxel([20, 16, 20]).unwrap();
     assert_eq!(r.light(0), LightVisibility::Visible);
     // The light is behind the stored normal: no diffuse in illum.
@@ -421,11 +423,11 @@ fn a_sphere_on_a_floor_casts_a_contact_shadow() {
     let mut w = World::new(&[vox([32, 32, 5000])]);
     w.objects.extend([tri, sphere_obj([32, 32, 20], 10)]);
     w.run(&mut scene);
-    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    let store = scene.store();
     // Under the ball, around the contact: occluded; far away: visible.
     for x in [29, 32, 35] {
         let r = store.get_voxel([x, 32, 10]).unwrap();
-        assert_eq!(r.object, 0);
+        assert_eq!(store.owner(r), 0);
         assert_eq!(r.light(0), LightVisibility::Occluded, "x = {x}");
     }
     assert_eq!(
@@ -455,7 +457,7 @@ fn a_torus_shadows_itself() {
         material: 0,
     });
     w.run(&mut scene);
-    let store = RecordStore::new(e, &scene.dir, &scene.records).unwrap();
+    let store = scene.store();
     // Inner wall on the far (−x) side faces +x, towards the light, but the
     // near side of the ring is in the way.
     let inner_far = (0..32)
@@ -492,7 +494,8 @@ fn missing_tables_and_extent_mismatch() {
     let other = Extent::cube(8).unwrap();
     let plane = vec![0u8; other.len()];
     let raster = Raster::new(other, &plane).unwrap();
-    let mut store = RecordStoreMut::new(e, &scene.dir, &mut scene.records).unwrap();
+    let mut store =
+        RecordStoreMut::with_lists(e, &scene.dir, &mut scene.records, &scene.lists).unwrap();
     let mut objs = [Object::UNUSED; 1];
     let table = ObjectTable::new(&mut objs, &mut []);
     assert_eq!(
@@ -553,7 +556,7 @@ fn runs_in_any_order_equal_the_serial_pass() {
         table.push(*o).unwrap();
     }
     let raster = Raster::new(e, &scene.plane).unwrap();
-    let store = RecordStore::new(e, &scene.dir, &unlit).unwrap();
+    let store = RecordStore::with_lists(e, &scene.dir, &unlit, &scene.lists).unwrap();
     let mut out = unlit.clone();
     let run = 97; // not a divisor of the record count, not a brick size
     let mut report = LightReport::default();

@@ -1,14 +1,24 @@
 //! The two-pass scene builder: the count pass sizes the records, the fill
 //! pass writes them (see the [module docs](super)).
 
-use super::brick::{BRICK_VOXELS, brick_of, directory_len};
+use super::brick::{BRICK, BRICK_VOXELS, brick_of, directory_len};
 use super::error::BuildError;
+use super::list::{MAX_LIST_ENTRIES, list_index};
 use super::proximity::{DENSE_RATIO, flag_proximity};
+use super::rank_hint::set_opaque_cells;
 use super::texture::Texture;
 use super::{RecordStore, RecordStoreMut};
 use crate::raster::{Raster, RasterMut, cell, to_usize};
-use crate::voxel::{KEY_POSITION_MASK, VoxelRecord, encode_normal, make_key};
+use crate::voxel::{
+    KEY_POSITION_MASK, MAX_OBJECTS, OBJECT_LIST, VoxelRecord, encode_normal, make_key,
+};
 use crate::voxelize::{Surfel, VoxelSink};
+
+/// The fill pass's mark on a voxel that has its record (a distance bit:
+/// opaque cells' distance bits are free until `finish` writes the rank
+/// hints). The count pass marks a voxel offered more than once with
+/// [`cell::PROXIMITY`]; `finish` rewrites both.
+const FILLED: u8 = 1 << cell::DISTANCE_SHIFT;
 
 /// Attributes shared by all voxels of one object in the fill pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -37,8 +47,20 @@ pub struct CountReport {
     pub offers: u64,
     /// Distinct voxels set (the record count).
     pub voxels: u64,
-    /// Offers outside the raster, skipped.
+    /// Distinct voxels offered more than once (by one object or several).
+    pub shared: u64,
+    /// Offers outside the raster (or the slab), skipped.
     pub outside: u64,
+}
+
+impl CountReport {
+    /// Repeat offers: offers inside the raster beyond each voxel's first.
+    #[must_use]
+    pub const fn repeats(&self) -> u64 {
+        self.offers
+            .saturating_sub(self.outside)
+            .saturating_sub(self.voxels)
+    }
 }
 
 /// The count pass: a [`VoxelSink`] that sets [`cell::OPAQUE`] and counts
@@ -48,6 +70,16 @@ pub struct Counter<'p, 'd> {
     raster: RasterMut<'p>,
     dir: &'d mut [u32],
     report: CountReport,
+    slab: Option<u32>,
+}
+
+/// Sets every element of `s` to zero unless all already are (a fresh
+/// allocation: reading its zero pages is cheaper than writing them).
+fn clear<T: Copy + PartialEq + Default>(s: &mut [T]) {
+    let zero = T::default();
+    if s.iter().any(|x| *x != zero) {
+        s.fill(zero);
+    }
 }
 
 impl<'p, 'd> Counter<'p, 'd> {
@@ -56,7 +88,41 @@ impl<'p, 'd> Counter<'p, 'd> {
     /// # Errors
     /// [`BuildError::DirectoryLength`] unless `dir.len()` is
     /// [`directory_len`] of the raster.
-    pub fn new(mut raster: RasterMut<'p>, dir: &'d mut [u32]) -> Result<Self, BuildError> {
+    pub fn new(raster: RasterMut<'p>, dir: &'d mut [u32]) -> Result<Self, BuildError> {
+        Self::start(raster, dir, None)
+    }
+
+    /// Starts one *slab* of a scene: the layers `z0 .. z0 + nz` of a larger
+    /// raster, where `raster` is the slab's own part of the plane (the
+    /// larger raster's cells `z0·nx·ny ..`, with the slab's extent
+    /// `nx × ny × nz`) and `dir` its own directory. Offers name voxels of
+    /// the larger raster; those outside the slab are skipped and counted.
+    /// Since `z0` is a multiple of the brick edge, the slab's bricks,
+    /// records and object lists are contiguous parts of the larger
+    /// raster's, in the same order: a caller builds slabs independently
+    /// (on as many threads as it likes) and concatenates them
+    /// (the fix-ups: add the earlier slabs' record count to the directory
+    /// entries, and their list entries to the list indices, [`shift_lists`]).
+    /// The built slab has no proximity flags (they depend on the
+    /// neighbouring slabs): compute them on the whole plane afterwards
+    /// ([`crate::proximity::flag_neighbourhood`] or
+    /// [`crate::proximity::distance_field`]).
+    ///
+    /// # Errors
+    /// [`BuildError::SlabOrigin`] unless `z0` is a multiple of 8, and as
+    /// [`Counter::new`].
+    pub fn slab(raster: RasterMut<'p>, dir: &'d mut [u32], z0: u32) -> Result<Self, BuildError> {
+        if !z0.is_multiple_of(BRICK) {
+            return Err(BuildError::SlabOrigin { z0 });
+        }
+        Self::start(raster, dir, Some(z0))
+    }
+
+    fn start(
+        mut raster: RasterMut<'p>,
+        dir: &'d mut [u32],
+        slab: Option<u32>,
+    ) -> Result<Self, BuildError> {
         let expected = directory_len(raster.extent()).unwrap_or(usize::MAX);
         if dir.len() != expected {
             return Err(BuildError::DirectoryLength {
@@ -64,12 +130,13 @@ impl<'p, 'd> Counter<'p, 'd> {
                 found: dir.len(),
             });
         }
-        raster.plane_mut().fill(cell::EMPTY);
-        dir.fill(0);
+        clear(raster.plane_mut());
+        clear(dir);
         Ok(Self {
             raster,
             dir,
             report: CountReport::default(),
+            slab,
         })
     }
 
@@ -96,7 +163,18 @@ impl<'p, 'd> Counter<'p, 'd> {
             dir: self.dir,
             total: to_usize(total),
             report: self.report,
+            slab: self.slab,
         })
+    }
+}
+
+/// `voxel` of the larger raster in a slab starting at layer `z0`, or `None`
+/// below it.
+#[inline]
+fn local(voxel: [u32; 3], slab: Option<u32>) -> Option<[u32; 3]> {
+    match slab {
+        None => Some(voxel),
+        Some(z0) => Some([voxel[0], voxel[1], voxel[2].checked_sub(z0)?]),
     }
 }
 
@@ -104,12 +182,22 @@ impl VoxelSink for Counter<'_, '_> {
     fn offer(&mut self, voxel: [u32; 3], _surfel: Surfel) {
         self.report.offers = self.report.offers.saturating_add(1);
         let extent = self.raster.extent();
+        let Some(voxel) = local(voxel, self.slab) else {
+            self.report.outside = self.report.outside.saturating_add(1);
+            return;
+        };
         let b = brick_of(extent, voxel);
         let Some(c) = self.raster.cell_mut(voxel) else {
             self.report.outside = self.report.outside.saturating_add(1);
             return;
         };
         if *c & cell::OPAQUE != 0 {
+            // A repeat offer: the first marks the voxel shared, which bounds
+            // its object list and tells the fill pass to look for its record.
+            if *c & cell::PROXIMITY == 0 {
+                *c |= cell::PROXIMITY;
+                self.report.shared = self.report.shared.saturating_add(1);
+            }
             return;
         }
         *c |= cell::OPAQUE;
@@ -129,6 +217,7 @@ pub struct Sizing<'p, 'd> {
     dir: &'d mut [u32],
     total: usize,
     report: CountReport,
+    slab: Option<u32>,
 }
 
 impl<'p, 'd> Sizing<'p, 'd> {
@@ -152,15 +241,59 @@ impl<'p, 'd> Sizing<'p, 'd> {
         self.report
     }
 
-    /// Starts the fill pass into `records` (only its first
-    /// [`Sizing::records`] entries are used).
+    /// An upper bound on the `u32` entries of list storage the fill pass
+    /// needs: `3·repeats + 2·shared` (saturating). A voxel offered `o ≥ 2`
+    /// times has at most `o` objects: its final list takes at most
+    /// `1 + o` entries, and the pass links each further object in with a
+    /// node of 2 entries while it runs. 0 when no voxel is offered twice.
+    #[must_use]
+    pub fn list_entries(&self) -> usize {
+        let r = self.report.repeats();
+        let bound = r
+            .saturating_mul(3)
+            .saturating_add(self.report.shared.saturating_mul(2));
+        usize::try_from(bound).unwrap_or(usize::MAX)
+    }
+
+    /// Starts the paper's fill pass into `records` (only its first
+    /// [`Sizing::records`] entries are used): one object per voxel, its
+    /// owner (see *Overlap* in [`crate::store`]), and no object lists.
     ///
     /// # Errors
     /// [`BuildError::RecordStorage`] if `records` is too short.
-    pub fn fill<'r>(
+    pub fn fill(
+        self,
+        records: &mut [VoxelRecord],
+        limits: Limits,
+    ) -> Result<Filler<'p, 'd, '_>, BuildError> {
+        self.start_fill(records, &mut [], limits, false)
+    }
+
+    /// Starts the fill pass into `records` (as [`Sizing::fill`]) and the
+    /// object-list storage `lists` (working space while the pass runs; the
+    /// finished lists are the front of it, [`Built::lists`]): every voxel
+    /// several objects offered gets the list of all of them.
+    /// [`Sizing::list_entries`] entries always suffice; fewer may (the
+    /// bound is loose), and when they do not, [`Filler::finish`] says so
+    /// ([`BuildError::ListStorage`]).
+    ///
+    /// # Errors
+    /// [`BuildError::RecordStorage`] if `records` is too short.
+    pub fn fill_with_lists<'r>(
         self,
         records: &'r mut [VoxelRecord],
+        lists: &'r mut [u32],
         limits: Limits,
+    ) -> Result<Filler<'p, 'd, 'r>, BuildError> {
+        self.start_fill(records, lists, limits, true)
+    }
+
+    fn start_fill<'r>(
+        self,
+        records: &'r mut [VoxelRecord],
+        lists: &'r mut [u32],
+        limits: Limits,
+        listing: bool,
     ) -> Result<Filler<'p, 'd, 'r>, BuildError> {
         let found = records.len();
         let records = records
@@ -169,16 +302,23 @@ impl<'p, 'd> Sizing<'p, 'd> {
                 needed: self.total,
                 found,
             })?;
+        let cap = lists.len().min(MAX_LIST_ENTRIES);
+        let lists = lists.get_mut(..cap).unwrap_or(&mut []);
         Ok(Filler {
             raster: self.raster,
             dir: self.dir,
             records,
+            lists,
+            node_top: cap,
             limits,
             current: None,
             report: FillReport::default(),
             filled: 0,
             uncounted: 0,
             no_object: 0,
+            unlisted: 0,
+            listing,
+            slab: self.slab,
         })
     }
 }
@@ -194,8 +334,14 @@ pub struct FillReport {
     pub replaced: u64,
     /// Repeat offers that lost to the record already there.
     pub kept: u64,
-    /// Offers outside the raster, skipped.
+    /// Offers outside the raster (or the slab), skipped.
     pub outside: u64,
+    /// Voxels with an object list (offered by more than one object); set
+    /// by [`Filler::finish`].
+    pub listed: u64,
+    /// Entries of the finished object lists ([`Built::lists`]); set by
+    /// [`Filler::finish`].
+    pub list_entries: u64,
 }
 
 /// The fill pass: a [`VoxelSink`] that writes records (module docs).
@@ -206,12 +352,53 @@ pub struct Filler<'p, 'd, 'r> {
     dir: &'d mut [u32],
     /// Exactly the counted number of records.
     records: &'r mut [VoxelRecord],
+    /// List storage, at most [`MAX_LIST_ENTRIES`] long. While the pass
+    /// runs, nodes `[object, next]` fill it from the top down (`node_top`
+    /// is the lowest used entry).
+    lists: &'r mut [u32],
+    node_top: usize,
     limits: Limits,
     current: Option<ObjectAttrs>,
     report: FillReport,
     filled: usize,
     uncounted: u64,
     no_object: u64,
+    unlisted: u64,
+    /// Whether voxels several objects offer get object lists
+    /// ([`Sizing::fill_with_lists`]) or keep their owner only.
+    listing: bool,
+    slab: Option<u32>,
+}
+
+/// While the fill pass runs, a record's `lights` and first two `illum`
+/// bytes (zero until the light pass) hold the head of its voxel's chain of
+/// list nodes: 0 for none, else the node's index plus one.
+fn chain_head(r: &VoxelRecord) -> usize {
+    to_usize(u32::from(r.lights) | (u32::from(u16::from_le_bytes([r.illum[0], r.illum[1]])) << 16))
+}
+
+fn set_chain_head(r: &mut VoxelRecord, head: usize) {
+    let h = u32::try_from(head).unwrap_or(0);
+    // Truncations on purpose: the head is split into its two halves.
+    #[allow(clippy::cast_possible_truncation)]
+    {
+        r.lights = h as u16;
+        let [a, b] = ((h >> 16) as u16).to_le_bytes();
+        r.illum[0] = a;
+        r.illum[1] = b;
+    }
+}
+
+/// The objects of the chain starting at `head` (see [`chain_head`]).
+fn chain(lists: &[u32], head: usize) -> impl Iterator<Item = (usize, u32)> + '_ {
+    let mut next = head;
+    // A chain is at most as long as the nodes that fit the storage.
+    (0..lists.len() / 2).map_while(move |_| {
+        let at = next.checked_sub(1)?;
+        let object = *lists.get(at)?;
+        next = to_usize(*lists.get(at.checked_add(1)?)?);
+        Some((at, object))
+    })
 }
 
 /// The voxel-centre position of `v` in fixed units.
@@ -230,10 +417,11 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
     /// [`BuildError::ObjectOutOfRange`] or [`BuildError::MaterialOutOfRange`]
     /// against the pass's [`Limits`]; the previous object stays current.
     pub fn begin_object(&mut self, attrs: ObjectAttrs) -> Result<(), BuildError> {
-        if attrs.object >= self.limits.objects {
+        let limit = self.limits.objects.min(MAX_OBJECTS);
+        if attrs.object >= limit {
             return Err(BuildError::ObjectOutOfRange {
                 object: attrs.object,
-                limit: self.limits.objects,
+                limit,
             });
         }
         if u32::from(attrs.material) >= self.limits.materials {
@@ -261,13 +449,17 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
         self.report
     }
 
-    fn put<T: Texture + ?Sized>(&mut self, v: [u32; 3], surfel: Surfel, texture: Option<&T>) {
+    fn put<T: Texture + ?Sized>(&mut self, global: [u32; 3], surfel: Surfel, texture: Option<&T>) {
         self.report.offers = self.report.offers.saturating_add(1);
         let Some(attrs) = self.current else {
             self.no_object = self.no_object.saturating_add(1);
             return;
         };
         let extent = self.raster.extent();
+        let Some(v) = local(global, self.slab) else {
+            self.report.outside = self.report.outside.saturating_add(1);
+            return;
+        };
         let b = brick_of(extent, v);
         let Some(c) = self.raster.cell_mut(v) else {
             self.report.outside = self.report.outside.saturating_add(1);
@@ -280,7 +472,7 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
         let key = make_key(v, surfel.distance);
         let make = |attrs: ObjectAttrs| {
             let color = match texture {
-                Some(t) => t.color(centre(v), surfel.normal, attrs.color),
+                Some(t) => t.color(centre(global), surfel.normal, attrs.color),
                 None => attrs.color,
             };
             VoxelRecord {
@@ -298,7 +490,7 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
             return;
         };
         let at = to_usize(*cursor);
-        if *c & cell::PROXIMITY == 0 {
+        if *c & FILLED == 0 {
             // First offer of this voxel in the fill pass. The count pass
             // counted every OPAQUE voxel of the brick once and each gets one
             // slot, so the cursor is still inside the brick's range.
@@ -307,41 +499,87 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
                 return;
             };
             *slot = make(attrs);
-            *c |= cell::PROXIMITY;
+            *c |= FILLED;
             *cursor = cursor.saturating_add(1);
             self.filled = self.filled.saturating_add(1);
             self.report.records = self.report.records.saturating_add(1);
-        } else {
-            // Marked: its record is among this brick's filled records, just
-            // below the cursor; scan back to it.
-            let pos = key & KEY_POSITION_MASK;
-            let Some(filled) = self.records.get_mut(..at) else {
-                return;
+            return;
+        }
+        if *c & cell::PROXIMITY == 0 {
+            // The count pass saw this voxel once: the passes differ.
+            self.uncounted = self.uncounted.saturating_add(1);
+            return;
+        }
+        // Marked: its record is among this brick's filled records, just
+        // below the cursor; scan back to it.
+        let pos = key & KEY_POSITION_MASK;
+        let Some(filled) = self.records.get_mut(..at) else {
+            return;
+        };
+        let Some(r) = filled
+            .iter_mut()
+            .rev()
+            .take(SCAN_LIMIT)
+            .find(|r| r.position() == pos)
+        else {
+            return;
+        };
+        let nearer = (key >> crate::voxel::KEY_DISTANCE_SHIFT) < r.distance();
+        let owner = r.object;
+        let mut head = chain_head(r);
+        if self.listing && attrs.object != owner {
+            // The chain holds every object of the voxel but its owner, once.
+            let listed = chain(self.lists, head).find(|&(_, o)| o == attrs.object);
+            let add = match (nearer, listed) {
+                // The new owner leaves the chain, the old one joins it.
+                (true, Some((at, _))) => {
+                    if let Some(slot) = self.lists.get_mut(at) {
+                        *slot = owner;
+                    }
+                    None
+                }
+                (true, None) => Some(owner),
+                (false, None) => Some(attrs.object),
+                (false, Some(_)) => None,
             };
-            let found = filled
-                .iter_mut()
-                .rev()
-                .take(SCAN_LIMIT)
-                .find(|r| r.position() == pos);
-            if let Some(r) = found {
-                if (key >> crate::voxel::KEY_DISTANCE_SHIFT) < r.distance() {
-                    *r = make(attrs);
-                    self.report.replaced = self.report.replaced.saturating_add(1);
-                } else {
-                    self.report.kept = self.report.kept.saturating_add(1);
+            if let Some(object) = add {
+                let node = self
+                    .node_top
+                    .checked_sub(2)
+                    .and_then(|top| Some((top, self.lists.get_mut(top..self.node_top)?)));
+                match node {
+                    Some((top, [o, next])) => {
+                        *o = object;
+                        // head < 2^31: the storage is at most MAX_LIST_ENTRIES long.
+                        *next = u32::try_from(head).unwrap_or(0);
+                        self.node_top = top;
+                        head = top.saturating_add(1);
+                    }
+                    _ => self.unlisted = self.unlisted.saturating_add(1),
                 }
             }
         }
+        if nearer {
+            *r = make(attrs);
+            self.report.replaced = self.report.replaced.saturating_add(1);
+        } else {
+            self.report.kept = self.report.kept.saturating_add(1);
+        }
+        set_chain_head(r, head);
     }
 
     /// Ends the fill pass: checks it matched the count pass, restores the
-    /// directory, sorts each brick and sets the proximity flags.
+    /// directory, sorts each brick, lays out the object lists, writes the
+    /// rank hints ([`super::write_rank_hints`]) and, for a whole raster (not
+    /// a [`Counter::slab`]), sets the proximity flags.
     ///
     /// # Errors
     /// [`BuildError::OfferWithoutObject`], [`BuildError::PassMismatch`] or
     /// [`BuildError::FillIncomplete`] when the fill pass did not voxelize
-    /// the scene the count pass did. The plane and directory are then in an
-    /// unspecified (but memory-safe) state: start again with [`Counter`].
+    /// the scene the count pass did; [`BuildError::ListStorage`] when the
+    /// object lists did not fit the list storage. The plane and directory
+    /// are then in an unspecified (but memory-safe) state: start again with
+    /// [`Counter`].
     pub fn finish(self) -> Result<Built<'p, 'd, 'r>, BuildError> {
         if self.no_object > 0 {
             return Err(BuildError::OfferWithoutObject {
@@ -361,6 +599,18 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
                 expected: self.records.len(),
             });
         }
+        let cap = self.lists.len();
+        let nodes = cap.saturating_sub(self.node_top);
+        if self.unlisted > 0 {
+            return Err(BuildError::ListStorage {
+                needed: cap.saturating_add(
+                    usize::try_from(self.unlisted)
+                        .unwrap_or(usize::MAX)
+                        .saturating_mul(2),
+                ),
+                found: cap,
+            });
+        }
         let dir: &'d mut [u32] = self.dir;
         // dir[b] is now end(b) = start(b + 1): shift right by one.
         let bricks = dir.len().saturating_sub(1);
@@ -375,27 +625,138 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
                 s.sort_unstable_by_key(VoxelRecord::position);
             }
         }
+        let mut report = self.report;
+        let used = lay_out_lists(self.records, self.lists, self.node_top, &mut report).ok_or(
+            BuildError::ListStorage {
+                needed: list_space(self.records, self.lists).saturating_add(nodes),
+                found: cap,
+            },
+        )?;
+        let all: &'r [u32] = self.lists;
+        let lists = all.get(..used).unwrap_or(&[]);
         let dir: &'d [u32] = dir;
         let mut raster = self.raster;
         let store = RecordStore {
             extent: raster.extent(),
             dir,
             records: self.records,
+            lists,
         };
-        if store.len().saturating_mul(DENSE_RATIO) > raster.extent().len() {
-            // Dense scene: the whole-plane pass is cheaper. It recomputes
-            // PROXIMITY from OPAQUE, which also clears the fill marks.
-            crate::proximity::flag_neighbourhood(&mut raster);
+        if self.slab.is_some() {
+            // Clears the fill and count marks; the flags come later.
+            set_opaque_cells(&mut raster, &store, cell::OPAQUE);
         } else {
-            flag_proximity(&mut raster, &store);
+            set_opaque_cells(&mut raster, &store, cell::OPAQUE | cell::PROXIMITY);
+            if store.len().saturating_mul(DENSE_RATIO) > raster.extent().len() {
+                // Dense scene: the whole-plane pass is cheaper.
+                crate::proximity::flag_neighbourhood(&mut raster);
+            } else {
+                flag_proximity(&mut raster, &store);
+            }
         }
         Ok(Built {
             raster,
             dir,
             records: self.records,
-            report: self.report,
+            lists,
+            report,
+            slab: self.slab,
         })
     }
+}
+
+/// Entries the finished lists of `records` take: `1 + n` per voxel of `n`
+/// objects (its chain's length plus the owner).
+fn list_space(records: &[VoxelRecord], lists: &[u32]) -> usize {
+    records
+        .iter()
+        .map(|r| match chain_head(r) {
+            0 => 0,
+            h => chain(lists, h).count().saturating_add(2),
+        })
+        .fold(0usize, usize::saturating_add)
+}
+
+/// Writes the finished object lists to the front of `lists`, in the
+/// records' (final) order, from the chains of nodes at `node_top..`; points
+/// each listed record at its list and clears the chain heads. `None` (and
+/// nothing changed) when the lists would reach the nodes not yet read.
+fn lay_out_lists(
+    records: &mut [VoxelRecord],
+    lists: &mut [u32],
+    node_top: usize,
+    report: &mut FillReport,
+) -> Option<usize> {
+    if list_space(records, lists) > node_top {
+        return None;
+    }
+    let mut w = 0usize;
+    for r in records.iter_mut() {
+        let head = chain_head(r);
+        set_chain_head(r, 0);
+        if head == 0 {
+            continue;
+        }
+        // The lists written so far end below every node (checked above).
+        let start = w;
+        let mut put = |lists: &mut [u32], x: u32| {
+            if let Some(slot) = lists.get_mut(w) {
+                *slot = x;
+            }
+            w = w.saturating_add(1);
+        };
+        put(lists, 0);
+        put(lists, r.object);
+        let mut n = 1u32;
+        let mut next = head;
+        while let Some(at) = next.checked_sub(1) {
+            let (Some(&o), Some(&nx)) = (lists.get(at), lists.get(at.saturating_add(1))) else {
+                break;
+            };
+            put(lists, o);
+            n = n.saturating_add(1);
+            next = to_usize(nx);
+        }
+        if let Some(len) = lists.get_mut(start) {
+            *len = n;
+        }
+        if let Some(others) = lists.get_mut(start.saturating_add(2)..w) {
+            others.sort_unstable();
+        }
+        // start < w <= node_top <= MAX_LIST_ENTRIES < 2^31.
+        r.object = OBJECT_LIST | u32::try_from(start).unwrap_or(0);
+        report.listed = report.listed.saturating_add(1);
+    }
+    report.list_entries = u64::try_from(w).unwrap_or(u64::MAX);
+    Some(w)
+}
+
+/// Adds `by` to the list index of every record of `records` that names an
+/// object list: the fix-up when slabs' lists are concatenated (see
+/// [`Counter::slab`]).
+///
+/// # Errors
+/// [`BuildError::ListStorage`] when an index would pass
+/// [`MAX_LIST_ENTRIES`](super::MAX_LIST_ENTRIES); the records are then
+/// partly shifted.
+pub fn shift_lists(records: &mut [VoxelRecord], by: usize) -> Result<(), BuildError> {
+    if by == 0 {
+        return Ok(());
+    }
+    for r in records.iter_mut() {
+        if let Some(i) = list_index(r) {
+            let j = i
+                .checked_add(by)
+                .filter(|&j| j < MAX_LIST_ENTRIES)
+                .and_then(|j| u32::try_from(j).ok())
+                .ok_or(BuildError::ListStorage {
+                    needed: i.saturating_add(by),
+                    found: MAX_LIST_ENTRIES,
+                })?;
+            r.object = OBJECT_LIST | j;
+        }
+    }
+    Ok(())
 }
 
 impl VoxelSink for Filler<'_, '_, '_> {
@@ -418,13 +779,16 @@ impl<T: Texture> VoxelSink for Textured<'_, '_, '_, '_, T> {
     }
 }
 
-/// A built scene: the plane (with OPAQUE and PROXIMITY set) and the store.
+/// A built scene: the plane (with OPAQUE, the rank hints and, for a whole
+/// raster, PROXIMITY set) and the store.
 #[derive(Debug)]
 pub struct Built<'p, 'd, 'r> {
     raster: RasterMut<'p>,
     dir: &'d [u32],
     records: &'r mut [VoxelRecord],
+    lists: &'r [u32],
     report: FillReport,
+    slab: Option<u32>,
 }
 
 impl<'p, 'd, 'r> Built<'p, 'd, 'r> {
@@ -441,7 +805,22 @@ impl<'p, 'd, 'r> Built<'p, 'd, 'r> {
             extent: self.raster.extent(),
             dir: self.dir,
             records: self.records,
+            lists: self.lists,
         }
+    }
+
+    /// The finished object lists: the front of the list storage given to
+    /// [`Sizing::fill`], [`FillReport::list_entries`] long.
+    #[must_use]
+    pub const fn lists(&self) -> &'r [u32] {
+        self.lists
+    }
+
+    /// For a slab ([`Counter::slab`]), its first layer in the larger
+    /// raster; `None` for a whole raster.
+    #[must_use]
+    pub const fn slab(&self) -> Option<u32> {
+        self.slab
     }
 
     /// The raster and a writable store at once (for the light pass).
@@ -452,6 +831,7 @@ impl<'p, 'd, 'r> Built<'p, 'd, 'r> {
                 extent: self.raster.extent(),
                 dir: self.dir,
                 records: self.records,
+                lists: self.lists,
             },
         )
     }
@@ -475,6 +855,7 @@ impl<'p, 'd, 'r> Built<'p, 'd, 'r> {
                 extent,
                 dir: self.dir,
                 records: self.records,
+                lists: self.lists,
             },
         )
     }

@@ -3,26 +3,40 @@
 
 use super::brick::{BRICK_VOXELS, brick_of, brick_origin, directory_len, voxel_at};
 use super::error::StoreError;
+use super::list;
 use super::rank_hint::{cell_hint, hint_window};
 use crate::raster::{Extent, to_usize};
 use crate::voxel::{VoxelRecord, brick_position};
 
 /// A read-only record store: a validated brick directory over sorted
-/// records.
+/// records, and the object lists of the voxels several objects share.
 ///
 /// Invariants (checked by [`RecordStore::new`]): `dir.len() == bricks + 1`,
 /// `dir[0] == 0`, entries non-decreasing with at most 512 records per brick,
 /// `dir[last] == records.len()`, and inside each brick the records' position
-/// bits strictly increase and name voxels inside the raster.
+/// bits strictly increase and name voxels inside the raster; the object
+/// lists are laid out as [`crate::store`]'s *Object lists* says.
 #[derive(Clone, Copy, Debug)]
 pub struct RecordStore<'a> {
     pub(super) extent: Extent,
     pub(super) dir: &'a [u32],
     pub(super) records: &'a [VoxelRecord],
+    pub(super) lists: &'a [u32],
 }
 
 /// Checks the store invariants (see [`RecordStore`]).
-fn validate(extent: Extent, dir: &[u32], records: &[VoxelRecord]) -> Result<(), StoreError> {
+fn validate(
+    extent: Extent,
+    dir: &[u32],
+    records: &[VoxelRecord],
+    lists: &[u32],
+) -> Result<(), StoreError> {
+    validate_bricks(extent, dir, records)?;
+    list::validate(records, lists)
+}
+
+/// The directory and key invariants.
+fn validate_bricks(extent: Extent, dir: &[u32], records: &[VoxelRecord]) -> Result<(), StoreError> {
     let expected = directory_len(extent).ok_or(StoreError::TooManyBricks)?;
     if dir.len() != expected {
         return Err(StoreError::DirectoryLength {
@@ -103,8 +117,10 @@ pub(super) fn find(
 
 impl<'a> RecordStore<'a> {
     /// Validates `dir` and `records` against `extent`, in
-    /// O(bricks + records). A store loaded from a file goes through this, so
-    /// a corrupt file cannot cause a wrong-brick lookup or a panic later.
+    /// O(bricks + records), for a store without object lists (a record
+    /// naming a list is refused). A store loaded from a file goes through
+    /// this or [`RecordStore::with_lists`], so a corrupt file cannot cause a
+    /// wrong-brick lookup or a panic later.
     ///
     /// # Errors
     /// A [`StoreError`] naming the first broken invariant.
@@ -124,12 +140,72 @@ impl<'a> RecordStore<'a> {
         dir: &'a [u32],
         records: &'a [VoxelRecord],
     ) -> Result<Self, StoreError> {
-        validate(extent, dir, records)?;
+        Self::with_lists(extent, dir, records, &[])
+    }
+
+    /// Validates like [`RecordStore::new`], with the object lists `lists`
+    /// (O(bricks + records + list entries)).
+    ///
+    /// # Errors
+    /// A [`StoreError`] naming the first broken invariant.
+    ///
+    /// ```
+    /// use rrt_core::raster::Extent;
+    /// use rrt_core::store::RecordStore;
+    /// use rrt_core::voxel::{VoxelRecord, OBJECT_LIST};
+    /// let e = Extent::cube(8).unwrap();
+    /// // Voxel (5, 0, 0) holds object 3 alone; voxel (6, 0, 0) objects 7 (its owner), 2 and 4.
+    /// let recs = [
+    ///     VoxelRecord { key: 5, object: 3, ..Default::default() },
+    ///     VoxelRecord { key: 6, object: OBJECT_LIST | 0, ..Default::default() },
+    /// ];
+    /// let lists = [3, 7, 2, 4];
+    /// let store = RecordStore::with_lists(e, &[0, 2], &recs, &lists).unwrap();
+    /// assert_eq!((store.owner(&recs[0]), store.objects(&recs[0])), (3, &[3][..]));
+    /// assert_eq!((store.owner(&recs[1]), store.objects(&recs[1])), (7, &[7, 2, 4][..]));
+    /// assert!(RecordStore::with_lists(e, &[0, 2], &recs, &[3, 7, 4, 2]).is_err());
+    /// ```
+    pub fn with_lists(
+        extent: Extent,
+        dir: &'a [u32],
+        records: &'a [VoxelRecord],
+        lists: &'a [u32],
+    ) -> Result<Self, StoreError> {
+        validate(extent, dir, records, lists)?;
         Ok(Self {
             extent,
             dir,
             records,
+            lists,
         })
+    }
+
+    /// The owner of record `rec` (of this store): the object whose surface
+    /// passes nearest the voxel centre, whose attributes the record holds.
+    /// O(1); one read of the list array for a voxel several objects share.
+    #[inline]
+    #[must_use]
+    pub fn owner(&self, rec: &VoxelRecord) -> u32 {
+        list::owner(self.lists, rec)
+    }
+
+    /// Every object whose surface passes through the voxel of record `rec`
+    /// (of this store), each once, the owner first and the others in
+    /// increasing id order. O(1); a one-element slice of the record itself
+    /// for a voxel of one object.
+    #[inline]
+    #[must_use]
+    pub fn objects<'r>(&self, rec: &'r VoxelRecord) -> &'r [u32]
+    where
+        'a: 'r,
+    {
+        list::objects(self.lists, rec)
+    }
+
+    /// The object list array (see [`crate::store`]).
+    #[must_use]
+    pub const fn lists(&self) -> &'a [u32] {
+        self.lists
     }
 
     /// The record of the voxel with linear raster index `index`, or `None`
@@ -248,12 +324,14 @@ impl<'a> RecordStore<'a> {
 }
 
 /// A record store whose records can be updated in place (the light pass
-/// writes visibility and illumination). Same invariants as [`RecordStore`].
+/// writes visibility and illumination; the object lists stay as they are).
+/// Same invariants as [`RecordStore`].
 #[derive(Debug)]
 pub struct RecordStoreMut<'a> {
     pub(super) extent: Extent,
     pub(super) dir: &'a [u32],
     pub(super) records: &'a mut [VoxelRecord],
+    pub(super) lists: &'a [u32],
 }
 
 impl<'a> RecordStoreMut<'a> {
@@ -266,11 +344,25 @@ impl<'a> RecordStoreMut<'a> {
         dir: &'a [u32],
         records: &'a mut [VoxelRecord],
     ) -> Result<Self, StoreError> {
-        validate(extent, dir, records)?;
+        Self::with_lists(extent, dir, records, &[])
+    }
+
+    /// Validates like [`RecordStore::with_lists`].
+    ///
+    /// # Errors
+    /// As [`RecordStore::with_lists`].
+    pub fn with_lists(
+        extent: Extent,
+        dir: &'a [u32],
+        records: &'a mut [VoxelRecord],
+        lists: &'a [u32],
+    ) -> Result<Self, StoreError> {
+        validate(extent, dir, records, lists)?;
         Ok(Self {
             extent,
             dir,
             records,
+            lists,
         })
     }
 
@@ -281,14 +373,15 @@ impl<'a> RecordStoreMut<'a> {
             extent: self.extent,
             dir: self.dir,
             records: self.records,
+            lists: self.lists,
         }
     }
 
     /// Calls `f` once per record, in storage order, with a read-only view of
     /// the whole store, the record's voxel and a copy of the record; a
     /// returned record replaces it. `f` must not change the key (the light
-    /// pass changes only visibility and illumination); a changed key is
-    /// restored so the store stays valid.
+    /// pass changes only visibility and illumination); a changed key or
+    /// object field is restored so the store stays valid.
     ///
     /// # Errors
     /// The first error `f` returns; records visited before it keep their
@@ -312,11 +405,13 @@ impl<'a> RecordStoreMut<'a> {
                     extent,
                     dir,
                     records: self.records,
+                    lists: self.lists,
                 };
                 if let Some(mut new) = f(view, voxel_at(origin, r.position()), r)?
                     && let Some(slot) = self.records.get_mut(k)
                 {
                     new.key = r.key;
+                    new.object = r.object;
                     *slot = new;
                 }
             }

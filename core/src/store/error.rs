@@ -36,6 +36,25 @@ pub enum StoreError {
         /// Index of the offending record.
         record: usize,
     },
+    /// A record's object list is not where the previous list ended, runs
+    /// past the array, names fewer than two objects, an id of 2^31 or more,
+    /// or repeats or misorders its other objects.
+    BadList {
+        /// Index of the offending record.
+        record: usize,
+    },
+    /// The object lists end before the end of the list array.
+    ListsEnd {
+        /// Entries the records' lists use.
+        used: usize,
+        /// Entries in the array.
+        len: usize,
+    },
+    /// The list array is longer than 31-bit indices reach.
+    ListsTooLong {
+        /// Entries in the array.
+        len: usize,
+    },
 }
 
 impl fmt::Display for StoreError {
@@ -57,6 +76,18 @@ impl fmt::Display for StoreError {
             Self::BadKey { record } => write!(
                 f,
                 "record {record} has a position that is unsorted, repeated or outside the raster"
+            ),
+            Self::BadList { record } => write!(
+                f,
+                "record {record} has an object list that is misplaced, too short, out of range or unsorted"
+            ),
+            Self::ListsEnd { used, len } => write!(
+                f,
+                "the object lists use {used} entries, but the list array has {len}"
+            ),
+            Self::ListsTooLong { len } => write!(
+                f,
+                "the list array has {len} entries, more than 31-bit indices reach"
             ),
         }
     }
@@ -85,7 +116,8 @@ pub enum BuildError {
         found: usize,
     },
     /// [`ObjectAttrs::object`](super::ObjectAttrs::object) is not below
-    /// [`Limits::objects`](super::Limits::objects).
+    /// [`Limits::objects`](super::Limits::objects) (nor below
+    /// [`MAX_OBJECTS`](crate::voxel::MAX_OBJECTS), which then is the limit).
     ObjectOutOfRange {
         /// The object id.
         object: u32,
@@ -118,6 +150,21 @@ pub enum BuildError {
         filled: usize,
         /// Records counted.
         expected: usize,
+    },
+    /// The object lists did not fit the list storage given to
+    /// [`Sizing::fill`](super::Sizing::fill) (at most
+    /// [`Sizing::list_entries`](super::Sizing::list_entries) entries are
+    /// ever needed).
+    ListStorage {
+        /// Entries of list storage needed, at least.
+        needed: usize,
+        /// Entries of list storage given.
+        found: usize,
+    },
+    /// A slab's first layer is not a multiple of the brick edge (8).
+    SlabOrigin {
+        /// The first layer given.
+        z0: u32,
     },
 }
 
@@ -153,6 +200,14 @@ impl fmt::Display for BuildError {
             Self::FillIncomplete { filled, expected } => write!(
                 f,
                 "the fill pass wrote {filled} records, the count pass found {expected}"
+            ),
+            Self::ListStorage { needed, found } => write!(
+                f,
+                "the object lists need at least {needed} entries of list storage, {found} given"
+            ),
+            Self::SlabOrigin { z0 } => write!(
+                f,
+                "a slab starts at layer {z0}, not at a multiple of the brick edge 8"
             ),
         }
     }

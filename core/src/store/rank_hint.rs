@@ -66,6 +66,11 @@ pub const fn cell_hint(c: u8) -> Option<u8> {
 /// assert_eq!(store.get_hinted([2, 0, 0], plane[2]), Some(&recs[1]));
 /// ```
 pub fn write_rank_hints(raster: &mut RasterMut<'_>, store: &RecordStore<'_>) {
+    set_opaque_cells(raster, store, cell::OPAQUE | cell::PROXIMITY);
+}
+
+/// Sets each record's cell to its bits in `keep` plus its rank hint.
+pub(super) fn set_opaque_cells(raster: &mut RasterMut<'_>, store: &RecordStore<'_>, keep: u8) {
     let extent = raster.extent();
     if store.extent() != extent {
         return;
@@ -89,7 +94,7 @@ pub fn write_rank_hints(raster: &mut RasterMut<'_>, store: &RecordStore<'_>) {
                 .and_then(|i| plane.get_mut(i))
                 .filter(|c| **c & cell::OPAQUE != 0)
             {
-                *c = (*c & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
+                *c = (*c & keep) | (hint << cell::DISTANCE_SHIFT);
             }
         }
     }

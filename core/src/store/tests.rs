@@ -47,11 +47,29 @@ struct Scene {
     plane: Vec<u8>,
     dir: Vec<u32>,
     records: Vec<VoxelRecord>,
+    lists: Vec<u32>,
     count: CountReport,
     fill: FillReport,
 }
 
+impl Scene {
+    fn store(&self, extent: Extent) -> RecordStore<'_> {
+        RecordStore::with_lists(extent, &self.dir, &self.records, &self.lists)
+            .unwrap_or_else(|e| panic!("built store invalid: {e}"))
+    }
+}
+
 fn build(extent: Extent, script: &Script) -> Result<Scene, BuildError> {
+    build_with(extent, script, None)
+}
+
+/// [`build`] with `list_storage` entries of list storage (default: the
+/// count pass's bound).
+fn build_with(
+    extent: Extent,
+    script: &Script,
+    list_storage: Option<usize>,
+) -> Result<Scene, BuildError> {
     let mut plane = vec![0u8; extent.len()];
     let mut dir = vec![0u32; directory_len(extent).unwrap()];
     let mut counter = Counter::new(RasterMut::new(extent, &mut plane).unwrap(), &mut dir)?;
@@ -64,11 +82,12 @@ fn build(extent: Extent, script: &Script) -> Result<Scene, BuildError> {
     let sizing = counter.finish()?;
     assert_eq!(sizing.records() as u64, count.voxels);
     let mut records = vec![VoxelRecord::default(); sizing.records()];
+    let mut lists = vec![0u32; list_storage.unwrap_or(sizing.list_entries())];
     let limits = Limits {
         objects: script.len() as u32,
         materials: 1,
     };
-    let mut filler = sizing.fill(&mut records, limits)?;
+    let mut filler = sizing.fill_with_lists(&mut records, &mut lists, limits)?;
     for (id, obj) in script.iter().enumerate() {
         filler.begin_object(ObjectAttrs {
             object: id as u32,
@@ -79,11 +98,16 @@ fn build(extent: Extent, script: &Script) -> Result<Scene, BuildError> {
             filler.offer(v, surfel(d));
         }
     }
-    let fill = filler.finish()?.report();
+    let built = filler.finish()?;
+    let fill = built.report();
+    let used = built.lists().len();
+    assert_eq!(used as u64, fill.list_entries);
+    lists.truncate(used);
     Ok(Scene {
         plane,
         dir,
         records,
+        lists,
         count,
         fill,
     })
@@ -139,8 +163,7 @@ fn lookups_match_brute_force_on_random_sparse_rasters() {
         assert_eq!(scene.count.voxels as usize, expect.len(), "seed {seed}");
         assert_eq!(scene.fill.records as usize, expect.len(), "seed {seed}");
         assert_eq!(scene.records.len(), expect.len(), "seed {seed}");
-        let store = RecordStore::new(extent, &scene.dir, &scene.records)
-            .unwrap_or_else(|e| panic!("seed {seed}: built store invalid: {e}"));
+        let store = scene.store(extent);
         for i in 0..extent.len() {
             let v = extent.coord(i).unwrap();
             let got = store.get(i);
@@ -148,7 +171,7 @@ fn lookups_match_brute_force_on_random_sparse_rasters() {
             match expect.get(&v) {
                 Some(&(owner, q)) => {
                     let r = got.unwrap_or_else(|| panic!("seed {seed}: {v:?} has no record"));
-                    assert_eq!(r.object, owner, "seed {seed}: owner of {v:?}");
+                    assert_eq!(store.owner(r), owner, "seed {seed}: owner of {v:?}");
                     assert_eq!(r.distance(), q, "seed {seed}: distance of {v:?}");
                     assert_eq!(r.color, [owner as u8, 0, 0]);
                     assert!(opaque);
@@ -161,7 +184,7 @@ fn lookups_match_brute_force_on_random_sparse_rasters() {
         }
         assert!(store.get(extent.len()).is_none());
         // iter() yields every record once, with its coordinates.
-        let listed: Vec<_> = store.iter().map(|(v, r)| (v, r.object)).collect();
+        let listed: Vec<_> = store.iter().map(|(v, r)| (v, store.owner(r))).collect();
         assert_eq!(listed.len(), expect.len());
         for (v, o) in listed {
             assert_eq!(expect[&v].0, o);
@@ -177,17 +200,18 @@ fn overlapping_objects_keep_the_nearest_in_either_order() {
     for order in [[near, far], [far, near]] {
         let script: Script = vec![vec![([3, 3, 3], order[0])], vec![([3, 3, 3], order[1])]];
         let s = build(e, &script).unwrap();
-        let store = RecordStore::new(e, &s.dir, &s.records).unwrap();
+        let store = s.store(e);
         let r = store.get_voxel([3, 3, 3]).unwrap();
         let want = if order[0] == near { 0 } else { 1 };
-        assert_eq!(r.object, want, "order {order:?}");
+        assert_eq!(store.owner(r), want, "order {order:?}");
+        assert_eq!(store.objects(r), [want, 1 - want], "order {order:?}");
         assert_eq!(s.records.len(), 1);
         assert_eq!(s.fill.replaced + s.fill.kept, 1);
     }
     // Ties keep the first offer.
     let script: Script = vec![vec![([1, 2, 3], 5)], vec![([1, 2, 3], 5)]];
     let s = build(e, &script).unwrap();
-    assert_eq!(s.records[0].object, 0);
+    assert_eq!(s.store(e).owner(&s.records[0]), 0);
     assert_eq!(s.fill.kept, 1);
 }
 
@@ -201,7 +225,7 @@ fn same_object_repeat_offers_keep_the_nearest() {
         ([9, 9, 9], 20_000),
     ]];
     let s = build(e, &script).unwrap();
-    let store = RecordStore::new(e, &s.dir, &s.records).unwrap();
+    let store = s.store(e);
     assert_eq!(store.get_voxel([9, 9, 9]).unwrap().distance(), 4);
     assert_eq!(s.fill.replaced, 1);
     assert_eq!(s.fill.kept, 1);
@@ -483,7 +507,19 @@ fn proximity_after_build_is_the_26_neighbourhood() {
         // Reference: the whole-plane dilation on the OPAQUE bits alone.
         let mut reference: Vec<u8> = s.plane.iter().map(|c| c & cell::OPAQUE).collect();
         flag_neighbourhood(&mut RasterMut::new(extent, &mut reference).unwrap());
-        assert_eq!(s.plane, reference, "seed {seed}");
+        // Opaque cells carry their rank hints, transparent ones distance 0.
+        let flags: Vec<u8> = s
+            .plane
+            .iter()
+            .map(|c| c & (cell::OPAQUE | cell::PROXIMITY))
+            .collect();
+        assert_eq!(flags, reference, "seed {seed}");
+        assert!(
+            s.plane
+                .iter()
+                .all(|c| c & cell::OPAQUE != 0 || c >> cell::DISTANCE_SHIFT == 0),
+            "seed {seed}"
+        );
         // And the definition: chessboard distance <= 1 from an opaque voxel.
         let [nx, ny, nz] = extent.dims().map(i64::from);
         for i in 0..extent.len() {
@@ -505,7 +541,6 @@ fn proximity_after_build_is_the_26_neighbourhood() {
                 near,
                 "seed {seed} voxel {v:?}"
             );
-            assert_eq!(s.plane[i] & !(cell::OPAQUE | cell::PROXIMITY), 0);
         }
     }
 }
@@ -538,7 +573,8 @@ fn hinted_lookups_are_plain_lookups() {
         let offers = rng.below_u32(40_000) as usize;
         let script = random_script(extent, 2, offers, seed.wrapping_mul(31));
         let mut scene = build(extent, &script).unwrap();
-        let store = RecordStore::new(extent, &scene.dir, &scene.records).unwrap();
+        let store =
+            RecordStore::with_lists(extent, &scene.dir, &scene.records, &scene.lists).unwrap();
         write_rank_hints(
             &mut RasterMut::new(extent, &mut scene.plane).unwrap(),
             &store,
@@ -574,4 +610,149 @@ fn hinted_lookups_are_plain_lookups() {
         }
         assert_eq!(in_window, scene.records.len());
     }
+}
+
+/// Every object that offered each voxel, by brute force.
+fn offering_objects(script: &Script) -> HashMap<[u32; 3], Vec<u32>> {
+    let mut m: HashMap<[u32; 3], Vec<u32>> = HashMap::new();
+    for (id, obj) in script.iter().enumerate() {
+        for &(v, _) in obj {
+            let l = m.entry(v).or_default();
+            if !l.contains(&(id as u32)) {
+                l.push(id as u32);
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn object_lists_hold_every_offering_object_once_owner_first() {
+    for seed in 0..40u64 {
+        let mut rng = Rng(seed ^ 0x5eed);
+        let extent = Extent::new(
+            1 + rng.below_u32(24),
+            1 + rng.below_u32(24),
+            1 + rng.below_u32(24),
+        )
+        .unwrap();
+        let objects = 1 + rng.below_u32(7) as usize;
+        let offers = rng.below_u32(4000) as usize;
+        let mut script = random_script(extent, objects, offers, seed.wrapping_mul(91));
+        // Same-object repeats too: each object offers a part of its voxels again.
+        for obj in script.iter_mut() {
+            let again: Vec<_> = obj.iter().step_by(3).map(|&(v, d)| (v, d / 2)).collect();
+            obj.extend(again);
+        }
+        let s = build(extent, &script).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let store = s.store(extent);
+        let owners = brute_force(&script);
+        let all = offering_objects(&script);
+        let mut listed = 0u64;
+        for (v, r) in store.iter() {
+            let objs = store.objects(r);
+            let want = &all[&v];
+            assert_eq!(store.owner(r), owners[&v].0, "seed {seed}: owner of {v:?}");
+            assert_eq!(objs[0], store.owner(r), "seed {seed}: owner first at {v:?}");
+            assert_eq!(
+                objs.len(),
+                want.len(),
+                "seed {seed}: {v:?}: {objs:?} vs {want:?}"
+            );
+            assert!(want.iter().all(|o| objs.contains(o)), "seed {seed}: {v:?}");
+            assert!(
+                objs[1..].windows(2).all(|w| w[0] < w[1]),
+                "seed {seed}: {v:?}"
+            );
+            if want.len() == 1 {
+                // One object: the record holds the id itself.
+                assert_eq!(r.object, want[0]);
+            } else {
+                listed += 1;
+            }
+        }
+        assert_eq!(s.fill.listed, listed, "seed {seed}");
+        assert!(s.lists.len() <= 3 * s.count.repeats() as usize + 2 * s.count.shared as usize);
+    }
+}
+
+#[test]
+fn too_little_list_storage_is_refused_never_dropped() {
+    let e = Extent::cube(16).unwrap();
+    // Three objects share two voxels: lists [3, a, b, c] twice = 8 entries,
+    // laid out while the 2 nodes of 2 entries per voxel are still live.
+    let script: Script = (0..3)
+        .map(|o| vec![([1, 1, 1], 10_000 * o), ([9, 9, 9], 30_000 - 10_000 * o)])
+        .collect();
+    let full = build(e, &script).unwrap();
+    assert_eq!(full.lists.len(), 8);
+    let store = full.store(e);
+    let r = store.get_voxel([9, 9, 9]).unwrap();
+    assert_eq!(store.objects(r), [2, 0, 1]);
+    assert_eq!(
+        store.objects(store.get_voxel([1, 1, 1]).unwrap()),
+        [0, 1, 2]
+    );
+    // Just enough working space: 8 list entries + 8 of nodes.
+    assert!(build_with(e, &script, Some(16)).is_ok());
+    for short in [0, 3, 7, 15] {
+        match build_with(e, &script, Some(short)) {
+            Err(BuildError::ListStorage { needed, found }) => {
+                assert_eq!(found, short);
+                assert!(needed > short, "{needed} <= {short}");
+            }
+            other => panic!("{short} entries: {:?}", other.map(|s| s.lists)),
+        }
+    }
+    // No shared voxel: no list storage at all.
+    let alone: Script = vec![vec![([1, 1, 1], 0)], vec![([2, 1, 1], 0)]];
+    assert_eq!(build_with(e, &alone, Some(0)).unwrap().lists.len(), 0);
+}
+
+#[test]
+fn corrupt_object_lists_are_rejected() {
+    use crate::voxel::OBJECT_LIST;
+    let e = Extent::cube(8).unwrap();
+    let rec = |key: u16, object: u32| VoxelRecord {
+        key,
+        object,
+        ..VoxelRecord::default()
+    };
+    let recs = [rec(1, OBJECT_LIST), rec(2, 5), rec(3, OBJECT_LIST | 3)];
+    let ok = [2, 4, 1, 3, 9, 2, 7];
+    assert!(RecordStore::with_lists(e, &[0, 3], &recs, &ok).is_ok());
+    // Without lists, a listed record is refused.
+    assert_eq!(
+        RecordStore::new(e, &[0, 3], &recs).unwrap_err(),
+        StoreError::BadList { record: 0 }
+    );
+    let bad = |lists: &[u32]| RecordStore::with_lists(e, &[0, 3], &recs, lists).unwrap_err();
+    // Unsorted others, the owner among them, a single object, an id with bit 31.
+    assert_eq!(
+        bad(&[2, 4, 1, 3, 9, 7, 2]),
+        StoreError::BadList { record: 2 }
+    );
+    assert_eq!(
+        bad(&[2, 4, 4, 3, 9, 2, 7]),
+        StoreError::BadList { record: 0 }
+    );
+    assert_eq!(
+        bad(&[1, 4, 3, 3, 9, 2, 7]),
+        StoreError::BadList { record: 0 }
+    );
+    assert_eq!(
+        bad(&[2, OBJECT_LIST, 1, 3, 9, 2, 7]),
+        StoreError::BadList { record: 0 }
+    );
+    // A gap, a list past the end, entries left over.
+    let gap = [rec(1, OBJECT_LIST), rec(2, 5), rec(3, OBJECT_LIST | 4)];
+    assert_eq!(
+        RecordStore::with_lists(e, &[0, 3], &gap, &[2, 4, 1, 0, 3, 9, 2, 7]).unwrap_err(),
+        StoreError::BadList { record: 2 }
+    );
+    assert_eq!(bad(&[2, 4, 1, 3, 9, 2]), StoreError::BadList { record: 2 });
+    assert_eq!(
+        bad(&[2, 4, 1, 3, 9, 2, 7, 0]),
+        StoreError::ListsEnd { used: 7, len: 8 }
+    );
 }

@@ -38,6 +38,13 @@ pub struct RasterArgs {
     /// enough for it).
     #[arg(long, value_enum, default_value_t = ConnectivityArg::Adaptive)]
     pub connectivity: ConnectivityArg,
+    /// Intersection verification: voxelize every exact object
+    /// conservatively (every voxel its surface passes through, with the
+    /// list of all objects of a voxel several share) and, when rendering,
+    /// check each discrete hit against those objects' exact geometry,
+    /// using the true point and normal.
+    #[arg(long)]
+    pub verify: bool,
     /// World box to voxelize, `X0,Y0,Z0,X1,Y1,Z1` (default: all geometry).
     #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_bounds, allow_hyphen_values = true)]
     pub bounds: Option<Bounds>,
@@ -53,6 +60,7 @@ impl RasterArgs {
     pub fn build_options(&self) -> BuildOptions {
         let mut o = BuildOptions::new(self.raster.unwrap_or(DEFAULT_RASTER));
         o.connectivity = self.connectivity.into();
+        o.exact = self.verify;
         o.fit = FitOptions {
             bounds: self.bounds,
             max_memory: self.max_memory.unwrap_or_else(default_max_memory),

@@ -40,7 +40,7 @@ pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
         "file: {} ({}, format version {})",
         args.file.display(),
         Bytes(i.file_bytes),
-        rasterfile::VERSION
+        i.version
     )?;
     writeln!(out, "dimensions: {nx}×{ny}×{nz} voxels ({voxels})")?;
     writeln!(
@@ -68,11 +68,24 @@ pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
         "objects: {}, materials: {}, lights: {}",
         i.objects, i.materials, i.lights
     )?;
-    writeln!(
-        out,
-        "memory: {} (plane, line level, brick directory, records)",
-        Bytes(i.memory)
-    )?;
+    if i.list_entries > 0 {
+        writeln!(
+            out,
+            "object lists: {} entries (voxels several objects share)",
+            i.list_entries
+        )?;
+        writeln!(
+            out,
+            "memory: {} (plane, line level, brick directory, records, object lists)",
+            Bytes(i.memory)
+        )?;
+    } else {
+        writeln!(
+            out,
+            "memory: {} (plane, line level, brick directory, records)",
+            Bytes(i.memory)
+        )?;
+    }
     writeln!(out, "checksums: header and all sections match")?;
     Ok(())
 }

@@ -144,8 +144,9 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
 /// (the continuous ray misses the object), or `verify rejected:
 /// intersection farther on`; after a rejection the walk resumes, as the
 /// renderer's does; `miss` if the ray leaves the raster without an
-/// accepted hit. Only the voxel's own object is verified here (the
-/// renderer also tries the objects of its neighbours before resuming).
+/// accepted hit. Only the voxel's owner is verified here, in the voxel's
+/// neighbourhood (the renderer tests every object of the voxel's list and
+/// accepts the nearest intersection the walk has reached).
 fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Result<(), CliError> {
     use rrt_core::raster::cell;
     let scene = crate::output::rasterfile::load(path)?;
@@ -196,9 +197,10 @@ fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Re
         let Some(rec) = store.get(v.index) else {
             continue;
         };
+        let owner = store.owner(rec);
         let verdict = scene
             .objects
-            .get(rec.object as usize)
+            .get(owner as usize)
             .map_or(crate::trace::Verdict::False, |obj| {
                 crate::trace::verify(&scene.frame, obj, &world, [x, y, z], 0.0)
             });
@@ -207,7 +209,7 @@ fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Re
             crate::trace::Verdict::Ahead => "rejected: intersection farther on",
             crate::trace::Verdict::False => "rejected: false hit",
         };
-        writeln!(out, "hit {x} {y} {z} object {} verify {what}", rec.object)?;
+        writeln!(out, "hit {x} {y} {z} object {owner} verify {what}")?;
         if matches!(verdict, crate::trace::Verdict::Hit(_)) {
             return Ok(());
         }

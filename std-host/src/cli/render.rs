@@ -42,10 +42,6 @@ pub struct RenderArgs {
     /// Depth of the ray tree (the eye ray counts as 1).
     #[arg(long, value_name = "D", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub depth: u32,
-    /// Intersection verification: check each discrete hit against the
-    /// object's exact geometry, use the true point and normal.
-    #[arg(long)]
-    pub verify: bool,
     /// Exact shadows at verified hits: a render-time shadow ray per light,
     /// each object it meets intersected exactly (slower; beyond the
     /// paper, which uses the precomputed light visibility).
@@ -102,7 +98,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         TraceOptions {
             connectivity: args.raster.connectivity.into(),
             depth: args.depth,
-            verify: args.verify,
+            verify: args.raster.verify,
             packets: args.packets,
             exact_shadows: args.exact_shadows,
             ..TraceOptions::default()
@@ -147,7 +143,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             rrt_core::Connectivity::from(args.raster.connectivity).name(),
             if args.exact_shadows {
                 ", verified, exact shadows"
-            } else if args.verify {
+            } else if args.raster.verify {
                 ", verified"
             } else {
                 ""

@@ -3,19 +3,25 @@
 //! precomputed illumination) is done once and the scene rendered from any
 //! view (the paper's point).
 //!
-//! # Layout (version 1)
+//! # Layout (versions 1 and 2)
 //! All integers and floats are little-endian; floats are IEEE 754 `f64`.
 //!
 //! ```text
 //! offset  size  field
 //!      0     8  magic "RRTRASTR"
-//!      8     4  version (1)
-//!     12     4  section count (7)
-//!     16   168  section table: 7 × { kind u32, crc32 u32, offset u64, length u64 }
-//!    184     4  crc32 of bytes 0..184
-//!    188     4  zero
-//!    192        sections, in table order, each starting at a multiple of 64
+//!      8     4  version (1: no object lists, 2: with object lists)
+//!     12     4  section count n (7 for version 1, 8 for version 2)
+//!     16  24·n  section table: n × { kind u32, crc32 u32, offset u64, length u64 }
+//! 16+24n     4  crc32 of the bytes before it
+//! 20+24n     4  zero, then zeros up to H
+//!      H        sections, in table order, each starting at a multiple of 64
+//!               (H = 192 for version 1, 256 for version 2)
 //! ```
+//!
+//! A raster without object lists (the paper's raster,
+//! one object per voxel) is written as version 1, byte for byte as before
+//! lists existed; one with lists as version 2, which an rrt reading only
+//! version 1 refuses by its version.
 //!
 //! | kind | section | contents |
 //! |---|---|---|
@@ -26,6 +32,7 @@
 //! | 5 | objects | per object 168 bytes: kind u32 (1 sphere, 2 cone, 3 triangle, 4 triangle with vertex normals, 5 voxels only: volume, `.vox` or CSG, all slots 0, 6 torus), material u32, 20 × f64, the shape's saved form ([`crate::shape`]): sphere centre, radius; cone base, base radius, apex, apex radius; triangle v0 v1 v2, then n0 n1 n2; torus centre, axis, major, minor; unused slots 0 |
 //! | 6 | materials | per material 8 × f64: colour r g b, Kd, Ks, Shine, T, index of refraction |
 //! | 7 | lights | per light 6 × f64: position, colour |
+//! | 8 | lists | version 2 only: the store's object-list array, u32 each ([`rrt_core::store`], *Object lists*) |
 //!
 //! The crc32 (IEEE, `crc32fast`) of each section is in its table entry.
 //!
@@ -65,10 +72,15 @@ use crate::voxelize::{WorldLight, WorldObject};
 
 /// The file's first bytes.
 pub const MAGIC: [u8; 8] = *b"RRTRASTR";
-/// The version this code writes and reads.
-pub const VERSION: u32 = 1;
-const SECTIONS: usize = 7;
+/// The newest version this code writes and reads (it reads version 1
+/// too, and writes it for a raster without object lists).
+pub const VERSION: u32 = 2;
+/// Sections of a version 2 file (version 1 has the first 7).
+const SECTIONS: usize = 8;
+/// The header of a version 1 file.
 const HEADER_LEN: u64 = 192;
+/// The header of a version 2 file.
+const HEADER2_LEN: u64 = 256;
 const META_LEN: u64 = 192;
 /// Kind, material and the shape's saved numbers.
 const OBJECT_LEN: u64 = 8 + 8 * SLOTS as u64;
@@ -87,7 +99,17 @@ const NAMES: [&str; SECTIONS] = [
     "objects",
     "materials",
     "lights",
+    "lists",
 ];
+
+/// The section count and header length of `version` (1 or 2).
+const fn layout(version: u32) -> (usize, u64) {
+    if version == 1 {
+        (SECTIONS - 1, HEADER_LEN)
+    } else {
+        (SECTIONS, HEADER2_LEN)
+    }
+}
 
 /// Why a raster file could not be written or read.
 #[derive(Debug, thiserror::Error)]
@@ -111,7 +133,7 @@ pub enum RasterFileError {
         path: PathBuf,
     },
     /// Another version.
-    #[error("{}: raster file version {found}; this rrt reads version {VERSION}", path.display())]
+    #[error("{}: raster file version {found}; this rrt reads versions 1 to {VERSION}", path.display())]
     Version {
         /// The file.
         path: PathBuf,
@@ -346,17 +368,20 @@ pub fn save_to(
     };
     let file = out.file();
     let mut w = BufWriter::with_capacity(1 << 20, &mut *file);
-    w.write_all(&[0u8; HEADER_LEN as usize])
+    let version = if scene.lists.is_empty() { 1 } else { 2 };
+    let (sections, header_len) = layout(version);
+    w.write_all(&vec![0u8; header_len as usize])
         .map_err(io("cannot write"))?;
     progress.set_length(
         scene.plane.len() as u64
             + scene.directory.len() as u64 * DIRECTORY_ENTRY_LEN
-            + scene.records.len() as u64 * RECORD_LEN,
+            + scene.records.len() as u64 * RECORD_LEN
+            + scene.lists.len() as u64 * 4,
     );
     progress.set_position(0);
-    let mut table = Vec::with_capacity(SECTIONS);
-    let mut offset = HEADER_LEN;
-    for kind in 1..=SECTIONS as u32 {
+    let mut table = Vec::with_capacity(sections);
+    let mut offset = header_len;
+    for kind in 1..=sections as u32 {
         let mut c = Checked {
             inner: &mut w,
             crc: crc32fast::Hasher::new(),
@@ -391,7 +416,11 @@ pub fn save_to(
             }
             5 => c.put(&objects_bytes(scene)),
             6 => c.put(&materials_bytes(scene)),
-            _ => c.put(&lights_bytes(scene)),
+            7 => c.put(&lights_bytes(scene)),
+            _ => {
+                let b: Vec<u8> = scene.lists.iter().flat_map(|v| v.to_le_bytes()).collect();
+                c.put(&b)
+            }
         };
         r.map_err(io("cannot write"))?;
         let (len, crc) = (c.len, c.crc.finalize());
@@ -404,10 +433,10 @@ pub fn save_to(
     }
     w.flush().map_err(io("cannot write"))?;
     drop(w);
-    let mut h = Vec::with_capacity(HEADER_LEN as usize);
+    let mut h = Vec::with_capacity(header_len as usize);
     h.extend_from_slice(&MAGIC);
-    h.extend_from_slice(&VERSION.to_le_bytes());
-    h.extend_from_slice(&(SECTIONS as u32).to_le_bytes());
+    h.extend_from_slice(&version.to_le_bytes());
+    h.extend_from_slice(&(sections as u32).to_le_bytes());
     for (kind, crc, off, len) in &table {
         h.extend_from_slice(&kind.to_le_bytes());
         h.extend_from_slice(&crc.to_le_bytes());
@@ -416,7 +445,7 @@ pub fn save_to(
     }
     let hcrc = crc32fast::hash(&h);
     h.extend_from_slice(&hcrc.to_le_bytes());
-    h.extend_from_slice(&[0; 4]);
+    h.resize(header_len as usize, 0);
     file.seek(SeekFrom::Start(0)).map_err(io("cannot write"))?;
     file.write_all(&h).map_err(io("cannot write"))?;
     out.commit().map_err(io("cannot write"))?;
@@ -436,6 +465,10 @@ pub fn is_raster_file(path: &Path) -> bool {
 /// only.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Info {
+    /// The file's format version.
+    pub version: u32,
+    /// Entries of the object lists (0 for a raster without them).
+    pub list_entries: u64,
     /// Voxels per axis.
     pub dims: [u32; 3],
     /// World position of the raster's lowest corner.
@@ -460,7 +493,10 @@ pub struct Info {
 }
 
 struct Header {
+    version: u32,
     file_len: u64,
+    /// (crc, offset, length) per section; the lists' is all zero in a
+    /// version 1 file.
     sections: [(u32, u64, u64); SECTIONS],
 }
 
@@ -474,7 +510,7 @@ fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> 
             source,
         })?
         .len();
-    let mut h = [0u8; HEADER_LEN as usize];
+    let mut h = [0u8; HEADER2_LEN as usize];
     let got = read_up_to(file, &mut h).map_err(|source| RasterFileError::Io {
         path: p(),
         what: "cannot read",
@@ -491,35 +527,37 @@ fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> 
     }
     let mut c = Cursor::new(&h[8..]);
     let version = c.u32();
-    if version != VERSION {
+    if !(1..=VERSION).contains(&version) {
         return Err(RasterFileError::Version {
             path: p(),
             found: version,
         });
     }
-    if (got as u64) < HEADER_LEN {
+    let (n, header_len) = layout(version);
+    if (got as u64) < header_len {
         return Err(RasterFileError::Truncated {
             path: p(),
-            what: format!("{got} bytes, shorter than the {HEADER_LEN}-byte header"),
+            what: format!("{got} bytes, shorter than the {header_len}-byte header"),
         });
     }
-    let stored = u32::from_le_bytes([h[184], h[185], h[186], h[187]]);
-    if crc32fast::hash(&h[..184]) != stored {
+    let at = 16 + 24 * n;
+    let stored = u32::from_le_bytes([h[at], h[at + 1], h[at + 2], h[at + 3]]);
+    if crc32fast::hash(&h[..at]) != stored {
         return Err(RasterFileError::Checksum {
             path: p(),
             section: "header",
         });
     }
     let count = c.u32();
-    if count as usize != SECTIONS {
+    if count as usize != n {
         return Err(RasterFileError::Invalid {
             path: p(),
-            what: format!("{count} sections, expected {SECTIONS}"),
+            what: format!("{count} sections, expected {n} for version {version}"),
         });
     }
     let mut sections = [(0u32, 0u64, 0u64); SECTIONS];
-    let mut end = HEADER_LEN;
-    for (k, s) in sections.iter_mut().enumerate() {
+    let mut end = header_len;
+    for (k, s) in sections.iter_mut().take(n).enumerate() {
         let kind = c.u32();
         let crc = c.u32();
         let off = c.u64();
@@ -548,7 +586,11 @@ fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> 
         end = stop;
         *s = (crc, off, len);
     }
-    Ok(Header { file_len, sections })
+    Ok(Header {
+        version,
+        file_len,
+        sections,
+    })
 }
 
 fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
@@ -694,6 +736,8 @@ pub fn info(path: &Path) -> Result<Info, RasterFileError> {
     let h = read_header(&mut file, path)?;
     let m = read_meta(&mut file, path, &h)?;
     Ok(Info {
+        version: h.version,
+        list_entries: h.sections[7].2 / 4,
         dims: m.dims,
         origin: m.origin,
         voxel_size: m.voxel_size,
@@ -706,7 +750,8 @@ pub fn info(path: &Path) -> Result<Info, RasterFileError> {
         memory: h.sections[1].2
             + h.sections[1].2.div_ceil(LINE_CELLS as u64)
             + h.sections[2].2
-            + m.records * std::mem::size_of::<VoxelRecord>() as u64,
+            + m.records * std::mem::size_of::<VoxelRecord>() as u64
+            + h.sections[7].2,
     })
 }
 
@@ -729,11 +774,13 @@ pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError
     let h = read_header(&mut file, path)?;
     progress.set_length(h.file_len);
     progress.set_position(0);
-    let mut order: Vec<usize> = (0..SECTIONS).collect();
+    let (n, header_len) = layout(h.version);
+    let mut order: Vec<usize> = (0..n).collect();
     order.sort_by_key(|&k| h.sections[k].1);
-    // The zero word after the header's checksum, then each section and
+    // The zero bytes after the header's checksum, then each section and
     // the padding after it (to the next section or the end of the file).
-    let mut pieces = vec![(None, HEADER_LEN - 4, 4)];
+    let checksum_end = 16 + 24 * n as u64 + 4;
+    let mut pieces = vec![(None, checksum_end, header_len - checksum_end)];
     for (n, &k) in order.iter().enumerate() {
         let (_, off, len) = h.sections[k];
         let end = off.saturating_add(len);
@@ -806,6 +853,13 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     let obj_len = expect(4, m.objects.saturating_mul(OBJECT_LEN))?;
     let mat_len = expect(5, u64::from(m.materials) * MATERIAL_LEN)?;
     let light_len = expect(6, u64::from(m.lights) * LIGHT_LEN)?;
+    let lists_bytes = h.sections[7].2;
+    if lists_bytes % 4 != 0 {
+        return Err(invalid(format!(
+            "lists section of {lists_bytes} bytes, not a whole number of u32 entries"
+        )));
+    }
+    let lists_len = expect(7, lists_bytes)?;
     let section = |file: &mut File, k: usize, len: usize| -> Result<Vec<u8>, RasterFileError> {
         let mut b = vec![0u8; len];
         read_section(file, path, &h, k, &mut b)?;
@@ -824,12 +878,25 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     let objects =
         objects_from(&section(&mut file, 4, obj_len)?, materials.len()).map_err(invalid)?;
     let lights = lights_from(&section(&mut file, 6, light_len)?).map_err(invalid)?;
-    RecordStore::new(extent, &directory, &records).map_err(|e| invalid(e.to_string()))?;
+    let lists: Vec<u32> = if lists_len == 0 {
+        Vec::new()
+    } else {
+        section(&mut file, 7, lists_len)?
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect()
+    };
+    let store = RecordStore::with_lists(extent, &directory, &records, &lists)
+        .map_err(|e| invalid(e.to_string()))?;
     for (i, r) in records.iter().enumerate() {
-        if r.object as usize >= objects.len() || usize::from(r.material) >= materials.len() {
+        let ids = store.objects(r);
+        if ids.iter().any(|&o| o as usize >= objects.len())
+            || usize::from(r.material) >= materials.len()
+        {
             return Err(invalid(format!(
                 "record {i} names object {} and material {}, beyond the tables",
-                r.object, r.material
+                ids.iter().max().copied().unwrap_or(u32::MAX),
+                r.material
             )));
         }
     }
@@ -844,6 +911,7 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         plane,
         directory,
         records,
+        lists,
         objects,
         materials,
         lights,

@@ -19,8 +19,10 @@
 //! time only for lights whose bits say *translucent*; `att` multiplies the
 //! transmittance `T` of each translucent object the shadow ray passes
 //! (each object once). With [`TraceOptions::exact_shadows`] (and
-//! verification), every verified hit fires a 6-connected shadow ray to each
-//! light it faces and counts only objects the continuous segment really
+//! verification), every verified hit fires a shadow ray to each light it
+//! faces; it walks adaptively with empty-space skipping (exact: every
+//! opaque voxel the segment's line passes through is visited) and counts
+//! only objects of those voxels' lists that the continuous segment really
 //! intersects (voxels of objects without exact geometry count as they
 //! are): exact shadow edges, at the cost of those rays. The reflected ray
 //! (when `Ks > 0`) and the refracted ray (when `T > 0`: Snell's law with
@@ -36,44 +38,50 @@
 //! whose bits say that side sees them are computed here instead.
 //!
 //! # Intersection verification
-//! With [`TraceOptions::verify`], a discrete hit is checked by intersecting
-//! the continuous world ray with the hit voxel's object ([`WorldObject`],
-//! indexed by the record's object id: the paper's object table). The
-//! first intersection from the voxel on is the hit when it lies near the
-//! voxel: within the voxel's box grown by one voxel on every side (a
-//! voxelized surface layer is at most √3 voxels thick). When the ray does
-//! not meet the object at all the hit is *false* (the paper's term): it is
-//! counted and the discrete walk resumes after the voxel. When it meets
-//! the object only farther on (a ray grazing a surface's voxel layer, whose
-//! intersection lies many voxels along it) the walk also resumes, to stop
-//! at the voxels near the intersection; accepting the far intersection at
-//! once could skip a nearer object. Before either, the objects that own
-//! the voxel's 26 neighbours are tried in the same window, and the nearest
-//! intersection among them is the hit: voxels are atomic, one object each,
-//! so where surfaces meet (the shared edges of a mesh, a small sphere on a
-//! big one) the object the ray truly meets here may own only the voxel
-//! next door; without this a ray would pass through the seam (a dark dot
-//! on a teapot). With a hit, the true point and the true normal are used, and the diffuse terms are recomputed with the true
-//! normal for the lights the bits say are visible (the precomputed `illum`
-//! was sampled at the voxel centre).
+//! With [`TraceOptions::verify`], on a raster voxelized for it
+//! ([`BuildOptions::exact`](crate::voxelize::BuildOptions::exact): every
+//! exact object owns every voxel whose closed cube its surface meets, and a
+//! voxel several objects share lists all of them), the walk stops at every
+//! opaque voxel and tests each object of the voxel's list
+//! ([`RecordStore::objects`]) against the continuous world ray (the
+//! paper's object table, [`WorldObject`]): its first intersection with
+//! `t > tmin` anywhere along the ray. A per-ray mailbox keeps an object
+//! from being intersected twice. The nearest intersection found so far is
+//! the hit as soon as it lies in the part of the ray the walk has reached:
+//! `t` at most the continuous ray's exit from the current voxel (plus a
+//! hundred-thousandth of a voxel for the fixed-point line's rounding);
+//! otherwise the walk goes on, and a walk that leaves the raster takes the
+//! nearest intersection it found. Adaptive walks take 6-steps next to
+//! every surface voxel and skip only empty space, so every opaque voxel
+//! the line passes through is visited: the hit is the nearest exact
+//! intersection over all objects, however small the objects or crowded
+//! the voxels. An object without exact geometry (a volume, a `.vox` model,
+//! a CSG tree) is hit where the ray enters its voxel. A hit takes the
+//! true point and normal, and the attributes of the object hit (its own
+//! record: the voxel's, or a neighbouring voxel's it owns); the diffuse
+//! terms are recomputed with the true normal for the lights the bits say
+//! are visible. Voxels whose objects are all missed are the paper's
+//! *false hits* ([`RayStats::false_hits`]).
 //!
 //! # No acne
 //! A secondary ray starts on the surface it leaves: at the point where the
 //! incoming ray entered the hit voxel, or at the true intersection under
-//! verification. The surface's voxel layer is up to two voxels thick there,
-//! so the ray would hit its own surface at once. The tracer applies the
-//! light pass's rule ([`LeavingSurface`], see [`rrt_core::light`]): a voxel
-//! met by a ray leaving voxel `c₀` towards the side of unit normal `N₀` is
-//! ignored when its centre lies at most two voxels above `c₀`'s tangent
-//! plane (`(c − c₀)·N₀ ≤ 2`) *and* it belongs to the same object or to a
-//! surface oriented within 60° of this one. `N₀` is the side the ray goes
-//! to: the viewer's side for reflections and the render-time shadow rays,
-//! the other side for a refracted ray entering the object. Concave objects
-//! still reflect and shadow themselves beyond the two-voxel slab (the far
-//! side of a torus hole, a teapot's body seen in its spout); a refracted
-//! ray still meets the far wall of a sphere. Under verification the exact
-//! intersection with the object left additionally requires `t` above
-//! 1/1000 voxel, so the surface point itself is never its own next hit.
+//! verification. In the paper's raw mode the surface's voxel layer is up
+//! to two voxels thick there, so the ray would hit its own surface at once.
+//! The tracer applies the light pass's rule ([`LeavingSurface`], see
+//! [`rrt_core::light`]): a voxel met by a ray leaving voxel `c₀` towards
+//! the side of unit normal `N₀` is ignored when its centre lies at most two
+//! voxels above `c₀`'s tangent plane (`(c − c₀)·N₀ ≤ 2`) *and* its owner is
+//! the same object or its surface is oriented within 60° of this one. `N₀`
+//! is the side the ray goes to: the viewer's side for reflections and the
+//! render-time shadow rays, the other side for a refracted ray entering
+//! the object. Concave objects still reflect and shadow themselves beyond
+//! the two-voxel slab (the far side of a torus hole, a teapot's body seen
+//! in its spout); a refracted ray still meets the far wall of a sphere.
+//! Under verification no voxel is ignored for exact objects: an exact
+//! intersection counts when `t` is above a thousandth of a voxel, so the
+//! surface point itself is never its own next hit, and the rule is kept
+//! only for objects without exact geometry.
 //!
 //! # Packets
 //! [`Tracer::trace_block`] traces eight primary rays (a 4×2 pixel block)
@@ -145,7 +153,7 @@ pub struct TraceOptions {
     /// Exact shadows for verified hits (a quality option beyond the paper,
     /// which uses the precomputed light bits): from each verified hit a
     /// render-time shadow ray walks to every light the surface faces, and
-    /// each object whose voxels it meets is intersected exactly with the
+    /// each object of the voxels it meets is intersected exactly with the
     /// continuous shadow ray; only a true intersection shadows. Shadow
     /// edges then follow the geometry instead of the receiving voxels.
     /// Needs `verify` (unverified hits keep the light bits).
@@ -183,10 +191,9 @@ pub struct RayStats {
     /// Discrete hits that verification rejected: the continuous ray does
     /// not meet the voxel's object (the paper's false hits).
     pub false_hits: u64,
-    /// Discrete hits whose own object failed verification but an object
-    /// owning a neighbouring voxel passed it (see [`verify()`]'s use in the
-    /// module docs).
-    pub neighbour_hits: u64,
+    /// Verified hits in voxels that hold more than one object (found
+    /// through the voxel's object list).
+    pub shared_hits: u64,
     /// Rays (of any kind but shadow) that met at least one false hit.
     pub false_hit_rays: u64,
     /// Discrete hits whose object the continuous ray meets only farther
@@ -207,7 +214,7 @@ impl RayStats {
         self.hits += o.hits;
         self.false_hits += o.false_hits;
         self.deferred += o.deferred;
-        self.neighbour_hits += o.neighbour_hits;
+        self.shared_hits += o.shared_hits;
         self.false_hit_rays += o.false_hit_rays;
         self.missing += o.missing;
     }
@@ -223,12 +230,35 @@ impl RayStats {
 #[derive(Clone, Copy, Debug)]
 struct SurfaceHit {
     voxel: [u32; 3],
+    /// The attributes of the object hit (its record).
     rec: VoxelRecord,
+    /// The object hit.
+    object: u32,
+    /// The ray parameter of `point`.
+    t: f64,
     /// World point used for shading and secondary rays.
     point: DVec3,
     /// Unit normal (stored, or true under verification), not turned.
     normal: DVec3,
     verified: bool,
+}
+
+/// What a ray hits ([`Tracer::hit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayHit {
+    /// The object's id in the object table ([`VoxelScene::objects`]).
+    pub object: u32,
+    /// The ray parameter (world units along the unit direction).
+    pub t: f64,
+    /// The world point.
+    pub point: DVec3,
+    /// The unit normal there (the object's true normal when verified, the
+    /// stored one otherwise), not turned towards the ray.
+    pub normal: DVec3,
+    /// The voxel the hit was found from.
+    pub voxel: [u32; 3],
+    /// Verified against the object's exact geometry.
+    pub verified: bool,
 }
 
 /// The renderer over one voxelized scene.
@@ -320,8 +350,10 @@ impl<'s> Tracer<'s> {
         stats: &mut RayStats,
     ) -> DVec3 {
         let mut walk = match leave {
-            None => self.first_walk(ray),
-            Some(rule) => self.secondary_walk(ray, rule, stats),
+            Some(rule) if !self.opts.verify => self.secondary_walk(ray, rule, stats),
+            // Verification tests every object of every opaque voxel with
+            // t > tmin: no voxel is skipped by the acne rule on the way.
+            _ => self.first_walk(ray),
         };
         let tmin = if leave.is_some() {
             self.leaving_tmin()
@@ -374,6 +406,23 @@ impl<'s> Tracer<'s> {
                 self.shade(r, &h, 1, stats)
             }
         }
+    }
+
+    /// The surface a primary ray (unit direction) hits, resolved as the
+    /// renderer resolves it (the discrete hit, or under verification the
+    /// nearest exact intersection), without shading; `None` when it leaves
+    /// the raster. Counts go to `stats` as for a traced ray.
+    pub fn hit(&self, ray: &Ray, stats: &mut RayStats) -> Option<RayHit> {
+        let mut walk = self.first_walk(ray);
+        self.resolve(ray, &mut walk, 0.0, None, stats)
+            .map(|h| RayHit {
+                object: h.object,
+                t: h.t,
+                point: h.point,
+                normal: h.normal,
+                voxel: h.voxel,
+                verified: h.verified,
+            })
     }
 
     /// Traces one primary ray (unit direction) and returns its colour.

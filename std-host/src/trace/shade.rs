@@ -7,9 +7,11 @@
 use glam::DVec3;
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use rrt_core::light::LeavingSurface;
+use rrt_core::raster::cell;
 use rrt_core::voxel::LightVisibility;
 use rrt_core::voxelize::NORMAL_ONE;
 
+use super::verify::Mailbox;
 use super::walk::surface_voxel;
 use super::{RayStats, SurfaceHit, Tracer, shading};
 use crate::frame::unit_to_fixed;
@@ -31,7 +33,7 @@ impl Tracer<'_> {
     /// The acne rule for a ray leaving hit `h` towards the side `side`.
     pub(super) fn leaving(&self, h: &SurfaceHit, side: DVec3) -> LeavingSurface {
         let side = unit_to_fixed(side).unwrap_or([0, 0, NORMAL_ONE]);
-        LeavingSurface::new(self.extent, h.voxel, side, &h.rec, &self.opts.light)
+        LeavingSurface::new(&self.store, h.voxel, side, &h.rec, &self.opts.light)
     }
 
     /// The colour of hit `h` of `ray` at `depth` (module docs).
@@ -76,12 +78,12 @@ impl Tracer<'_> {
             let att = match vis {
                 _ if exact => {
                     stats.shadow += 1;
-                    self.shadow(h, n, k, Some((l, dist)), stats)
+                    self.exact_shadow(h, n, k, l, dist, stats)
                 }
                 LightVisibility::Visible => 1.0,
                 LightVisibility::Translucent => {
                     stats.shadow += 1;
-                    self.shadow(h, n, k, None, stats)
+                    self.shadow(h, n, k, stats)
                 }
                 LightVisibility::Occluded | LightVisibility::Reserved => 0.0,
             };
@@ -120,27 +122,13 @@ impl Tracer<'_> {
         shading::combine(m, local, reflected, refracted)
     }
 
-    /// A render-time shadow ray from hit `h` (seen side `n`) to light `k`:
-    /// the product of the transmittances of the translucent objects in
-    /// between (each object once), 0 if an opaque voxel blocks.
-    ///
-    /// `exact` (unit direction and distance to the light) makes it an
-    /// exact shadow ray ([`TraceOptions::exact_shadows`](super::TraceOptions::exact_shadows)): a 6-connected
-    /// walk, which meets every voxel the continuous segment passes
-    /// through, and a voxel counts only if the continuous segment
-    /// intersects its object (each object tested once); voxels of objects
-    /// without exact geometry (volumes, voxel models) count as they are.
-    pub(super) fn shadow(
-        &self,
-        h: &SurfaceHit,
-        n: DVec3,
-        k: usize,
-        exact: Option<(DVec3, f64)>,
-        stats: &mut RayStats,
-    ) -> f64 {
+    /// The discrete segment from hit `h` to light `k`, or `None` when
+    /// there is none (the light or the point outside the fixed-point
+    /// range, or a segment outside the raster: nothing in between).
+    fn light_segment(&self, h: &SurfaceHit, k: usize) -> Option<Option<DiscreteRay>> {
         let (Some(Some(light)), Some(p)) = (self.lights_fx.get(k), self.frame.to_fixed(h.point))
         else {
-            return 0.0;
+            return None;
         };
         let delta = [0, 1, 2].map(|a| i128::from(light[a]) - i128::from(p[a]));
         let span = delta.iter().map(|v| v.unsigned_abs()).max().unwrap_or(0);
@@ -156,7 +144,18 @@ impl Tracer<'_> {
             let dir = delta.map(|v| i32::try_from(v >> shift).unwrap_or(0));
             DiscreteRay::new(self.extent, p, dir)
         };
-        let Ok(Some(mut dray)) = ray else {
+        Some(ray.ok().flatten())
+    }
+
+    /// A render-time shadow ray from hit `h` (seen side `n`) to light `k`
+    /// (the paper's, for lights seen through translucent material): the
+    /// product of the transmittances of the translucent objects in between
+    /// (each object once), 0 if an opaque voxel blocks.
+    pub(super) fn shadow(&self, h: &SurfaceHit, n: DVec3, k: usize, stats: &mut RayStats) -> f64 {
+        let Some(ray) = self.light_segment(h, k) else {
+            return 0.0;
+        };
+        let Some(mut dray) = ray else {
             return 1.0;
         };
         let rule = self.leaving(h, n);
@@ -165,49 +164,109 @@ impl Tracer<'_> {
         let materials = self.materials;
         let mut att = 1.0;
         let mut seen: Vec<u32> = Vec::new();
-        // Objects the exact segment was found not to intersect.
-        let mut clear: Vec<u32> = Vec::new();
-        let segment = exact.map(|(l, dist)| (Ray::new(h.point, l), dist));
-        let tmin = self.leaving_tmin();
-        let objects = self.objects;
-        let mode = if exact.is_some() {
-            Connectivity::Six
-        } else {
-            self.opts.light.mode
-        };
         let mut missing = 0u64;
         let end = dray
-            .walk_skipping(&self.raster, mode, u32::MAX, |index, c| {
+            .walk_skipping(&self.raster, self.opts.light.mode, u32::MAX, |index, c| {
                 let Some(b) = surface_voxel(&store, extent, Some(&rule), index, c, &mut missing)
                 else {
                     return false;
                 };
-                if let Some((ray, dist)) = &segment
-                    && let Some(obj) = usize::try_from(b.object)
-                        .ok()
-                        .and_then(|i| objects.get(i))
-                        .filter(|o| o.shape.is_exact())
-                {
-                    if seen.contains(&b.object) || clear.contains(&b.object) {
-                        return false;
-                    }
-                    if obj.shape.intersect(ray, tmin, *dist).is_none() {
-                        clear.push(b.object);
-                        return false;
-                    }
-                }
                 let t = materials
                     .get(usize::from(b.material))
                     .map_or(0.0, |m| m.transmittance);
                 if t > 0.0 {
-                    if !seen.contains(&b.object) {
-                        seen.push(b.object);
+                    let owner = store.owner(b);
+                    if !seen.contains(&owner) {
+                        seen.push(owner);
                         att *= t;
                     }
                     return false;
                 }
                 true
             })
+            .unwrap_or(WalkEnd::Exit);
+        stats.steps += u64::from(dray.steps());
+        stats.missing += missing;
+        if end == WalkEnd::Hit { 0.0 } else { att }
+    }
+
+    /// An exact shadow ray ([`TraceOptions::exact_shadows`](super::TraceOptions::exact_shadows))
+    /// from verified hit `h` (seen side `n`) towards light `k` (unit
+    /// direction `l`, distance `dist`): the same walk and object tests as
+    /// verification. The segment walks adaptively with empty-space
+    /// skipping, which visits every opaque voxel the line passes through
+    /// (proximity is set around every surface voxel); every object of
+    /// each opaque voxel is tested once (a [`Mailbox`]) against the
+    /// continuous segment `t ∈ (tmin, dist)`. Any intersection with an
+    /// opaque object is a shadow (any hit ends the walk); a translucent
+    /// object attenuates once. An object without exact geometry counts at
+    /// its voxels, unless the acne rule ignores them.
+    pub(super) fn exact_shadow(
+        &self,
+        h: &SurfaceHit,
+        n: DVec3,
+        k: usize,
+        l: DVec3,
+        dist: f64,
+        stats: &mut RayStats,
+    ) -> f64 {
+        let Some(ray) = self.light_segment(h, k) else {
+            return 0.0;
+        };
+        let Some(mut dray) = ray else {
+            return 1.0;
+        };
+        let rule = self.leaving(h, n);
+        let store = self.store;
+        let materials = self.materials;
+        let objects = self.objects;
+        let segment = Ray::new(h.point, l);
+        let tmin = self.leaving_tmin();
+        let mut att = 1.0;
+        let mut mail = Mailbox::default();
+        // Translucent objects already counted (each attenuates once).
+        let mut seen: Vec<u32> = Vec::new();
+        let mut missing = 0u64;
+        let end = dray
+            .walk_skipping(
+                &self.raster,
+                Connectivity::Adaptive,
+                u32::MAX,
+                |index, c| {
+                    if c & cell::OPAQUE == 0 {
+                        return false;
+                    }
+                    let Some(b) = store.get(index) else {
+                        missing += 1;
+                        return false;
+                    };
+                    for &id in store.objects(b) {
+                        let Some(obj) = usize::try_from(id).ok().and_then(|i| objects.get(i))
+                        else {
+                            continue;
+                        };
+                        let blocks = if obj.shape.is_exact() {
+                            !mail.tested(id) && obj.shape.intersect(&segment, tmin, dist).is_some()
+                        } else {
+                            !rule.ignores(&store, index, b)
+                        };
+                        if !blocks {
+                            continue;
+                        }
+                        let t = materials
+                            .get(usize::from(obj.material))
+                            .map_or(0.0, |m| m.transmittance);
+                        if t <= 0.0 {
+                            return true;
+                        }
+                        if !seen.contains(&id) {
+                            seen.push(id);
+                            att *= t;
+                        }
+                    }
+                    false
+                },
+            )
             .unwrap_or(WalkEnd::Exit);
         stats.steps += u64::from(dray.steps());
         stats.missing += missing;

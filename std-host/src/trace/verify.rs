@@ -1,5 +1,6 @@
-//! Intersection verification: a discrete hit checked against the exact
-//! object of the object table (module docs of [`crate::trace`]).
+//! Intersection verification: the objects of each opaque voxel a ray's walk
+//! reaches tested against the continuous ray, the nearest intersection the
+//! walk has reached accepted (module docs of [`crate::trace`]).
 
 use glam::DVec3;
 use rrt_core::light::LeavingSurface;
@@ -33,7 +34,7 @@ pub(super) fn slab(o: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> Option<(f64, f64
 
 /// The unit vector of a stored octahedral normal (unfolded in integers,
 /// normalized in floating point).
-fn decode(rec: &VoxelRecord) -> DVec3 {
+pub(super) fn decode(rec: &VoxelRecord) -> DVec3 {
     let n = rrt_core::voxel::unfold(rec.normal);
     DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize_or(DVec3::Z)
 }
@@ -82,78 +83,192 @@ pub fn verify(
     }
 }
 
+/// Objects one ray has already been tested against: its *mailbox*. A ray
+/// meets an object in many voxels; each exact object is intersected once
+/// per ray. It holds the last [`MAILBOX`] objects tested: a ray meeting
+/// more objects than that may test one again, which costs time, never
+/// changes the answer (the nearest candidate is kept apart).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Mailbox {
+    ids: [u32; MAILBOX],
+    len: usize,
+    next: usize,
+}
+
+/// Objects a [`Mailbox`] holds.
+pub const MAILBOX: usize = 16;
+
+impl Mailbox {
+    /// Whether `id` was tested on this ray; if not, it is now recorded as
+    /// tested (the oldest entry giving way when full).
+    pub(super) fn tested(&mut self, id: u32) -> bool {
+        if self.ids.iter().take(self.len).any(|&x| x == id) {
+            return true;
+        }
+        if let Some(slot) = self.ids.get_mut(self.next) {
+            *slot = id;
+        }
+        self.next = (self.next + 1) % MAILBOX;
+        self.len = (self.len + 1).min(MAILBOX);
+        false
+    }
+}
+
+/// How far (in voxels) past the continuous ray's exit from the current
+/// voxel an intersection still counts as reached: the discrete line's
+/// fixed-point rounding (well below this over any raster).
+pub const REACH_MARGIN: f64 = 1e-5;
+
+/// The nearest intersection a verified walk has found so far.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Candidate {
+    /// World ray parameter.
+    pub(super) t: f64,
+    /// The object.
+    object: u32,
+    /// Its true unit normal (exact objects).
+    normal: DVec3,
+    /// The voxel it was found from, and that voxel's record.
+    voxel: [u32; 3],
+    rec: VoxelRecord,
+    /// An exact intersection (else a hit at the voxel of an object without
+    /// exact geometry).
+    exact: bool,
+    /// The voxel holds more than one object.
+    shared: bool,
+}
+
+/// The world ray parameter at which the continuous ray `o_r + s·d` (raster
+/// coordinates) leaves voxel `v`'s box, in voxels: the smallest exit-plane
+/// parameter over the axes (defined even for a voxel the continuous ray
+/// only grazes).
+pub(super) fn exit_param(o_r: DVec3, d: DVec3, v: [u32; 3]) -> f64 {
+    let mut t = f64::INFINITY;
+    for k in 0..3 {
+        let lo = f64::from(v[k]);
+        if d[k] > 0.0 {
+            t = t.min((lo + 1.0 - o_r[k]) / d[k]);
+        } else if d[k] < 0.0 {
+            t = t.min((lo - o_r[k]) / d[k]);
+        }
+    }
+    t
+}
+
+/// The point (as a world ray parameter, in voxels) where the ray enters
+/// voxel `v`, or, for a voxel the continuous ray only grazes, its point
+/// nearest the voxel centre.
+pub(super) fn entry_param(o_r: DVec3, d: DVec3, v: [u32; 3]) -> f64 {
+    let lo = DVec3::from(v.map(f64::from));
+    match slab(o_r, d, lo, lo + 1.0) {
+        Some((t0, _)) => t0,
+        None => (lo + 0.5 - o_r).dot(d),
+    }
+}
+
 impl Tracer<'_> {
-    /// The hit at voxel `v` with record `rec`, or `None` for a false hit.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn check_hit(
+    /// The hit at voxel `v` with record `rec` for the paper's raw mode
+    /// (no verification): the point where the ray entered the voxel, the
+    /// stored normal.
+    pub(super) fn discrete_hit(
         &self,
         ray: &Ray,
         o_r: DVec3,
-        vs: f64,
         v: [u32; 3],
         rec: &VoxelRecord,
         tmin: f64,
-        leave: Option<&LeavingSurface>,
-        stats: &mut RayStats,
-    ) -> Option<SurfaceHit> {
-        let lo = DVec3::from(v.map(f64::from));
-        if self.opts.verify
-            && let Some(obj) = self.objects.get(usize::try_from(rec.object).ok()?)
-            && obj.shape.is_exact()
-        {
-            let verdict = verify(&self.frame, obj, ray, v, tmin);
-            if let Verdict::Hit(hit) = verdict {
-                return Some(SurfaceHit {
-                    voxel: v,
-                    rec: *rec,
-                    point: ray.at(hit.t),
-                    normal: hit.normal,
-                    verified: true,
-                });
-            }
-            if let Some(h) = self.verify_neighbours(ray, v, rec.object, tmin, leave) {
-                stats.neighbour_hits += 1;
-                return Some(h);
-            }
-            match verdict {
-                Verdict::Ahead => stats.deferred += 1,
-                _ => stats.false_hits += 1,
-            }
-            return None;
-        }
-        // The point where the ray entered the voxel (or, for a voxel the
-        // continuous ray only grazes, its point nearest the voxel centre).
-        let t = match slab(o_r, ray.dir, lo, lo + 1.0) {
-            Some((t0, _)) => t0,
-            None => (lo + 0.5 - o_r).dot(ray.dir),
-        };
-        let t = (t * vs).max(tmin.max(0.0));
-        Some(SurfaceHit {
+    ) -> SurfaceHit {
+        let t = (entry_param(o_r, ray.dir, v) * self.frame.voxel_size).max(tmin.max(0.0));
+        SurfaceHit {
             voxel: v,
             rec: *rec,
+            object: self.store.owner(rec),
+            t,
             point: ray.at(t),
             normal: decode(rec),
             verified: false,
-        })
+        }
     }
 
-    /// When the hit voxel's own object fails verification: the nearest
-    /// exact intersection, within the same window, with the objects that
-    /// own the voxel's 26 neighbours (each object once, none the acne rule
-    /// ignores). A voxel holds one object; where surfaces meet (a mesh's
-    /// shared edges, touching spheres) the object the ray truly meets in
-    /// this voxel may own only the voxel next to it.
-    pub(super) fn verify_neighbours(
+    /// Verification at one opaque voxel `v` (plane index `index`, record
+    /// `rec`) of the walk of `ray`: every object of the voxel not yet in
+    /// `mail` is tested; an exact object by its first intersection with
+    /// `t > tmin` anywhere on the ray, an object without exact geometry by
+    /// the point where the ray enters this voxel (unless the acne rule
+    /// `leave` ignores the voxel). The nearest is kept in `best`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn test_voxel(
         &self,
         ray: &Ray,
+        o_r: DVec3,
         v: [u32; 3],
-        own: u32,
+        index: usize,
+        rec: &VoxelRecord,
         tmin: f64,
         leave: Option<&LeavingSurface>,
-    ) -> Option<SurfaceHit> {
-        let mut tried = [own; 27];
-        let mut n_tried = 1;
-        let mut best: Option<(f64, SurfaceHit)> = None;
+        mail: &mut Mailbox,
+        best: &mut Option<Candidate>,
+    ) {
+        let ids = self.store.objects(rec);
+        let shared = ids.len() > 1;
+        let vs = self.frame.voxel_size;
+        for &id in ids {
+            let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) else {
+                continue;
+            };
+            let found = if obj.shape.is_exact() {
+                if mail.tested(id) {
+                    continue;
+                }
+                obj.shape
+                    .intersect(ray, tmin, f64::INFINITY)
+                    .filter(|h| h.normal.is_finite() && h.t.is_finite())
+                    .map(|h| (h.t, h.normal, true))
+            } else if leave.is_some_and(|l| l.ignores(&self.store, index, rec)) {
+                None
+            } else {
+                let t = (entry_param(o_r, ray.dir, v) * vs).max(tmin.max(0.0));
+                Some((t, decode(rec), false))
+            };
+            if let Some((t, normal, exact)) = found
+                && best.as_ref().is_none_or(|b| t < b.t)
+            {
+                *best = Some(Candidate {
+                    t,
+                    object: id,
+                    normal,
+                    voxel: v,
+                    rec: *rec,
+                    exact,
+                    shared,
+                });
+            }
+        }
+    }
+
+    /// The surface hit of an accepted candidate: its object's attributes
+    /// (the voxel's record when the object owns the voxel, else the record
+    /// of the nearest neighbouring voxel it owns, else its material's),
+    /// the true point and normal.
+    pub(super) fn candidate_hit(&self, ray: &Ray, c: &Candidate) -> SurfaceHit {
+        SurfaceHit {
+            voxel: c.voxel,
+            rec: self.attributes_of(c.object, c.voxel, &c.rec),
+            object: c.object,
+            t: c.t,
+            point: ray.at(c.t),
+            normal: c.normal,
+            verified: c.exact,
+        }
+    }
+
+    /// A record with object `id`'s attributes near voxel `v` (record
+    /// `rec`): see [`Tracer::candidate_hit`].
+    fn attributes_of(&self, id: u32, v: [u32; 3], rec: &VoxelRecord) -> VoxelRecord {
+        if self.store.owner(rec) == id {
+            return *rec;
+        }
+        let mut nearest: Option<(i32, VoxelRecord)> = None;
         for dz in -1i32..=1 {
             for dy in -1i32..=1 {
                 for dx in -1i32..=1 {
@@ -171,41 +286,34 @@ impl Tracer<'_> {
                     if c & cell::OPAQUE == 0 {
                         continue;
                     }
-                    let Some(nrec) = self.store.get_hinted([x, y, z], c) else {
-                        continue;
-                    };
-                    if tried[..n_tried].contains(&nrec.object)
-                        || leave.is_some_and(|l| l.ignores(self.extent, index, nrec))
+                    let far = dx.abs() + dy.abs() + dz.abs();
+                    if let Some(n) = self.store.get_hinted([x, y, z], c)
+                        && self.store.owner(n) == id
+                        && nearest.as_ref().is_none_or(|(d, _)| far < *d)
                     {
-                        continue;
-                    }
-                    if let Some(slot) = tried.get_mut(n_tried) {
-                        *slot = nrec.object;
-                        n_tried += 1;
-                    }
-                    let Some(obj) = usize::try_from(nrec.object)
-                        .ok()
-                        .and_then(|i| self.objects.get(i))
-                    else {
-                        continue;
-                    };
-                    if let Verdict::Hit(hit) = verify(&self.frame, obj, ray, v, tmin)
-                        && best.as_ref().is_none_or(|(t, _)| hit.t < *t)
-                    {
-                        best = Some((
-                            hit.t,
-                            SurfaceHit {
-                                voxel: [x, y, z],
-                                rec: *nrec,
-                                point: ray.at(hit.t),
-                                normal: hit.normal,
-                                verified: true,
-                            },
-                        ));
+                        nearest = Some((far, *n));
                     }
                 }
             }
         }
-        best.map(|(_, h)| h)
+        if let Some((_, n)) = nearest {
+            return n;
+        }
+        let mut r = *rec;
+        if let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) {
+            r.material = obj.material;
+            if let Some(m) = self.materials.get(usize::from(obj.material)) {
+                r.color = [m.colour.x, m.colour.y, m.colour.z]
+                    .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+            }
+        }
+        r
+    }
+
+    pub(super) fn accept(&self, ray: &Ray, c: &Candidate, stats: &mut RayStats) -> SurfaceHit {
+        if c.shared {
+            stats.shared_hits += 1;
+        }
+        self.candidate_hit(ray, c)
     }
 }

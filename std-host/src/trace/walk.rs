@@ -13,7 +13,7 @@ use rrt_core::raster::{Extent, cell};
 use rrt_core::store::RecordStore;
 use rrt_core::voxel::VoxelRecord;
 
-use super::verify::slab;
+use super::verify::{Candidate, Mailbox, REACH_MARGIN, exit_param, slab};
 use super::{BLOCK, RayStats, SurfaceHit, Tracer};
 use crate::frame::round_to_i64;
 use crate::world::Ray;
@@ -22,9 +22,9 @@ use crate::world::Ray;
 /// non-transparent voxel (`None`: the ray misses the raster).
 #[derive(Clone, Copy, Debug)]
 pub struct FirstWalk {
-    ray: Option<DiscreteRay>,
-    end: WalkEnd,
-    steps: u64,
+    pub(super) ray: Option<DiscreteRay>,
+    pub(super) end: WalkEnd,
+    pub(super) steps: u64,
     /// The record of the hit voxel when the walk's hit test already
     /// fetched it (index, record), so that resolving does not look it up
     /// again.
@@ -183,7 +183,8 @@ impl Tracer<'_> {
     }
 
     /// Resolves a ray's walk into its surface hit: checks the hit voxel
-    /// (record, verification) and resumes the walk past false hits.
+    /// (record, verification) and resumes the walk past false hits
+    /// (verification: [`Tracer::resolve_verified`]).
     pub(super) fn resolve(
         &self,
         ray: &Ray,
@@ -193,13 +194,18 @@ impl Tracer<'_> {
         stats: &mut RayStats,
     ) -> Option<SurfaceHit> {
         let before = stats.false_hits;
-        let hit = self.resolve_walk(ray, walk, tmin, leave, stats);
+        let hit = if self.opts.verify {
+            self.resolve_verified(ray, walk, tmin, leave, stats)
+        } else {
+            self.resolve_walk(ray, walk, tmin, leave, stats)
+        };
         if stats.false_hits > before {
             stats.false_hit_rays += 1;
         }
         hit
     }
 
+    /// The paper's raw mode: the first surface voxel is the hit.
     pub(super) fn resolve_walk(
         &self,
         ray: &Ray,
@@ -213,7 +219,6 @@ impl Tracer<'_> {
         let dray = walk.ray.as_mut()?;
         let mut end = walk.end;
         let o_r = self.frame.world_to_raster(ray.origin);
-        let vs = self.frame.voxel_size;
         loop {
             if end != WalkEnd::Hit {
                 return None;
@@ -226,15 +231,9 @@ impl Tracer<'_> {
                     self.store.get_hinted(h.voxel, c).copied()
                 }
             };
-            let accepted = match &rec {
-                None => {
-                    stats.missing += 1;
-                    None
-                }
-                Some(rec) => self.check_hit(ray, o_r, vs, h.voxel, rec, tmin, leave, stats),
-            };
-            if accepted.is_some() {
-                return accepted;
+            match &rec {
+                None => stats.missing += 1,
+                Some(rec) => return Some(self.discrete_hit(ray, o_r, h.voxel, rec, tmin)),
             }
             // Resume after this voxel.
             let before = dray.steps();
@@ -256,6 +255,58 @@ impl Tracer<'_> {
                 })
                 .unwrap_or(WalkEnd::Exit);
             stats.missing += missing;
+            stats.steps += u64::from(dray.steps().saturating_sub(before));
+        }
+    }
+
+    /// Resolves a walk under verification (module docs, *Intersection
+    /// verification*): at each opaque voxel reached, its objects are tested
+    /// ([`Tracer::test_voxel`]); the nearest candidate is the hit as soon
+    /// as its `t` is within the part of the ray the walk has reached (up to
+    /// the continuous ray's exit from the current voxel, plus
+    /// [`REACH_MARGIN`]); otherwise the walk goes on. A walk that leaves the
+    /// raster with a candidate takes it.
+    pub(super) fn resolve_verified(
+        &self,
+        ray: &Ray,
+        walk: &mut FirstWalk,
+        tmin: f64,
+        leave: Option<&LeavingSurface>,
+        stats: &mut RayStats,
+    ) -> Option<SurfaceHit> {
+        stats.steps += walk.steps;
+        let dray = walk.ray.as_mut()?;
+        let mut end = walk.end;
+        let o_r = self.frame.world_to_raster(ray.origin);
+        let vs = self.frame.voxel_size;
+        let mut mail = Mailbox::default();
+        let mut best: Option<Candidate> = None;
+        loop {
+            if end != WalkEnd::Hit {
+                return best.map(|c| self.accept(ray, &c, stats));
+            }
+            let h = dray.hit();
+            let c = self.raster.plane().get(h.index).copied().unwrap_or(0);
+            match self.store.get_hinted(h.voxel, c) {
+                None => stats.missing += 1,
+                Some(rec) => {
+                    self.test_voxel(
+                        ray, o_r, h.voxel, h.index, rec, tmin, leave, &mut mail, &mut best,
+                    );
+                    let reach = (exit_param(o_r, ray.dir, h.voxel) + REACH_MARGIN) * vs;
+                    match &best {
+                        Some(b) if b.t <= reach => return Some(self.accept(ray, b, stats)),
+                        Some(_) => stats.deferred += 1,
+                        None => stats.false_hits += 1,
+                    }
+                }
+            }
+            let before = dray.steps();
+            end = dray
+                .walk_skipping(&self.raster, self.opts.connectivity, u32::MAX, |_, c| {
+                    c & cell::OPAQUE != 0
+                })
+                .unwrap_or(WalkEnd::Exit);
             stats.steps += u64::from(dray.steps().saturating_sub(before));
         }
     }
@@ -305,6 +356,6 @@ pub(super) fn surface_voxel<'s>(
         return None;
     };
     leave
-        .is_none_or(|l| !l.ignores_voxel(v, rec))
+        .is_none_or(|l| !l.ignores_voxel(store, v, rec))
         .then_some(rec)
 }

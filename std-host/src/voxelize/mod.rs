@@ -80,6 +80,13 @@ pub struct BuildOptions {
     pub light: LightParams,
     /// Threads of the light pass; 0 for one per core.
     pub threads: usize,
+    /// Voxelize for exact intersection verification: every object
+    /// conservatively ([`Separation::TwentySix`]: each voxel whose closed
+    /// cube its surface meets, however small the object), and every voxel
+    /// that several objects' surfaces pass through gets the list of all of
+    /// them ([`rrt_core::store`], *Object lists*). Otherwise the paper's
+    /// raster: the separation the rays need, one object per voxel.
+    pub exact: bool,
 }
 
 impl BuildOptions {
@@ -95,6 +102,7 @@ impl BuildOptions {
             connectivity: Connectivity::Adaptive,
             light: LightParams::default(),
             threads: 0,
+            exact: false,
         }
     }
 }
@@ -246,7 +254,11 @@ pub fn build(
     let fitted = fit::fit(scene, &opts.fit)?;
     let frame = fitted.frame;
     let extent = frame.extent;
-    let separation = Separation::for_rays(opts.connectivity);
+    let separation = if opts.exact {
+        Separation::TwentySix
+    } else {
+        Separation::for_rays(opts.connectivity)
+    };
     let objects = objects::in_id_order(scene, &fitted);
     let n = objects.len();
 
@@ -272,11 +284,15 @@ pub fn build(
             bounds,
         });
     }
+    // The lists' working storage: the count pass's bound (see
+    // `Sizing::list_entries`), only for an exact raster.
+    let list_n = if opts.exact { sizing.list_entries() } else { 0 };
     let needed = u64::try_from(
         extent
             .len()
             .saturating_add(dir_len.saturating_mul(size_of::<u32>()))
-            .saturating_add(sizing.record_bytes()),
+            .saturating_add(sizing.record_bytes())
+            .saturating_add(list_n.saturating_mul(size_of::<u32>())),
     )
     .unwrap_or(u64::MAX);
     if needed > opts.fit.max_memory {
@@ -288,17 +304,19 @@ pub fn build(
         });
     }
     let mut records = vec![VoxelRecord::default(); records_n];
+    let mut lists = vec![0u32; list_n];
     let textures = MaterialTextures::new(scene, frame);
     let built = fill_pass(
         &objects,
         &frame,
         separation,
         sizing,
-        &mut records,
+        (&mut records, opts.exact.then_some(&mut lists[..])),
         &materials,
         &textures,
         progress,
     )?;
+    let lists_used = built.lists().len();
     let voxelize = t0.elapsed();
 
     let t1 = Instant::now();
@@ -311,10 +329,12 @@ pub fn build(
         progress,
     )?;
     records = lit;
+    lists.truncate(lists_used);
+    lists.shrink_to_fit();
     let lights_time = t1.elapsed();
 
     let t2 = Instant::now();
-    let lines = finish_plane(extent, &mut plane, &directory, &records);
+    let lines = finish_plane(extent, &mut plane, &directory, &records, &lists);
     let voxelize = voxelize + t2.elapsed();
 
     let world_objects = objects
@@ -349,6 +369,7 @@ pub fn build(
             lines,
             directory,
             records,
+            lists,
             objects: world_objects,
             materials: materials.list,
             lights: world_lights,
@@ -387,16 +408,17 @@ fn count_pass<'p, 'd>(
     Ok((counter.finish()?, offers))
 }
 
-/// The fill pass: every object again, into `records`, named with its
-/// object id, material and colour (a textured material's colour computed
-/// per voxel). Returns the store, its bricks sorted and proximity flags set.
+/// The fill pass: every object again, into `records` (and, given list
+/// storage, the object lists), named with its object id, material and
+/// colour (a textured material's colour computed per voxel). Returns the
+/// store, its bricks sorted and proximity flags set.
 #[allow(clippy::too_many_arguments)]
 fn fill_pass<'p, 'd, 'r>(
     objects: &[TableObject<'_>],
     frame: &RasterFrame,
     separation: Separation,
     sizing: Sizing<'p, 'd>,
-    records: &'r mut [VoxelRecord],
+    (records, lists): (&'r mut [VoxelRecord], Option<&'r mut [u32]>),
     materials: &MaterialTable,
     textures: &MaterialTextures,
     progress: &ProgressBar,
@@ -411,7 +433,10 @@ fn fill_pass<'p, 'd, 'r>(
         objects: u32::try_from(objects.len()).unwrap_or(u32::MAX),
         materials: u32::try_from(materials.list.len()).unwrap_or(u32::MAX),
     };
-    let mut filler = sizing.fill(records, limits)?;
+    let mut filler = match lists {
+        Some(lists) => sizing.fill_with_lists(records, lists, limits)?,
+        None => sizing.fill(records, limits)?,
+    };
     for (id, o) in objects.iter().enumerate() {
         let m = o.material();
         let pass = Pass::Fill {

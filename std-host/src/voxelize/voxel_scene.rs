@@ -36,7 +36,11 @@ pub struct VoxelScene {
     pub directory: Vec<u32>,
     /// The voxel records, sorted by brick and position.
     pub records: Vec<VoxelRecord>,
-    /// The world object table, indexed by [`VoxelRecord::object`].
+    /// The object lists of the voxels several objects share (empty for the
+    /// paper's raster, one object per voxel; see [`rrt_core::store`]).
+    pub lists: Vec<u32>,
+    /// The world object table, indexed by the object ids of the records
+    /// and lists ([`RecordStore::objects`]).
     pub objects: Vec<WorldObject>,
     /// Distinct materials, indexed by [`VoxelRecord::material`].
     pub materials: Vec<Material>,
@@ -75,7 +79,12 @@ impl VoxelScene {
     /// # Errors
     /// The first broken store invariant.
     pub fn store(&self) -> Result<RecordStore<'_>, StoreError> {
-        RecordStore::new(self.frame.extent, &self.directory, &self.records)
+        RecordStore::with_lists(
+            self.frame.extent,
+            &self.directory,
+            &self.records,
+            &self.lists,
+        )
     }
 
     /// The SPD intensity of each light and of the ambient term.
@@ -84,7 +93,8 @@ impl VoxelScene {
         light_intensity(self.lights.len())
     }
 
-    /// Bytes held by the plane, its line level, directory and records.
+    /// Bytes held by the plane, its line level, directory, records and
+    /// object lists.
     #[must_use]
     pub fn memory(&self) -> u64 {
         let dir = self.directory.len().saturating_mul(size_of::<u32>());
@@ -97,7 +107,8 @@ impl VoxelScene {
             .len()
             .saturating_add(self.lines.len())
             .saturating_add(dir)
-            .saturating_add(rec);
+            .saturating_add(rec)
+            .saturating_add(self.lists.len().saturating_mul(size_of::<u32>()));
         u64::try_from(bytes).unwrap_or(u64::MAX)
     }
 }
@@ -106,17 +117,18 @@ impl VoxelScene {
 /// proximity distance field (empty-space skipping for 26-runs; it sets the
 /// same PROXIMITY flags the builder set), the records' rank hints in their
 /// opaque cells (which the field clears), and the line level, returned.
-/// A plane, directory or record array that does not match `extent` is left
-/// as it is, with no line level.
+/// A plane, directory, record or list array that does not match `extent`
+/// is left as it is, with no line level.
 pub fn finish_plane(
     extent: Extent,
     plane: &mut [u8],
     directory: &[u32],
     records: &[VoxelRecord],
+    lists: &[u32],
 ) -> Vec<u8> {
     if let Ok(mut raster) = RasterMut::new(extent, plane) {
         distance_field(&mut raster);
-        if let Ok(store) = RecordStore::new(extent, directory, records) {
+        if let Ok(store) = RecordStore::with_lists(extent, directory, records, lists) {
             write_rank_hints(&mut raster, &store);
         }
     }
