@@ -30,7 +30,7 @@ use rrt_core::raster::{Raster, RasterMut};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Algo {
     Rrt(Connectivity),
-    /// rrt with proximity-distance skipping (issue 8), on the same raster.
+    /// rrt with proximity-distance skipping, on the same raster.
     RrtSkip(Connectivity),
     AmanatidesWoo,
     WalkVoxels,
