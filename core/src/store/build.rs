@@ -319,6 +319,8 @@ impl<'p, 'd> Sizing<'p, 'd> {
             unlisted: 0,
             listing,
             slab: self.slab,
+            last_object: None,
+            in_order: true,
         })
     }
 }
@@ -368,6 +370,13 @@ pub struct Filler<'p, 'd, 'r> {
     /// ([`Sizing::fill_with_lists`]) or keep their owner only.
     listing: bool,
     slab: Option<u32>,
+    /// The largest object id begun so far.
+    last_object: Option<u32>,
+    /// Whether objects have been begun in increasing id order (repeats of
+    /// the current one allowed), each object's offers in one run: then an
+    /// object can only be in a voxel's chain as the chain's head node, the
+    /// last one added to it (see [`Filler::listed`]).
+    in_order: bool,
 }
 
 /// While the fill pass runs, a record's `lights` and first two `illum`
@@ -401,14 +410,64 @@ fn chain(lists: &[u32], head: usize) -> impl Iterator<Item = (usize, u32)> + '_ 
     })
 }
 
+/// Where the current `object` sits in the chain starting at `head`, if it
+/// does. With the objects begun in order ([`Filler`]'s `in_order`), only
+/// the head node can hold it: nodes are added at the head, and while an
+/// object's offers run only that object is added (a voxel's owner
+/// re-joins the chain only where the current object leaves it, in place).
+/// Otherwise the whole chain is searched.
+fn listed(lists: &[u32], in_order: bool, head: usize, object: u32) -> Option<(usize, u32)> {
+    if in_order {
+        let at = head.checked_sub(1)?;
+        let o = *lists.get(at)?;
+        (o == object).then_some((at, o))
+    } else {
+        chain(lists, head).find(|&(_, o)| o == object)
+    }
+}
+
 /// The voxel-centre position of `v` in fixed units.
 fn centre(v: [u32; 3]) -> [i64; 3] {
     v.map(crate::fixed::voxel_centre)
 }
 
 /// How many records back from a brick's cursor a repeat offer searches at
-/// most: a brick holds at most 512.
+/// most when its slot hint does not find the record: a brick holds at most
+/// 512.
 const SCAN_LIMIT: usize = BRICK_VOXELS as usize;
+
+/// Shift of a filled cell's *slot hint* (the bits above [`FILLED`], free
+/// until [`Filler::finish`] rewrites the cell): the record's slot divided
+/// by [`SLOT_BLOCK`], modulo [`SLOT_BLOCKS`]. A brick's records lie within
+/// 512 slots of its cursor, so the hint names the one block of 16 slots
+/// below the cursor that holds the record: a repeat offer scans at most 16
+/// records instead of the brick.
+const SLOT_HINT_SHIFT: u32 = cell::DISTANCE_SHIFT + 1;
+/// Slots per hinted block.
+const SLOT_BLOCK: usize = 16;
+/// Distinct hints (5 bits): `SLOT_BLOCK · SLOT_BLOCKS` = a brick's 512.
+const SLOT_BLOCKS: usize = 32;
+
+/// The hint bits of a record at `slot` ([`SLOT_HINT_SHIFT`]).
+fn slot_hint(slot: usize) -> u8 {
+    // Below 32: the truncation is the modulo.
+    #[allow(clippy::cast_possible_truncation)]
+    let h = ((slot / SLOT_BLOCK) % SLOT_BLOCKS) as u8;
+    h << SLOT_HINT_SHIFT
+}
+
+/// The slots `lo..hi` of the block a cell's hint names, below the cursor
+/// `at` (see [`SLOT_HINT_SHIFT`]); empty when `at` is 0.
+fn hinted_block(c: u8, at: usize) -> core::ops::Range<usize> {
+    let Some(last) = at.checked_sub(1) else {
+        return 0..0;
+    };
+    let hint = usize::from(c >> SLOT_HINT_SHIFT);
+    let top = last / SLOT_BLOCK;
+    let back = top.wrapping_sub(hint) % SLOT_BLOCKS;
+    let lo = top.saturating_sub(back).saturating_mul(SLOT_BLOCK);
+    lo..lo.saturating_add(SLOT_BLOCK).min(at)
+}
 
 impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
     /// Names the object whose voxels the following offers are.
@@ -431,6 +490,13 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
             });
         }
         self.current = Some(attrs);
+        if self.last_object.is_some_and(|last| attrs.object < last) {
+            self.in_order = false;
+        }
+        self.last_object = Some(
+            self.last_object
+                .map_or(attrs.object, |l| l.max(attrs.object)),
+        );
         Ok(())
     }
 
@@ -499,7 +565,7 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
                 return;
             };
             *slot = make(attrs);
-            *c |= FILLED;
+            *c |= FILLED | slot_hint(at);
             *cursor = cursor.saturating_add(1);
             self.filled = self.filled.saturating_add(1);
             self.report.records = self.report.records.saturating_add(1);
@@ -511,17 +577,27 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
             return;
         }
         // Marked: its record is among this brick's filled records, just
-        // below the cursor; scan back to it.
+        // below the cursor, in the block its hint names. Scanning that
+        // block down from its top meets this brick's records before any
+        // earlier brick's (positions repeat only across bricks); the whole
+        // brick is the fallback.
         let pos = key & KEY_POSITION_MASK;
-        let Some(filled) = self.records.get_mut(..at) else {
-            return;
-        };
-        let Some(r) = filled
-            .iter_mut()
-            .rev()
-            .take(SCAN_LIMIT)
-            .find(|r| r.position() == pos)
-        else {
+        let block = hinted_block(*c, at);
+        let found = self
+            .records
+            .get(block.clone())
+            .and_then(|b| b.iter().rposition(|r| r.position() == pos))
+            .map(|i| block.start.saturating_add(i))
+            .or_else(|| {
+                let filled = self.records.get(..at)?;
+                let back = filled
+                    .iter()
+                    .rev()
+                    .take(SCAN_LIMIT)
+                    .position(|r| r.position() == pos)?;
+                at.checked_sub(back)?.checked_sub(1)
+            });
+        let Some(r) = found.and_then(|i| self.records.get_mut(i)) else {
             return;
         };
         let nearer = (key >> crate::voxel::KEY_DISTANCE_SHIFT) < r.distance();
@@ -529,7 +605,7 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
         let mut head = chain_head(r);
         if self.listing && attrs.object != owner {
             // The chain holds every object of the voxel but its owner, once.
-            let listed = chain(self.lists, head).find(|&(_, o)| o == attrs.object);
+            let listed = listed(self.lists, self.in_order, head, attrs.object);
             let add = match (nearer, listed) {
                 // The new owner leaves the chain, the old one joins it.
                 (true, Some((at, _))) => {

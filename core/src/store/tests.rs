@@ -756,3 +756,109 @@ fn corrupt_object_lists_are_rejected() {
         StoreError::ListsEnd { used: 7, len: 8 }
     );
 }
+
+/// Builds with lists from `runs` of offers, each run begun with its
+/// object id, in the order given; the sorted objects of each voxel.
+fn objects_of_runs(
+    extent: Extent,
+    runs: &[(u32, Vec<([u32; 3], u32)>)],
+) -> HashMap<[u32; 3], Vec<u32>> {
+    let mut plane = vec![0u8; extent.len()];
+    let mut dir = vec![0u32; directory_len(extent).unwrap()];
+    let mut counter = Counter::new(RasterMut::new(extent, &mut plane).unwrap(), &mut dir).unwrap();
+    for (_, offers) in runs {
+        for &(v, d) in offers {
+            counter.offer(v, surfel(d));
+        }
+    }
+    let sizing = counter.finish().unwrap();
+    let mut records = vec![VoxelRecord::default(); sizing.records()];
+    let mut lists = vec![0u32; sizing.list_entries()];
+    let objects = runs.iter().map(|r| r.0 + 1).max().unwrap_or(1);
+    let limits = Limits {
+        objects,
+        materials: 1,
+    };
+    let mut filler = sizing
+        .fill_with_lists(&mut records, &mut lists, limits)
+        .unwrap();
+    for (id, offers) in runs {
+        filler
+            .begin_object(ObjectAttrs {
+                object: *id,
+                material: 0,
+                color: [0; 3],
+            })
+            .unwrap();
+        for &(v, d) in offers {
+            filler.offer(v, surfel(d));
+        }
+    }
+    let built = filler.finish().unwrap();
+    let store = built.store();
+    store
+        .iter()
+        .map(|(v, r)| {
+            let mut objs = store.objects(r).to_vec();
+            objs.sort_unstable();
+            (v, objs)
+        })
+        .collect()
+}
+
+#[test]
+fn object_lists_do_not_depend_on_the_order_objects_are_begun_in() {
+    for seed in 0..30u64 {
+        let mut rng = Rng(seed ^ 0x0dd);
+        let extent = Extent::new(
+            1 + rng.below_u32(16),
+            1 + rng.below_u32(16),
+            1 + rng.below_u32(16),
+        )
+        .unwrap();
+        let objects = 2 + rng.below_u32(6) as usize;
+        let offers = rng.below_u32(3000) as usize;
+        let script = random_script(extent, objects, offers, seed.wrapping_mul(7919));
+        let in_order: Vec<(u32, Vec<_>)> = script
+            .iter()
+            .enumerate()
+            .map(|(id, o)| (id as u32, o.clone()))
+            .collect();
+        // Each object's offers in two runs: every first half in order,
+        // then every second half backwards (objects begun again, out of
+        // order).
+        let halves = |back: bool| -> Vec<(u32, Vec<_>)> {
+            let mut v: Vec<(u32, Vec<_>)> = script
+                .iter()
+                .enumerate()
+                .map(|(id, o)| {
+                    let (a, b) = o.split_at(o.len() / 2);
+                    (id as u32, if back { b.to_vec() } else { a.to_vec() })
+                })
+                .collect();
+            if back {
+                v.reverse();
+            }
+            v
+        };
+        let mut split = halves(false);
+        split.extend(halves(true));
+        let want = offering_objects(&script)
+            .into_iter()
+            .map(|(v, mut o)| {
+                o.sort_unstable();
+                (v, o)
+            })
+            .collect::<HashMap<_, _>>();
+        assert_eq!(
+            objects_of_runs(extent, &in_order),
+            want,
+            "seed {seed}: in order"
+        );
+        assert_eq!(
+            objects_of_runs(extent, &split),
+            want,
+            "seed {seed}: split runs"
+        );
+    }
+}
