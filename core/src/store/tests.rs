@@ -757,12 +757,12 @@ fn corrupt_object_lists_are_rejected() {
     );
 }
 
+/// Runs of offers, each begun with its object id.
+type Runs = Vec<(u32, Vec<([u32; 3], u32)>)>;
+
 /// Builds with lists from `runs` of offers, each run begun with its
 /// object id, in the order given; the sorted objects of each voxel.
-fn objects_of_runs(
-    extent: Extent,
-    runs: &[(u32, Vec<([u32; 3], u32)>)],
-) -> HashMap<[u32; 3], Vec<u32>> {
+fn objects_of_runs(extent: Extent, runs: &Runs) -> HashMap<[u32; 3], Vec<u32>> {
     let mut plane = vec![0u8; extent.len()];
     let mut dir = vec![0u32; directory_len(extent).unwrap()];
     let mut counter = Counter::new(RasterMut::new(extent, &mut plane).unwrap(), &mut dir).unwrap();
@@ -819,7 +819,7 @@ fn object_lists_do_not_depend_on_the_order_objects_are_begun_in() {
         let objects = 2 + rng.below_u32(6) as usize;
         let offers = rng.below_u32(3000) as usize;
         let script = random_script(extent, objects, offers, seed.wrapping_mul(7919));
-        let in_order: Vec<(u32, Vec<_>)> = script
+        let in_order: Runs = script
             .iter()
             .enumerate()
             .map(|(id, o)| (id as u32, o.clone()))
@@ -827,8 +827,8 @@ fn object_lists_do_not_depend_on_the_order_objects_are_begun_in() {
         // Each object's offers in two runs: every first half in order,
         // then every second half backwards (objects begun again, out of
         // order).
-        let halves = |back: bool| -> Vec<(u32, Vec<_>)> {
-            let mut v: Vec<(u32, Vec<_>)> = script
+        let halves = |back: bool| -> Runs {
+            let mut v: Runs = script
                 .iter()
                 .enumerate()
                 .map(|(id, o)| {
