@@ -46,7 +46,6 @@ fn render_writes_a_png_and_one_summary_line() {
         "30",
         "--raster",
         "64",
-        "--verify",
         "--supersample",
         "2",
         "--threads",
@@ -86,7 +85,8 @@ fn render_writes_a_png_and_one_summary_line() {
     ])
     .unwrap();
     assert!(q.is_empty());
-    // Exact shadows: with verification only.
+    // The modes: exact by default (every light of a verified hit decided
+    // exactly), the verified and the paper's on request.
     let x = |extra: &[&str]| {
         let mut a = vec![
             "render",
@@ -98,18 +98,45 @@ fn render_writes_a_png_and_one_summary_line() {
             "16",
             "--raster",
             "64",
-            "--exact-shadows",
         ];
         a.extend_from_slice(extra);
         cli(&a)
     };
-    let e = x(&[]).unwrap_err();
-    assert!(e.contains("--verify"), "{e}");
-    let s = x(&["--verify"]).unwrap();
+    let s = x(&[]).unwrap();
     assert!(
-        s.contains("exact shadows") && !s.contains(" 0 shadow"),
+        s.contains("(exact mode,") && !s.contains(" 0 shadow"),
         "{s}"
     );
+    let s = x(&["--mode", "verified"]).unwrap();
+    assert!(s.contains("(verified mode,"), "{s}");
+    let s = x(&["--mode", "paper"]).unwrap();
+    assert!(
+        s.contains("(paper mode,") && s.contains(" 0 false hits"),
+        "{s}"
+    );
+    let e = x(&["--mode", "fast"]).unwrap_err();
+    assert!(e.contains("exact") && e.contains("paper"), "{e}");
+    // The paper's raster renders only in the paper's mode.
+    let rrt = dir.join("paper.rrt");
+    cli(&[
+        "voxelize",
+        "-o",
+        rrt.to_str().unwrap(),
+        "--raster",
+        "32",
+        "--mode",
+        "paper",
+        "-q",
+    ])
+    .unwrap();
+    let r = rrt.to_str().unwrap();
+    let o = out.to_str().unwrap();
+    let e = cli(&["render", r, "-o", o, "-q"]).unwrap_err();
+    assert!(
+        e.contains("exact mode") && e.contains("--mode paper"),
+        "{e}"
+    );
+    cli(&["render", r, "-o", o, "-q", "--mode", "paper"]).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -290,7 +317,8 @@ fn absurd_sizes_are_refused_up_front() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A raster voxelized for adaptive rays is too thin for 26-connected rays;
+/// The paper's raster voxelized for adaptive rays is too thin for
+/// 26-connected rays (an exact raster is thick enough for all);
 /// `--raster` and `--bounds` do not apply to a saved raster.
 #[test]
 fn saved_raster_options_are_checked() {
@@ -306,11 +334,22 @@ fn saved_raster_options_are_checked() {
         r,
         "--raster",
         "32",
+        "--mode",
+        "paper",
         "-q",
     ])
     .unwrap();
     fails_with(
-        &["render", r, "-o", o, "--connectivity", "twenty-six"],
+        &[
+            "render",
+            r,
+            "-o",
+            o,
+            "--connectivity",
+            "twenty-six",
+            "--mode",
+            "paper",
+        ],
         "26-connected rays would pass through",
     );
     fails_with(&["render", r, "-o", o, "--raster", "64"], "--raster: ");
@@ -323,7 +362,7 @@ fn saved_raster_options_are_checked() {
         "already a saved raster",
     );
     cli(&[
-        "render", r, "-o", o, "--width", "16", "--height", "16", "-q",
+        "render", r, "-o", o, "--width", "16", "--height", "16", "-q", "--mode", "paper",
     ])
     .unwrap();
     // Twenty-six-connected rays on a raster voxelized for them are fine.

@@ -214,7 +214,6 @@ fn toml_scene_renders_through_the_cli() {
         out.to_str().unwrap(),
         "--raster",
         "64",
-        "--verify",
         "--quiet",
     ])
     .unwrap();
@@ -364,12 +363,12 @@ fn scene_files_are_not_read_outside_the_options() {
 
 /// Exact shadows keep the shadows of objects without exact geometry: a
 /// metaball volume over a floor, lit from one side, shadows the floor
-/// beside it with and without `exact_shadows`.
+/// beside it in the verified and the exact mode.
 #[test]
 fn exact_shadows_keep_volume_shadows() {
     use rrt_host::render::camera::Camera;
     use rrt_host::render::{RenderOptions, render};
-    use rrt_host::trace::{TraceOptions, Tracer};
+    use rrt_host::trace::{Mode, TraceOptions, Tracer};
     let d = temp_dir("exact-volume");
     let p = d.join("s.toml");
     std::fs::write(
@@ -408,8 +407,11 @@ volume = "blob"
     let camera = Camera::new(&scene.view, 33, 33).unwrap();
     let draw = |exact_shadows: bool| {
         let opts = TraceOptions {
-            verify: true,
-            exact_shadows,
+            mode: if exact_shadows {
+                Mode::Exact
+            } else {
+                Mode::Verified
+            },
             ..TraceOptions::default()
         };
         let tracer = Tracer::new(&vs, opts).unwrap();

@@ -8,7 +8,7 @@ use glam::DVec3;
 use indicatif::ProgressBar;
 use rrt_host::output::rasterfile;
 use rrt_host::scene::Scene;
-use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+use rrt_host::trace::{Mode, RayStats, TraceOptions, Tracer};
 use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
 use rrt_host::world::Ray;
 
@@ -67,7 +67,6 @@ fn random_scene(seed: u64, spheres: usize, triangles: usize, r0: f64, r1: f64, e
 fn exact_build(nff: &str, raster: u32) -> VoxelScene {
     let scene = Scene::parse("random.nff", nff.as_bytes()).unwrap();
     let mut o = BuildOptions::new(raster);
-    o.exact = true;
     o.fit.max_memory = 1 << 30;
     build(&scene, &o, &ProgressBar::hidden()).unwrap().0
 }
@@ -91,7 +90,7 @@ fn check_rays(vs: &VoxelScene, seed: u64, n: usize, packets: bool) -> RayStats {
     let tracer = Tracer::new(
         vs,
         TraceOptions {
-            verify: true,
+            mode: Mode::Verified,
             packets,
             ..TraceOptions::default()
         },
@@ -186,7 +185,7 @@ fn a_small_sphere_in_a_voxel_of_a_triangle_is_found() {
     let tracer = Tracer::new(
         &vs,
         TraceOptions {
-            verify: true,
+            mode: Mode::Verified,
             ..TraceOptions::default()
         },
     )
@@ -236,7 +235,7 @@ fn object_lists_survive_a_saved_raster() {
     assert!(e.contains("bad.rrt"), "{e}");
     // The paper's raster (one object per voxel) stays version 1.
     let scene = Scene::parse("random.nff", nff.as_bytes()).unwrap();
-    let mut o = BuildOptions::new(32);
+    let mut o = BuildOptions::paper(32);
     o.fit.max_memory = 1 << 30;
     let raw = build(&scene, &o, &ProgressBar::hidden()).unwrap().0;
     assert!(raw.lists.is_empty());

@@ -16,7 +16,7 @@ pub(crate) use rrt_core::raster::{Raster, cell};
 pub(crate) use rrt_host::render::camera::Camera;
 pub(crate) use rrt_host::render::{Image, RenderOptions, render};
 pub(crate) use rrt_host::scene::{Scene, View};
-pub(crate) use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+pub(crate) use rrt_host::trace::{Mode, RayStats, TraceOptions, Tracer};
 pub(crate) use rrt_host::voxelize::{BuildOptions, BuildReport, VoxelScene, build};
 pub(crate) use rrt_host::world::Bounds;
 pub(crate) use rrt_host::world::Ray;
@@ -162,6 +162,7 @@ pub(crate) struct Built {
     pub(crate) report: BuildReport,
 }
 
+/// The paper's raster (one object per voxel, the paper's light bits).
 pub(crate) fn build_nff(
     scene: &Scene,
     raster: u32,
@@ -169,7 +170,28 @@ pub(crate) fn build_nff(
     threads: usize,
     bounds: Option<Bounds>,
 ) -> Res<Built> {
-    let mut opts = BuildOptions::new(raster);
+    build_with(scene, BuildOptions::paper(raster), conn, threads, bounds)
+}
+
+/// The exact raster `rrt voxelize` saves (object lists, the shadow
+/// classification): every mode renders from it.
+pub(crate) fn build_exact(scene: &Scene, raster: u32, threads: usize) -> Res<Built> {
+    build_with(
+        scene,
+        BuildOptions::new(raster),
+        Connectivity::Adaptive,
+        threads,
+        None,
+    )
+}
+
+fn build_with(
+    scene: &Scene,
+    mut opts: BuildOptions,
+    conn: Connectivity,
+    threads: usize,
+    bounds: Option<Bounds>,
+) -> Res<Built> {
     opts.connectivity = conn;
     opts.threads = threads;
     opts.fit.bounds = bounds;
@@ -210,11 +232,11 @@ pub(crate) fn render_scene(
     })
 }
 
-pub(crate) fn depth3(conn: Connectivity, verify: bool) -> TraceOptions {
+pub(crate) fn depth3(conn: Connectivity, mode: Mode) -> TraceOptions {
     TraceOptions {
+        mode,
         connectivity: conn,
         depth: 3,
-        verify,
         ..TraceOptions::default()
     }
 }
@@ -274,7 +296,7 @@ pub(crate) fn walk_all(
 }
 
 pub(crate) fn discrete_rays(scene: &VoxelScene, rays: &[Ray]) -> Res<Vec<Option<DiscreteRay>>> {
-    let tracer = Tracer::new(scene, TraceOptions::default())?;
+    let tracer = Tracer::new(scene, depth3(Connectivity::Adaptive, Mode::Paper))?;
     Ok(rays.iter().map(|r| tracer.discrete_ray(r)).collect())
 }
 

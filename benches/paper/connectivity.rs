@@ -37,7 +37,8 @@ pub(crate) fn connectivity(ctx: &mut Ctx) -> Res<()> {
             }
             for _ in 0..cfg.reps {
                 for (mi, &m) in modes.iter().enumerate() {
-                    let out = render_scene(&b.scene, &s.view, cfg.image, depth3(m, false), 1, 1)?;
+                    let out =
+                        render_scene(&b.scene, &s.view, cfg.image, depth3(m, Mode::Paper), 1, 1)?;
                     tr[mi].push(out.secs);
                     rstats[mi] = out.stats;
                 }

@@ -127,7 +127,7 @@ pub(crate) fn embree(ctx: &mut Ctx) -> Res<()> {
             for (ti, &th) in threads.iter().enumerate() {
                 let t = Instant::now();
                 let s = Scene::load(&path)?;
-                let b = build_nff(&s, r, Connectivity::Adaptive, th, None)?;
+                let b = build_exact(&s, r, th)?;
                 build_t[ti] = t.elapsed().as_secs_f64();
                 kept = Some((s, b));
             }
@@ -165,12 +165,12 @@ pub(crate) fn embree(ctx: &mut Ctx) -> Res<()> {
                         eb[fi][ti].push(e.build);
                         embree_img[fi] = Some(png);
                     }
-                    for (vi, verify) in [false, true].into_iter().enumerate() {
+                    for (vi, mode) in [Mode::Paper, Mode::Verified].into_iter().enumerate() {
                         let out = render_scene(
                             &fl.scene,
                             &fl.view,
                             cfg.image,
-                            depth3(Connectivity::Adaptive, verify),
+                            depth3(Connectivity::Adaptive, mode),
                             1,
                             th,
                         )?;
@@ -191,10 +191,7 @@ pub(crate) fn embree(ctx: &mut Ctx) -> Res<()> {
                 &fl.scene,
                 &fl.view,
                 cfg.image,
-                TraceOptions {
-                    exact_shadows: true,
-                    ..depth3(Connectivity::Adaptive, true)
-                },
+                depth3(Connectivity::Adaptive, Mode::Exact),
                 1,
                 1,
             )?;

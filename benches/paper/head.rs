@@ -185,6 +185,8 @@ pub fn build(
             directory,
             records,
             lists: Vec::new(),
+            exact: false,
+            exact_records: rrt_core::light::ExactRecords::Paper,
             objects: Vec::new(),
             materials: vec![material],
             lights: vec![WorldLight {

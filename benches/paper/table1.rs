@@ -66,7 +66,7 @@ pub(crate) fn table1(ctx: &mut Ctx) -> Res<()> {
                 &e.scene,
                 &e.view,
                 cfg.image,
-                depth3(Connectivity::Adaptive, false),
+                depth3(Connectivity::Adaptive, Mode::Paper),
                 1,
                 1,
             )?;

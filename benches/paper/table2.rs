@@ -92,7 +92,7 @@ pub(crate) fn table2(ctx: &mut Ctx) -> Res<()> {
         for rep in 0..cfg.reps {
             // RRT: the tracer's own setup and skipping walk, from world rays.
             let t = Instant::now();
-            let tracer = Tracer::new(&b.scene, TraceOptions::default())?;
+            let tracer = Tracer::new(&b.scene, depth3(Connectivity::Adaptive, Mode::Paper))?;
             let raster = b.scene.raster()?;
             let mut hits = Vec::with_capacity(rays.len());
             let mut steps = 0u64;
@@ -114,7 +114,7 @@ pub(crate) fn table2(ctx: &mut Ctx) -> Res<()> {
                 &b.scene,
                 &scene.view,
                 cfg.t2_image,
-                depth3(Connectivity::Adaptive, false),
+                depth3(Connectivity::Adaptive, Mode::Paper),
                 1,
                 1,
             )?;

@@ -9,17 +9,18 @@ pub(crate) fn verification(ctx: &mut Ctx) -> Res<()> {
         for (name, stem, _, _, paper_false) in FLAKES {
             ctx.log(&format!("verification: {stem} at {r}"));
             let s = Scene::load(ctx.spd(stem))?;
-            let b = build_nff(&s, r, Connectivity::Adaptive, 1, None)?;
-            let variants: [(bool, u32); 3] = [(false, 1), (true, 1), (false, 2)];
+            let b = build_exact(&s, r, 1)?;
+            let variants: [(Mode, u32); 3] =
+                [(Mode::Paper, 1), (Mode::Verified, 1), (Mode::Paper, 2)];
             let mut t = [Vec::new(), Vec::new(), Vec::new()];
             let mut st = [RayStats::default(); 3];
             for _ in 0..cfg.reps {
-                for (i, &(verify, ss)) in variants.iter().enumerate() {
+                for (i, &(mode, ss)) in variants.iter().enumerate() {
                     let out = render_scene(
                         &b.scene,
                         &s.view,
                         cfg.image,
-                        depth3(Connectivity::Adaptive, verify),
+                        depth3(Connectivity::Adaptive, mode),
                         ss,
                         1,
                     )?;

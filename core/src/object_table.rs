@@ -83,6 +83,21 @@ impl Shape {
             Self::Triangle(_) | Self::Cone(_) | Self::Patch(_) => false,
         }
     }
+
+    /// Whether the shape has a continuous definition a host can intersect
+    /// exactly (intersection verification): every shape but a sampled
+    /// volume and bare voxels.
+    ///
+    /// ```
+    /// use rrt_core::geometry::Sphere;
+    /// use rrt_core::object_table::Shape;
+    /// assert!(Shape::Sphere(Sphere { centre: [0; 3], radius: 1 }).is_exact());
+    /// assert!(!Shape::Voxels.is_exact());
+    /// ```
+    #[must_use]
+    pub const fn is_exact(&self) -> bool {
+        !matches!(self, Self::Volume(_) | Self::Voxels)
+    }
 }
 
 /// One entry of the object table.

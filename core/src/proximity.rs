@@ -127,6 +127,39 @@ pub const fn distance(c: u8) -> u8 {
     }
 }
 
+/// The cell `c` as it reads in the raster *dilated by one voxel*, where a
+/// voxel is non-transparent when a non-transparent voxel lies within
+/// chessboard distance 1 of it (`c` has [`cell::PROXIMITY`] or
+/// [`cell::OPAQUE`]): then [`cell::OPAQUE`] and [`cell::PROXIMITY`];
+/// otherwise the distance to the dilated voxels is the cell's distance
+/// less one, so a distance of 2 gives [`cell::PROXIMITY`] and a larger one
+/// that distance less one. A cell with no distance (0) reads as flagged,
+/// never skipped. For a plane with its distance field, or any line
+/// stand-in, this is the dilated raster's cell exactly (or with a smaller
+/// distance where the stored one saturated), so walks over the view keep
+/// the guarantees they have over a plane
+/// ([`DiscreteRay::walk_dilated`](crate::discrete_ray::DiscreteRay::walk_dilated)).
+///
+/// ```
+/// use rrt_core::proximity::{dilated, distance};
+/// use rrt_core::raster::cell;
+/// assert_eq!(dilated(cell::PROXIMITY | (1 << 2)), cell::OPAQUE | cell::PROXIMITY);
+/// assert_eq!(dilated(2 << 2), cell::PROXIMITY | (1 << 2));
+/// assert_eq!(distance(dilated(9 << 2)), 8);
+/// ```
+#[must_use]
+pub const fn dilated(c: u8) -> u8 {
+    if c & (cell::OPAQUE | cell::PROXIMITY) != 0 {
+        return cell::OPAQUE | cell::PROXIMITY;
+    }
+    let d = (c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK;
+    if d <= 2 {
+        cell::PROXIMITY | (d.saturating_sub(1) << cell::DISTANCE_SHIFT)
+    } else {
+        d.wrapping_sub(1) << cell::DISTANCE_SHIFT
+    }
+}
+
 /// Computes the raster's line level ([`Raster::with_lines`]): per line of
 /// [`LINE_CELLS`] consecutive plane cells, a stand-in cell carrying the
 /// smallest proximity distance of the line's cells when that is at least 2

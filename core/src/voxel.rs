@@ -126,8 +126,10 @@ pub enum LightVisibility {
     Occluded = 0,
     /// Nothing between the voxel and the light.
     Visible = 1,
-    /// Only translucent material (transmission `T > 0`) in between: the
-    /// renderer fires a shadow ray to find the attenuation.
+    /// Only translucent material (transmission `T > 0`) in between, or,
+    /// from the shadow classification, not proven lit
+    /// ([`crate::light::ExactRecords`]): the renderer fires a shadow ray
+    /// to decide.
     Translucent = 2,
     /// Not used by this version; read as occluded.
     Reserved = 3,

@@ -27,16 +27,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let quiet = ProgressBar::hidden();
 
-    // Voxelize once: 512 voxels along the scene's longest axis, lit.
+    // Voxelize once: 512 voxels along the scene's longest axis, with
+    // object lists and the shadow classification.
     let (voxels, report) = build(&scene, &BuildOptions::new(512), &quiet)?;
-    // Trace with intersection verification, render at the scene's resolution.
-    let tracer = Tracer::new(
-        &voxels,
-        TraceOptions {
-            verify: true,
-            ..TraceOptions::default()
-        },
-    )?;
+    // Trace in the exact mode (the default), at the scene's resolution.
+    let tracer = Tracer::new(&voxels, TraceOptions::default())?;
     let [w, h] = voxels.view.resolution;
     let camera = Camera::new(&voxels.view, w, h)?;
     let (image, stats, _) = render(&tracer, &camera, &RenderOptions::default(), &quiet)?;

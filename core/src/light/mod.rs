@@ -60,6 +60,26 @@
 //!
 //! A voxel whose record is missing (a plane that does not match the store)
 //! counts as an opaque blocker.
+//!
+//! # Shadow classification
+//! On a raster with object lists, whose hits the renderer verifies against
+//! each object's exact geometry, a record all of whose objects have exact
+//! geometry can get a proof instead of the paper's guess
+//! ([`ExactRecords::Classify`]; after Woo & Amanatides' voxel occlusion
+//! testing). For a light `L` and a voxel `v` with objects `O`: a point of
+//! a segment from any point of `v`'s closed cube to `L` lies within half a
+//! voxel (chessboard) of the segment from `v`'s centre to `L`, so every
+//! voxel such a segment passes through lies within chessboard distance 1
+//! of a voxel of that centre segment's 6-connected line: the segment's
+//! *tube* ([`DiscreteRay::walk_dilated`]). An object that blocks such a
+//! segment has a surface point on it, and every voxel its surface passes
+//! through lists it. So when every non-transparent voxel of the tube holds
+//! only objects of `O`, nothing but `O` can shadow any point of `v`, and a
+//! renderer needs to intersect only those: `Visible`. Otherwise
+//! `Translucent`: a render-time shadow ray decides. The answer does not
+//! depend on the stored normal (the renderer decides which side faces the
+//! light from the true normal), and the walk reads the distance field:
+//! the plane must be finished before the pass.
 
 use core::fmt;
 
@@ -87,6 +107,10 @@ pub struct LightParams {
     /// ([`NORMAL_ONE`]-scaled) belong to one surface for the acne rule:
     /// `NORMAL_ONE / 2` (60°) by default.
     pub same_surface_cos: i32,
+    /// What the pass computes for a record all of whose objects have
+    /// exact geometry ([`Shape::is_exact`](crate::object_table::Shape::is_exact)),
+    /// on a raster with object lists whose hits a renderer verifies.
+    pub exact_records: ExactRecords,
 }
 
 impl Default for LightParams {
@@ -95,8 +119,29 @@ impl Default for LightParams {
             mode: Connectivity::Six,
             slab: VOXEL.wrapping_mul(2),
             same_surface_cos: NORMAL_ONE / 2,
+            exact_records: ExactRecords::Paper,
         }
     }
+}
+
+/// The light pass's answer for a record whose objects all have exact
+/// geometry ([`LightParams::exact_records`]). Other records always get the
+/// paper's bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ExactRecords {
+    /// The paper's bits, from one discrete shadow ray per light.
+    #[default]
+    Paper,
+    /// The shadow classification (module docs, *Shadow classification*):
+    /// [`LightVisibility::Visible`] where it is proven that only the
+    /// voxel's own objects can stand between any point of the voxel and
+    /// the light, [`LightVisibility::Translucent`] (a render-time shadow
+    /// ray decides) elsewhere.
+    Classify,
+    /// No rays: every light [`LightVisibility::Translucent`], for a
+    /// renderer that decides every light of a verified hit with an exact
+    /// shadow ray.
+    Skip,
 }
 
 /// Why the light pass stopped.
@@ -271,38 +316,56 @@ fn shade_record<const N: usize>(
     let c0 = v.map(voxel_centre);
     let start = extent.index(v);
     rec.lights = 0;
+    // Every object of the voxel has exact geometry: the renderer verifies
+    // its hits and may read a classification instead of the paper's bits.
+    let original = rec;
+    let own = view.objects(&original);
+    let exact = params.exact_records != ExactRecords::Paper
+        && own
+            .iter()
+            .all(|&id| objects.get(id).is_some_and(|o| o.shape.is_exact()));
     // Sum of I·L_rgb·(N·L) over visible front-side lights, 2^-32 units.
     let mut acc = [u128::from(lights.ambient) << SCALAR_BITS; 3];
     for (i, light) in lights.as_slice().iter().enumerate() {
         let to_light = sub(light.position, c0);
         let l = normalize(to_light);
         let ndl = l.map_or(0, |l| dot_unit(normal, l));
-        let (side, front) = if ndl > 0 {
-            (normal, true)
-        } else if closed || ndl == 0 {
-            if l.is_some() {
-                report.facing_away = report.facing_away.saturating_add(1);
-                rec.set_light(i, LightVisibility::Occluded);
-                continue;
+        let front = ndl > 0;
+        let vis = match (exact, params.exact_records) {
+            (true, ExactRecords::Skip) => LightVisibility::Translucent,
+            (true, _) => {
+                report.rays = report.rays.saturating_add(1);
+                classify(raster, view, v, own, c0, light.position)?
             }
-            // The light sits at the voxel centre: nothing can block it.
-            (normal, true)
-        } else {
-            (normal.map(i32::wrapping_neg), false)
+            (false, _) => {
+                let side = if ndl > 0 {
+                    normal
+                } else if closed || ndl == 0 {
+                    if l.is_some() {
+                        report.facing_away = report.facing_away.saturating_add(1);
+                        rec.set_light(i, LightVisibility::Occluded);
+                        continue;
+                    }
+                    // The light sits at the voxel centre: nothing can block it.
+                    normal
+                } else {
+                    normal.map(i32::wrapping_neg)
+                };
+                report.rays = report.rays.saturating_add(1);
+                shadow_ray(
+                    raster,
+                    view,
+                    materials,
+                    params,
+                    start,
+                    c0,
+                    light.position,
+                    side,
+                    rec.normal,
+                    owner,
+                )?
+            }
         };
-        report.rays = report.rays.saturating_add(1);
-        let vis = shadow_ray(
-            raster,
-            view,
-            materials,
-            params,
-            start,
-            c0,
-            light.position,
-            side,
-            rec.normal,
-            owner,
-        )?;
         rec.set_light(i, vis);
         match vis {
             LightVisibility::Visible => {
@@ -405,60 +468,88 @@ fn shadow_ray<const N: usize>(
         }
         true
     };
-    let delta = [0, 1, 2].map(|k| {
-        i128::from(light.get(k).copied().unwrap_or(0))
-            .saturating_sub(i128::from(c0.get(k).copied().unwrap_or(0)))
-    });
-    let span = delta.iter().map(|d| d.unsigned_abs()).max().unwrap_or(0);
-    let limit = u128::from(i32::MAX.unsigned_abs());
-    let outcome = if span <= limit {
-        walk_piece(
-            raster,
-            params.mode,
-            DiscreteRay::segment(extent, c0, light)?,
-            &mut test,
-        )?
-    } else if !inside_box(extent, light) {
-        // Far light outside the raster: the half-line towards it leaves the
-        // raster where the segment would; scale the direction into i32.
-        let shift = 128u32
-            .saturating_sub(span.leading_zeros())
-            .saturating_sub(31);
-        let dir = delta.map(|d| i32::try_from(d >> shift).unwrap_or(0));
-        walk_piece(
-            raster,
-            params.mode,
-            DiscreteRay::new(extent, c0, dir)?,
-            &mut test,
-        )?
-    } else {
-        // A light inside a raster wider than 2^15 voxels: walk the segment
-        // in pieces whose extent fits i32 (at most 4: span < 2^33).
-        let pieces = span.div_ceil(limit).max(1);
-        let pieces_i = i128::try_from(pieces).unwrap_or(1);
-        let mut outcome = Piece::Clear;
-        let at = |j: i128| -> [i64; 3] {
-            [0, 1, 2].map(|k| {
-                let d = delta.get(k).copied().unwrap_or(0);
-                let c = i128::from(c0.get(k).copied().unwrap_or(0));
-                // |d·j| < 2^35 · 4: fits; the result lies between c0 and light.
-                let p = c.saturating_add(d.saturating_mul(j).checked_div(pieces_i).unwrap_or(0));
-                i64::try_from(p).unwrap_or(0)
-            })
-        };
-        for j in 0..pieces_i {
-            let ray = DiscreteRay::segment(extent, at(j), at(j.saturating_add(1)))?;
-            if walk_piece(raster, params.mode, ray, &mut test)? == Piece::Blocked {
-                outcome = Piece::Blocked;
-                break;
-            }
-        }
-        outcome
-    };
+    let outcome = to_light(extent, c0, light, |ray| {
+        walk_piece(raster, params.mode, ray, &mut test)
+    })?;
     Ok(match (outcome, translucent) {
         (Piece::Blocked, _) => LightVisibility::Occluded,
         (Piece::Clear, true) => LightVisibility::Translucent,
         (Piece::Clear, false) => LightVisibility::Visible,
+    })
+}
+
+/// The shadow classification of voxel `v` (centre `c0`, objects `own`)
+/// for a light at `light` (module docs, *Shadow classification*):
+/// [`LightVisibility::Visible`] when every non-transparent voxel within
+/// chessboard distance 1 of the 6-connected segment from `c0` to the
+/// light holds only objects of `own`, else [`LightVisibility::Translucent`]
+/// (undecided: a render-time shadow ray decides). A voxel without a record
+/// undecides too.
+fn classify(
+    raster: &Raster<'_>,
+    view: &RecordStore<'_>,
+    v: [u32; 3],
+    own: &[u32],
+    c0: [i64; 3],
+    light: [i64; 3],
+) -> Result<LightVisibility, LightError> {
+    let extent = raster.extent();
+    let plane = raster.plane();
+    // The last voxels found to hold only `own` objects: neighbouring path
+    // voxels share most of their neighbourhoods.
+    const PASSED: usize = 16;
+    let mut passed = [usize::MAX; PASSED];
+    let mut next = 0usize;
+    let mut foreign = |index: usize, _: u8| -> bool {
+        let Some(u) = extent.coord(index) else {
+            return true;
+        };
+        for w in neighbourhood(extent, u) {
+            let Some(wi) = extent.index(w) else {
+                continue;
+            };
+            let c = plane.get(wi).copied().unwrap_or(0);
+            if c & cell::OPAQUE == 0 || w == v || passed.contains(&wi) {
+                continue;
+            }
+            let Some(rec) = view.get_hinted(w, c) else {
+                return true;
+            };
+            if !view.objects(rec).iter().all(|o| own.contains(o)) {
+                return true;
+            }
+            if let Some(slot) = passed.get_mut(next) {
+                *slot = wi;
+            }
+            next = next.wrapping_add(1) & (PASSED - 1);
+        }
+        false
+    };
+    let outcome = to_light(extent, c0, light, |ray| {
+        let Some(mut ray) = ray else {
+            return Ok(Piece::Clear);
+        };
+        Ok(match ray.walk_dilated(raster, u32::MAX, &mut foreign)? {
+            WalkEnd::Hit => Piece::Blocked,
+            WalkEnd::Exit | WalkEnd::Budget => Piece::Clear,
+        })
+    })?;
+    Ok(match outcome {
+        Piece::Clear => LightVisibility::Visible,
+        Piece::Blocked => LightVisibility::Translucent,
+    })
+}
+
+/// The voxels within chessboard distance 1 of `u` inside `extent` (`u`
+/// among them).
+fn neighbourhood(extent: Extent, u: [u32; 3]) -> impl Iterator<Item = [u32; 3]> {
+    let [nx, ny, nz] = extent.dims();
+    let span = |c: u32, n: u32| c.saturating_sub(1)..=c.saturating_add(1).min(n.saturating_sub(1));
+    let (xs, ys, zs) = (span(u[0], nx), span(u[1], ny), span(u[2], nz));
+    zs.flat_map(move |z| {
+        let xs = xs.clone();
+        ys.clone()
+            .flat_map(move |y| xs.clone().map(move |x| [x, y, z]))
     })
 }
 
@@ -581,6 +672,58 @@ fn walk_piece<T: FnMut(usize, u8) -> bool>(
         // u32::MAX voxels exceed any raster's diagonal; treat as clear.
         WalkEnd::Budget => Ok(Piece::Clear),
     }
+}
+
+/// Walks the segment from `c0` to `light` (fixed units) through a raster
+/// of `extent` in the pieces `walk` is given: one segment when its extent
+/// fits `i32`; the half-line towards a far light outside the raster (which
+/// leaves the raster where the segment would); a light inside a raster
+/// wider than 2^15 voxels in up to 4 pieces. `Blocked` as soon as a piece
+/// is.
+fn to_light(
+    extent: Extent,
+    c0: [i64; 3],
+    light: [i64; 3],
+    mut walk: impl FnMut(Option<DiscreteRay>) -> Result<Piece, LightError>,
+) -> Result<Piece, LightError> {
+    let delta = [0, 1, 2].map(|k| {
+        i128::from(light.get(k).copied().unwrap_or(0))
+            .saturating_sub(i128::from(c0.get(k).copied().unwrap_or(0)))
+    });
+    let span = delta.iter().map(|d| d.unsigned_abs()).max().unwrap_or(0);
+    let limit = u128::from(i32::MAX.unsigned_abs());
+    if span <= limit {
+        return walk(DiscreteRay::segment(extent, c0, light)?);
+    }
+    if !inside_box(extent, light) {
+        let shift = 128u32
+            .saturating_sub(span.leading_zeros())
+            .saturating_sub(31);
+        let dir = delta.map(|d| i32::try_from(d >> shift).unwrap_or(0));
+        return walk(DiscreteRay::new(extent, c0, dir)?);
+    }
+    let pieces = span.div_ceil(limit).max(1);
+    let pieces_i = i128::try_from(pieces).unwrap_or(1);
+    let at = |j: i128| -> [i64; 3] {
+        [0, 1, 2].map(|k| {
+            let d = delta.get(k).copied().unwrap_or(0);
+            let c = i128::from(c0.get(k).copied().unwrap_or(0));
+            // |d·j| < 2^35 · 4: fits; the result lies between c0 and light.
+            let p = c.saturating_add(d.saturating_mul(j).checked_div(pieces_i).unwrap_or(0));
+            i64::try_from(p).unwrap_or(0)
+        })
+    };
+    for j in 0..pieces_i {
+        if walk(DiscreteRay::segment(
+            extent,
+            at(j),
+            at(j.saturating_add(1)),
+        )?)? == Piece::Blocked
+        {
+            return Ok(Piece::Blocked);
+        }
+    }
+    Ok(Piece::Clear)
 }
 
 #[cfg(test)]

@@ -7,12 +7,14 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
+use rrt_core::light::ExactRecords;
 
 use super::CliError;
 use super::ray::ConnectivityArg;
 use crate::fit::{FitOptions, default_max_memory};
 use crate::output::rasterfile;
 use crate::scene::{Scene, View};
+use crate::trace::Mode;
 use crate::voxelize::{BuildOptions, BuildReport, VoxelScene, build};
 use crate::world::Bounds;
 
@@ -38,13 +40,14 @@ pub struct RasterArgs {
     /// enough for it).
     #[arg(long, value_enum, default_value_t = ConnectivityArg::Adaptive)]
     pub connectivity: ConnectivityArg,
-    /// Intersection verification: voxelize every exact object
-    /// conservatively (every voxel its surface passes through, with the
-    /// list of all objects of a voxel several share) and, when rendering,
-    /// check each discrete hit against those objects' exact geometry,
-    /// using the true point and normal.
-    #[arg(long)]
-    pub verify: bool,
+    /// What a hit is and how it is lit. `exact` and `verified` voxelize
+    /// every object conservatively (every voxel its surface passes
+    /// through, with the list of all objects of a voxel several share); a
+    /// raster saved that way renders in every mode. `paper` voxelizes the
+    /// paper's raster (one object per voxel), which renders only in the
+    /// paper's mode.
+    #[arg(long, value_enum, default_value_t = ModeArg::Exact)]
+    pub mode: ModeArg,
     /// World box to voxelize, `X0,Y0,Z0,X1,Y1,Z1` (default: all geometry).
     #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_bounds, allow_hyphen_values = true)]
     pub bounds: Option<Bounds>,
@@ -54,13 +57,57 @@ pub struct RasterArgs {
     pub max_memory: Option<u64>,
 }
 
+/// The `--mode` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModeArg {
+    /// The exact ray tracer's image: every object of a voxel intersected
+    /// exactly, the true point and normal, exact shadows.
+    Exact,
+    /// The paper's intersection verification: exact hit point and normal,
+    /// the precomputed light visibility.
+    Verified,
+    /// The paper's raw discrete mode: the first surface voxel is the hit,
+    /// its stored normal, precomputed illumination and light visibility
+    /// (fastest).
+    Paper,
+}
+
+impl From<ModeArg> for Mode {
+    fn from(m: ModeArg) -> Self {
+        match m {
+            ModeArg::Exact => Self::Exact,
+            ModeArg::Verified => Self::Verified,
+            ModeArg::Paper => Self::Paper,
+        }
+    }
+}
+
+/// What a build is for: its light pass computes what that needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Purpose {
+    /// A raster to save: complete light visibility (the shadow
+    /// classification for records of exact objects), for every mode.
+    Save,
+    /// A render now, in the mode asked for: the exact mode reads no light
+    /// bits of exact objects, the verified mode the paper's.
+    Render,
+}
+
 impl RasterArgs {
-    /// The build options these arguments ask for.
+    /// The build options these arguments ask for, for `purpose`.
     #[must_use]
-    pub fn build_options(&self) -> BuildOptions {
-        let mut o = BuildOptions::new(self.raster.unwrap_or(DEFAULT_RASTER));
+    pub fn build_options(&self, purpose: Purpose) -> BuildOptions {
+        let raster = self.raster.unwrap_or(DEFAULT_RASTER);
+        let mut o = match self.mode {
+            ModeArg::Paper => BuildOptions::paper(raster),
+            _ => BuildOptions::new(raster),
+        };
+        o.light.exact_records = match (purpose, self.mode) {
+            (Purpose::Save, _) => ExactRecords::Classify,
+            (Purpose::Render, ModeArg::Exact) => ExactRecords::Skip,
+            (Purpose::Render, _) => ExactRecords::Paper,
+        };
         o.connectivity = self.connectivity.into();
-        o.exact = self.verify;
         o.fit = FitOptions {
             bounds: self.bounds,
             max_memory: self.max_memory.unwrap_or_else(default_max_memory),
@@ -234,6 +281,7 @@ pub enum Loaded {
 pub fn load_or_build(
     path: Option<&PathBuf>,
     raster: &RasterArgs,
+    purpose: Purpose,
     threads: usize,
     show_progress: bool,
 ) -> Result<Loaded, CliError> {
@@ -273,7 +321,7 @@ pub fn load_or_build(
             return Err(e);
         }
     };
-    let mut opts = raster.build_options();
+    let mut opts = raster.build_options(purpose);
     opts.threads = threads;
     let built = build(&scene, &opts, &bar);
     bar.finish_and_clear();

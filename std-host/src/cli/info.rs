@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use super::CliError;
 use crate::fit::Bytes;
 use crate::output::rasterfile;
+use rrt_core::light::ExactRecords;
 use rrt_core::voxelize::Separation;
 
 /// Arguments of `rrt info`.
@@ -55,6 +56,20 @@ pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
         match i.separation {
             Separation::Six => "6-tunnel-free (six, adaptive rays)",
             Separation::TwentySix => "26-tunnel-free (all rays)",
+        }
+    )?;
+    writeln!(
+        out,
+        "kind: {}",
+        match (i.version, i.exact_records) {
+            (1, _) => "the paper's raster (one object per voxel): renders in the paper's mode",
+            (_, ExactRecords::Classify) => {
+                "exact (object lists, the shadow classification): renders in every mode"
+            }
+            (_, ExactRecords::Skip) => {
+                "exact (object lists, no light bits for exact objects): renders in every mode, with a shadow ray for every light"
+            }
+            _ => "exact (object lists, the paper's light bits): renders in every mode",
         }
     )?;
     writeln!(

@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, RasterArgs, ViewArgs, load_or_build, progress, secs};
+use super::common::{Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, progress, secs};
 use crate::output::image::{Encoding, ImageOutput};
 use crate::render::camera::Camera;
 use crate::render::{RenderOptions, check_sizes, render};
@@ -42,11 +42,6 @@ pub struct RenderArgs {
     /// Depth of the ray tree (the eye ray counts as 1).
     #[arg(long, value_name = "D", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub depth: u32,
-    /// Exact shadows at verified hits: a render-time shadow ray per light,
-    /// each object it meets intersected exactly (slower; beyond the
-    /// paper, which uses the precomputed light visibility).
-    #[arg(long, requires = "verify")]
-    pub exact_shadows: bool,
     /// K×K rays per pixel, box-filtered.
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = parse_positive, allow_hyphen_values = true)]
     pub supersample: u32,
@@ -84,7 +79,13 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             linear: args.linear,
         },
     )?;
-    let loaded = load_or_build(args.scene.as_ref(), &args.raster, args.threads, !args.quiet)?;
+    let loaded = load_or_build(
+        args.scene.as_ref(),
+        &args.raster,
+        Purpose::Render,
+        args.threads,
+        !args.quiet,
+    )?;
     let scene = match &loaded {
         Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
     };
@@ -96,11 +97,10 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     let tracer = Tracer::new(
         scene,
         TraceOptions {
+            mode: args.raster.mode.into(),
             connectivity: args.raster.connectivity.into(),
             depth: args.depth,
-            verify: args.raster.verify,
             packets: args.packets,
-            exact_shadows: args.exact_shadows,
             ..TraceOptions::default()
         },
     )?;
@@ -135,25 +135,20 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         let rays = stats.rays().max(1);
         writeln!(
             out,
-            "{}: {w}×{h}, raster {}×{}×{} ({}{}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow; {:.1} steps/ray; {} hits, {} false hits ({:.2}% of rays)",
+            "{}: {w}×{h}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit); {:.1} steps/ray; {} hits, {} false hits ({:.2}% of rays)",
             args.output.display(),
             d[0],
             d[1],
             d[2],
+            crate::trace::Mode::from(args.raster.mode).name(),
             rrt_core::Connectivity::from(args.raster.connectivity).name(),
-            if args.exact_shadows {
-                ", verified, exact shadows"
-            } else if args.raster.verify {
-                ", verified"
-            } else {
-                ""
-            },
             args.depth,
             secs(time),
             stats.primary,
             stats.reflected,
             stats.refracted,
             stats.shadow,
+            stats.classified,
             stats.steps as f64 / rays as f64,
             stats.hits,
             stats.false_hits,

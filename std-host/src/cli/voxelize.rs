@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, RasterArgs, load_or_build, progress, secs};
+use super::common::{Loaded, Purpose, RasterArgs, load_or_build, progress, secs};
 use crate::fit::Bytes;
 use crate::output::atomic::AtomicFile;
 use crate::output::rasterfile;
@@ -53,7 +53,13 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         path: args.output.clone(),
         source,
     })?;
-    let loaded = load_or_build(args.scene.as_ref(), &args.raster, args.threads, !args.quiet);
+    let loaded = load_or_build(
+        args.scene.as_ref(),
+        &args.raster,
+        Purpose::Save,
+        args.threads,
+        !args.quiet,
+    );
     let Loaded::Built {
         scene,
         report,

@@ -9,7 +9,7 @@
 //! ```text
 //! offset  size  field
 //!      0     8  magic "RRTRASTR"
-//!      8     4  version (1: no object lists, 2: with object lists)
+//!      8     4  version (1: the paper's raster, 2: an exact raster, with object lists)
 //!     12     4  section count n (7 for version 1, 8 for version 2)
 //!     16  24·n  section table: n × { kind u32, crc32 u32, offset u64, length u64 }
 //! 16+24n     4  crc32 of the bytes before it
@@ -18,14 +18,15 @@
 //!               (H = 192 for version 1, 256 for version 2)
 //! ```
 //!
-//! A raster without object lists (the paper's raster,
-//! one object per voxel) is written as version 1, byte for byte as before
-//! lists existed; one with lists as version 2, which an rrt reading only
-//! version 1 refuses by its version.
+//! The paper's raster (one object per voxel) is written as version 1,
+//! byte for byte as before exact rasters existed; an exact raster
+//! ([`VoxelScene::exact`]: conservative, with object lists, possibly none)
+//! as version 2, which an rrt reading only version 1 refuses by its
+//! version.
 //!
 //! | kind | section | contents |
 //! |---|---|---|
-//! | 1 | meta | `nx ny nz` u32; separation u8 (6 or 26) + 3 zero bytes; world origin 3×f64; voxel size f64; background 3×f64; view: from, at, up 3×f64 each, angle f64, hither f64, resolution 2×u32; counts: records u64, objects u64, materials u32, lights u32 (192 bytes) |
+//! | 1 | meta | `nx ny nz` u32; separation u8 (6 or 26); what the light bits of records of exact objects hold u8 (0 the paper's bits, 1 the shadow classification, 2 nothing: always 0 in version 1; [`VoxelScene::exact_records`]) + 2 zero bytes; world origin 3×f64; voxel size f64; background 3×f64; view: from, at, up 3×f64 each, angle f64, hither f64, resolution 2×u32; counts: records u64, objects u64, materials u32, lights u32 (192 bytes) |
 //! | 2 | plane | one cell per voxel, x fastest ([`rrt_core::raster`]) |
 //! | 3 | directory | brick directory, `bricks + 1` × u32 ([`rrt_core::store`]) |
 //! | 4 | records | the 20-byte [`VoxelRecord`]s, field by field as in [`rrt_core::voxel`] |
@@ -57,6 +58,7 @@ use glam::DVec3;
 use indicatif::ProgressBar;
 
 use super::atomic::AtomicFile;
+use rrt_core::light::ExactRecords;
 use rrt_core::object_table::MAX_LIGHTS;
 use rrt_core::raster::{Extent, LINE_CELLS};
 use rrt_core::store::{RecordStore, directory_len};
@@ -231,7 +233,16 @@ fn meta_bytes(s: &VoxelScene) -> Vec<u8> {
         Separation::Six => 6,
         Separation::TwentySix => 26,
     });
-    b.0.extend_from_slice(&[0; 3]);
+    b.0.push(if s.exact {
+        match s.exact_records {
+            ExactRecords::Paper => 0,
+            ExactRecords::Classify => 1,
+            ExactRecords::Skip => 2,
+        }
+    } else {
+        0
+    });
+    b.0.extend_from_slice(&[0; 2]);
     b.vec(s.frame.origin);
     b.f64(s.frame.voxel_size);
     b.vec(s.background);
@@ -368,7 +379,7 @@ pub fn save_to(
     };
     let file = out.file();
     let mut w = BufWriter::with_capacity(1 << 20, &mut *file);
-    let version = if scene.lists.is_empty() { 1 } else { 2 };
+    let version = if scene.exact { 2 } else { 1 };
     let (sections, header_len) = layout(version);
     w.write_all(&vec![0u8; header_len as usize])
         .map_err(io("cannot write"))?;
@@ -477,6 +488,8 @@ pub struct Info {
     pub voxel_size: f64,
     /// The voxelization's separation.
     pub separation: Separation,
+    /// What the light bits of records of exact objects hold (version 2).
+    pub exact_records: ExactRecords,
     /// Records (non-transparent voxels).
     pub records: u64,
     /// Objects.
@@ -635,6 +648,7 @@ fn read_section(
 struct Meta {
     dims: [u32; 3],
     separation: Separation,
+    exact_records: ExactRecords,
     origin: DVec3,
     voxel_size: f64,
     background: DVec3,
@@ -665,7 +679,18 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
         26 => Separation::TwentySix,
         s => return Err(invalid(format!("separation {s}, expected 6 or 26"))),
     };
-    c.take::<3>();
+    let exact_records = match (h.version, c.u8()) {
+        (_, 0) => ExactRecords::Paper,
+        (2, 1) => ExactRecords::Classify,
+        (2, 2) => ExactRecords::Skip,
+        (v, b) => {
+            return Err(invalid(format!(
+                "light bits of exact records {b}, expected 0{} in a version {v} file",
+                if v == 2 { ", 1 or 2" } else { "" }
+            )));
+        }
+    };
+    c.take::<2>();
     let origin = c.vec();
     let voxel_size = c.f64();
     let background = c.vec();
@@ -678,6 +703,7 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
     let m = Meta {
         dims,
         separation,
+        exact_records,
         origin,
         voxel_size,
         background,
@@ -742,6 +768,7 @@ pub fn info(path: &Path) -> Result<Info, RasterFileError> {
         origin: m.origin,
         voxel_size: m.voxel_size,
         separation: m.separation,
+        exact_records: m.exact_records,
         records: m.records,
         objects: m.objects,
         materials: m.materials,
@@ -907,6 +934,8 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
             voxel_size: m.voxel_size,
         },
         separation: m.separation,
+        exact: h.version == 2,
+        exact_records: m.exact_records,
         lines: line_level(extent, &plane),
         plane,
         directory,

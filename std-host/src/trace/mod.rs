@@ -111,7 +111,7 @@ pub mod walk;
 
 use glam::DVec3;
 use rrt_core::discrete_ray::Connectivity;
-use rrt_core::light::{LeavingSurface, LightParams};
+use rrt_core::light::{ExactRecords, LeavingSurface, LightParams};
 use rrt_core::raster::{Extent, Raster};
 use rrt_core::store::RecordStore;
 use rrt_core::voxel::VoxelRecord;
@@ -131,15 +131,69 @@ pub const BLOCK_W: u32 = 4;
 /// Height of a primary block in pixels.
 pub const BLOCK_H: u32 = 2;
 
+/// What a hit is and how it is lit: the renderer's modes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Mode {
+    /// The default, on an exact raster
+    /// ([`VoxelScene::exact`](crate::voxelize::VoxelScene::exact)): every
+    /// object of each opaque voxel a ray reaches is intersected exactly
+    /// (intersection verification over the object lists; module docs), the
+    /// true point and normal are shaded, and every light a verified hit
+    /// faces is decided exactly: by the shadow classification where it
+    /// proves the voxel lit (only the voxel's own objects are
+    /// intersected), else by an exact shadow ray. Secondary rays leave the
+    /// surface as `embree_nff`'s do. The image is the exact ray tracer's
+    /// for every object with exact geometry.
+    #[default]
+    Exact,
+    /// The paper's intersection verification: exact hit point and normal
+    /// (on an exact raster), lit by the precomputed light visibility.
+    Verified,
+    /// The paper's raw discrete mode: the first surface voxel is the hit,
+    /// shaded with its stored normal, precomputed illumination and light
+    /// visibility bits. The fastest.
+    Paper,
+}
+
+impl Mode {
+    /// Every mode, in the order of `--mode`'s help.
+    pub const ALL: [Self; 3] = [Self::Exact, Self::Verified, Self::Paper];
+
+    /// Whether hits are verified against the objects' exact geometry
+    /// (which needs an exact raster).
+    #[must_use]
+    pub const fn verifies(self) -> bool {
+        !matches!(self, Self::Paper)
+    }
+
+    /// Whether verified hits are lit by exact shadow rays rather than the
+    /// precomputed bits.
+    #[must_use]
+    pub const fn exact_shadows(self) -> bool {
+        matches!(self, Self::Exact)
+    }
+
+    /// The mode's name on the command line.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Exact => "exact",
+            Self::Verified => "verified",
+            Self::Paper => "paper",
+        }
+    }
+}
+
 /// How rays are traced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TraceOptions {
+    /// What a hit is and how it is lit.
+    pub mode: Mode,
     /// Connectivity of the primary and secondary rays.
     pub connectivity: Connectivity,
     /// Maximum depth of the ray tree; the eye ray is depth 1.
     pub depth: u32,
-    /// Intersection verification.
-    pub verify: bool,
     /// The acne rule's slab and angle, and the connectivity of render-time
     /// shadow rays (those of the light pass by default).
     pub light: LightParams,
@@ -150,25 +204,16 @@ pub struct TraceOptions {
     /// space, and the scalar walk, the faster of the two where it was
     /// measured, is the default.
     pub packets: bool,
-    /// Exact shadows for verified hits (a quality option beyond the paper,
-    /// which uses the precomputed light bits): from each verified hit a
-    /// render-time shadow ray walks to every light the surface faces, and
-    /// each object of the voxels it meets is intersected exactly with the
-    /// continuous shadow ray; only a true intersection shadows. Shadow
-    /// edges then follow the geometry instead of the receiving voxels.
-    /// Needs `verify` (unverified hits keep the light bits).
-    pub exact_shadows: bool,
 }
 
 impl Default for TraceOptions {
     fn default() -> Self {
         Self {
+            mode: Mode::Exact,
             connectivity: Connectivity::Adaptive,
             depth: 3,
-            verify: false,
             light: LightParams::default(),
             packets: false,
-            exact_shadows: false,
         }
     }
 }
@@ -182,8 +227,14 @@ pub struct RayStats {
     pub reflected: u64,
     /// Refracted (or totally reflected) transmitted rays.
     pub refracted: u64,
-    /// Render-time shadow rays (lights seen through translucent material).
+    /// Render-time shadow rays (lights seen through translucent material;
+    /// in the exact mode, every light of a verified hit the shadow
+    /// classification does not prove lit).
     pub shadow: u64,
+    /// Lights of verified hits (exact mode) that the shadow classification
+    /// proved lit: only the voxel's own objects were intersected, no ray
+    /// walked.
+    pub classified: u64,
     /// Voxels visited by all rays (an empty-space jump counts as one).
     pub steps: u64,
     /// Rays that ended on a surface.
@@ -210,6 +261,7 @@ impl RayStats {
         self.reflected += o.reflected;
         self.refracted += o.refracted;
         self.shadow += o.shadow;
+        self.classified += o.classified;
         self.steps += o.steps;
         self.hits += o.hits;
         self.false_hits += o.false_hits;
@@ -261,6 +313,19 @@ pub struct RayHit {
     pub verified: bool,
 }
 
+/// How far a ray leaving a verified hit starts off the surface, along the
+/// normal towards the side it goes to: `embree_nff`'s ε, 10⁻⁵ of the
+/// diagonal of the scene's box (here the raster's box, which holds the
+/// scene). Near the contact of two objects (the spheres of a sphereflake
+/// touch their parents) which of them a grazing secondary ray meets
+/// depends on where it starts; starting where the exact tracer does gives
+/// its answer.
+#[must_use]
+pub fn surface_offset(frame: &RasterFrame) -> f64 {
+    let b = frame.world_bounds();
+    1e-5 * (b.max - b.min).length()
+}
+
 /// The renderer over one voxelized scene.
 #[derive(Clone, Debug)]
 pub struct Tracer<'s> {
@@ -272,6 +337,13 @@ pub struct Tracer<'s> {
     materials: &'s [Material],
     lights: &'s [WorldLight],
     lights_fx: Vec<Option<[i64; 3]>>,
+    /// The records of exact objects hold the shadow classification, and
+    /// the shadow segments stay close enough to the ones it covers
+    /// ([`Tracer::exact_light`]) to use it.
+    classified: bool,
+    /// How far rays leaving a verified hit start off the surface
+    /// ([`Tracer::leaving`]).
+    offset: f64,
     background: DVec3,
     intensity: f64,
     opts: TraceOptions,
@@ -292,6 +364,11 @@ pub enum TraceError {
     /// A depth of 0.
     #[error("depth: expected at least 1 (the eye ray), found 0")]
     Depth,
+    /// A verifying mode on the paper's raster, which has no object lists.
+    #[error(
+        "the {0} mode verifies hits against every object of a voxel, but this raster was voxelized for the paper's mode (one object per voxel): render it with --mode paper, or voxelize it again without --mode paper"
+    )]
+    NotExact(&'static str),
 }
 
 impl<'s> Tracer<'s> {
@@ -303,6 +380,9 @@ impl<'s> Tracer<'s> {
     pub fn new(scene: &'s VoxelScene, opts: TraceOptions) -> Result<Self, TraceError> {
         if opts.depth == 0 {
             return Err(TraceError::Depth);
+        }
+        if opts.mode.verifies() && !scene.exact {
+            return Err(TraceError::NotExact(opts.mode.name()));
         }
         if opts.connectivity == Connectivity::TwentySix
             && scene.separation != rrt_core::voxelize::Separation::TwentySix
@@ -329,6 +409,10 @@ impl<'s> Tracer<'s> {
             materials: &scene.materials,
             lights: &scene.lights,
             lights_fx,
+            classified: scene.exact
+                && scene.exact_records == ExactRecords::Classify
+                && surface_offset(&scene.frame) < scene.frame.voxel_size / 8.0,
+            offset: surface_offset(&scene.frame),
             background: scene.background,
             intensity: scene.intensity(),
             opts,
@@ -341,24 +425,22 @@ impl<'s> Tracer<'s> {
         &self.opts
     }
 
-    /// Traces one ray (unit direction) at `depth` and returns its colour.
+    /// Traces one ray (unit direction) at `depth` and returns its colour;
+    /// a ray leaving a surface has its acne rule `leave` and counts exact
+    /// intersections from `tmin` on ([`Tracer::leaving`]).
     fn trace(
         &self,
         ray: &Ray,
         depth: u32,
         leave: Option<&LeavingSurface>,
+        tmin: f64,
         stats: &mut RayStats,
     ) -> DVec3 {
         let mut walk = match leave {
-            Some(rule) if !self.opts.verify => self.secondary_walk(ray, rule, stats),
+            Some(rule) if !self.opts.mode.verifies() => self.secondary_walk(ray, rule, stats),
             // Verification tests every object of every opaque voxel with
             // t > tmin: no voxel is skipped by the acne rule on the way.
             _ => self.first_walk(ray),
-        };
-        let tmin = if leave.is_some() {
-            self.leaving_tmin()
-        } else {
-            0.0
         };
         match self.resolve(ray, &mut walk, tmin, leave, stats) {
             None => self.background,
@@ -428,6 +510,6 @@ impl<'s> Tracer<'s> {
     /// Traces one primary ray (unit direction) and returns its colour.
     pub fn trace_primary(&self, ray: &Ray, stats: &mut RayStats) -> DVec3 {
         stats.primary += 1;
-        self.trace(ray, 1, None, stats)
+        self.trace(ray, 1, None, 0.0, stats)
     }
 }

@@ -194,7 +194,7 @@ impl Tracer<'_> {
         stats: &mut RayStats,
     ) -> Option<SurfaceHit> {
         let before = stats.false_hits;
-        let hit = if self.opts.verify {
+        let hit = if self.opts.mode.verifies() {
             self.resolve_verified(ray, walk, tmin, leave, stats)
         } else {
             self.resolve_walk(ray, walk, tmin, leave, stats)

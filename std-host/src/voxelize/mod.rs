@@ -16,13 +16,15 @@
 //!    voxel once, [`texture`]);
 //!    [`Filler::finish`](rrt_core::store::Filler::finish) sorts the bricks
 //!    and sets the proximity flags;
-//! 5. **light visibility** ([`light`]): one discrete shadow ray per record
-//!    and light, the two visibility bits and the precomputed ambient +
-//!    diffuse illumination, on rayon's threads; the result does not depend
-//!    on the thread count;
-//! 6. **finish** ([`finish_plane`]): the proximity distance field, which
+//! 5. **finish** ([`finish_plane`]): the proximity distance field, which
 //!    lets 26-runs skip empty space, the records' rank hints and the line
-//!    level.
+//!    level;
+//! 6. **light visibility** ([`light`]): per record and light, one discrete
+//!    shadow ray (the paper's two bits), or for a record of exact objects
+//!    on an exact raster the shadow classification or nothing
+//!    ([`LightParams::exact_records`]); then the precomputed ambient +
+//!    diffuse illumination; on rayon's threads; the result does not
+//!    depend on the thread count.
 //!
 //! The primitives are voxelized by their core voxelizers
 //! ([`crate::shape`]); volumes ([`volume`]), `.vox` models ([`vox`]) and
@@ -47,7 +49,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
 use rrt_core::connectivity::Connectivity;
-use rrt_core::light::{LightError, LightParams, LightReport};
+use rrt_core::light::{ExactRecords, LightError, LightParams, LightReport};
 use rrt_core::object_table::MAX_LIGHTS;
 use rrt_core::raster::RasterMut;
 use rrt_core::store::{self, Built, Counter, Limits, Sizing, directory_len};
@@ -76,7 +78,9 @@ pub struct BuildOptions {
     pub fit: FitOptions,
     /// The rays the raster is built for: decides the separation.
     pub connectivity: Connectivity,
-    /// Shadow rays of the light pass.
+    /// Shadow rays of the light pass, and what it computes for records of
+    /// exact objects ([`LightParams::exact_records`]; only on an
+    /// [`exact`](Self::exact) raster, the paper's bits otherwise).
     pub light: LightParams,
     /// Threads of the light pass; 0 for one per core.
     pub threads: usize,
@@ -90,8 +94,9 @@ pub struct BuildOptions {
 }
 
 impl BuildOptions {
-    /// `raster` voxels along the longest axis, for adaptive rays, default
-    /// limits.
+    /// `raster` voxels along the longest axis, for adaptive rays, exact
+    /// (object lists, and the shadow classification for records of exact
+    /// objects: what every render mode can use), default limits.
     #[must_use]
     pub fn new(raster: u32) -> Self {
         Self {
@@ -100,9 +105,23 @@ impl BuildOptions {
                 ..FitOptions::new(raster)
             },
             connectivity: Connectivity::Adaptive,
-            light: LightParams::default(),
+            light: LightParams {
+                exact_records: ExactRecords::Classify,
+                ..LightParams::default()
+            },
             threads: 0,
+            exact: true,
+        }
+    }
+
+    /// The paper's raster: one object per voxel, as thick as the rays
+    /// need, the paper's light bits for every record.
+    #[must_use]
+    pub fn paper(raster: u32) -> Self {
+        Self {
+            light: LightParams::default(),
             exact: false,
+            ..Self::new(raster)
         }
     }
 }
@@ -317,25 +336,38 @@ pub fn build(
         progress,
     )?;
     let lists_used = built.lists().len();
+    lists.truncate(lists_used);
+    lists.shrink_to_fit();
+    // The light pass changes no cell and no record's place: the plane can
+    // be finished first, so that its walks read the distance field and
+    // the rank hints.
+    let lines = finish_plane(extent, &mut plane, &directory, &records, &lists);
     let voxelize = t0.elapsed();
 
     let t1 = Instant::now();
+    let light = LightParams {
+        exact_records: if opts.exact {
+            opts.light.exact_records
+        } else {
+            ExactRecords::Paper
+        },
+        ..opts.light
+    };
     crate::progress::phase(progress, "light visibility", Unit::Voxels, records_n as u64);
+    let raster = rrt_core::raster::Raster::new(extent, &plane)
+        .and_then(|r| r.with_lines(&lines))
+        .map_err(|e| BuildError::Raster(e.to_string()))?;
+    let store = rrt_core::store::RecordStore::with_lists(extent, &directory, &records, &lists)
+        .map_err(|e| BuildError::Raster(e.to_string()))?;
     let (lit, light_report) = LightScene::new(&objects, &materials, &fitted.lights).illuminate(
-        &built.raster(),
-        &built.store(),
-        &opts.light,
+        &raster,
+        &store,
+        &light,
         opts.threads,
         progress,
     )?;
     records = lit;
-    lists.truncate(lists_used);
-    lists.shrink_to_fit();
     let lights_time = t1.elapsed();
-
-    let t2 = Instant::now();
-    let lines = finish_plane(extent, &mut plane, &directory, &records, &lists);
-    let voxelize = voxelize + t2.elapsed();
 
     let world_objects = objects
         .iter()
@@ -370,6 +402,8 @@ pub fn build(
             directory,
             records,
             lists,
+            exact: opts.exact,
+            exact_records: light.exact_records,
             objects: world_objects,
             materials: materials.list,
             lights: world_lights,

@@ -6,6 +6,7 @@
 //! the lights in `f64` for shading.
 
 use glam::DVec3;
+use rrt_core::light::ExactRecords;
 use rrt_core::proximity::{distance_field, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut, line_count};
 use rrt_core::store::{RecordStore, StoreError, write_rank_hints};
@@ -39,6 +40,16 @@ pub struct VoxelScene {
     /// The object lists of the voxels several objects share (empty for the
     /// paper's raster, one object per voxel; see [`rrt_core::store`]).
     pub lists: Vec<u32>,
+    /// Voxelized for exact verification
+    /// ([`BuildOptions::exact`](super::BuildOptions::exact)): every exact
+    /// object owns every voxel its surface passes through, and the voxels
+    /// several objects share have their lists. Otherwise the paper's
+    /// raster, one object per voxel.
+    pub exact: bool,
+    /// What the light bits of the records whose objects all have exact
+    /// geometry hold ([`LightParams::exact_records`](rrt_core::light::LightParams::exact_records));
+    /// every other record has the paper's bits.
+    pub exact_records: ExactRecords,
     /// The world object table, indexed by the object ids of the records
     /// and lists ([`RecordStore::objects`]).
     pub objects: Vec<WorldObject>,
