@@ -11,6 +11,7 @@ pub mod mesh;
 pub mod oracle;
 pub mod packet_case;
 pub mod tunnel;
+pub mod vec3;
 pub mod voxelize_case;
 
 use std::path::PathBuf;
