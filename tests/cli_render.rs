@@ -14,9 +14,7 @@ fn data(name: &str) -> PathBuf {
 /// Runs `f` in a fresh temporary folder named after `test`, removed once
 /// `f` returns (left for inspection when it panics).
 fn in_temp_dir(test: &str, f: impl FnOnce(&Path)) {
-    let d = std::env::temp_dir().join(format!("rrt-cli-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
+    let d = rrt_tests::fresh_dir("rrt-cli", test);
     f(&d);
     let _ = std::fs::remove_dir_all(&d);
 }

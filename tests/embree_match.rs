@@ -154,23 +154,12 @@ fn read_ppm(path: &Path) -> (u32, u32, Vec<u8>) {
 
 /// PSNR in dB and the share of pixels with a channel off by more than 8.
 fn compare(a: &[u8], b: &[u8]) -> (f64, f64) {
-    let mse = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
-        .sum::<f64>()
-        / a.len() as f64;
     let off = a
         .chunks(3)
         .zip(b.chunks(3))
         .filter(|(p, q)| p.iter().zip(q.iter()).any(|(&x, &y)| x.abs_diff(y) > 8))
         .count();
-    let psnr = if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (255.0f64 * 255.0 / mse).log10()
-    };
-    (psnr, off as f64 / (a.len() / 3) as f64)
+    (rrt_tests::psnr(a, b), off as f64 / (a.len() / 3) as f64)
 }
 
 /// Renders `scene` at the reference image's size and compares; `counts`
