@@ -12,6 +12,7 @@ use crate::geometry::{Sphere, Torus};
 use crate::raster::{Extent, RasterMut};
 use crate::store::{Counter, Limits, ObjectAttrs, directory_len};
 use crate::voxel::VoxelRecord;
+use crate::voxelize::error::VoxelizeError;
 use crate::voxelize::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 
 pub use crate::rng::Rng;
@@ -29,6 +30,64 @@ impl VoxelSink for Offers {
             e.0 = s;
         }
     }
+}
+
+/// A voxelizer's entry point, over the recording sink.
+pub type Voxelizer<T> = fn(&T, Separation, Extent, &mut Offers) -> Result<u64, VoxelizeError>;
+
+/// What `voxelize` makes of `shape` with `sep` in `extent`: its result and
+/// the offers.
+pub fn voxelized<T>(
+    voxelize: Voxelizer<T>,
+    shape: &T,
+    sep: Separation,
+    extent: Extent,
+) -> (Result<u64, VoxelizeError>, Offers) {
+    let mut offers = Offers::default();
+    let r = voxelize(shape, sep, extent, &mut offers);
+    (r, offers)
+}
+
+/// What `voxelize` makes of `shape` with `sep` in a 4³ raster.
+pub fn voxelized_in_4<T>(
+    voxelize: Voxelizer<T>,
+    shape: &T,
+    sep: Separation,
+) -> Result<u64, VoxelizeError> {
+    voxelized(voxelize, shape, sep, Extent::cube(4).unwrap()).0
+}
+
+/// `voxelize` refuses `shape` (6-separating, in a 4³ raster) with `want`.
+#[track_caller]
+pub fn assert_refused<T>(voxelize: Voxelizer<T>, shape: &T, want: VoxelizeError) {
+    assert_eq!(voxelized_in_4(voxelize, shape, Separation::Six), Err(want));
+}
+
+/// `offers` are the voxels of `e` that `contains` accepts, each offered
+/// once; `what` names the case.
+#[track_caller]
+pub fn assert_offers_are(
+    offers: &Offers,
+    e: Extent,
+    contains: impl Fn([u32; 3]) -> bool,
+    what: &str,
+) {
+    assert!(offers.0.values().all(|o| o.1 == 1), "{what}: offered twice");
+    let [nx, ny, nz] = e.dims();
+    let mut want = Vec::new();
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                if contains([x, y, z]) {
+                    want.push([x, y, z]);
+                }
+            }
+        }
+    }
+    for v in &want {
+        assert!(offers.0.contains_key(v), "{what}: missing {v:?}");
+    }
+    assert_eq!(offers.0.len(), want.len(), "{what}: extra voxels");
 }
 
 /// Sphere surface, through the real voxelizer.
