@@ -85,6 +85,17 @@ pub fn shared_data() -> Option<PathBuf> {
     p.is_dir().then_some(p)
 }
 
+/// `../shared/data/spd` (the SPD scenes), or `None` with a skip message
+/// when the shared data is absent.
+#[must_use]
+pub fn shared_spd() -> Option<PathBuf> {
+    let Some(data) = shared_data() else {
+        eprintln!("skipped: ../shared/data not present");
+        return None;
+    };
+    Some(data.join("spd"))
+}
+
 /// Runs the `rrt` command line with `args` (without the program name):
 /// its standard output, or its error with every source in the chain, as a
 /// user would read it.
