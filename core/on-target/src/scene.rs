@@ -53,16 +53,8 @@ pub const PATCH_INIT: BezierPatch = BezierPatch {
     control: [[[0; 3]; 4]; 4],
 };
 
-/// A filler value for the record storage.
-pub const RECORD_INIT: VoxelRecord = VoxelRecord {
-    object: 0,
-    normal: [0; 2],
-    color: [0; 3],
-    illum: [0; 3],
-    lights: 0,
-    material: 0,
-    key: 0,
-};
+/// A filler value for the record storage: the zero record.
+pub const RECORD_INIT: VoxelRecord = bytemuck::zeroed();
 
 /// The ray connectivity the scene is built and traced for.
 pub const MODE: Connectivity = Connectivity::Adaptive;
