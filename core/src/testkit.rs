@@ -102,6 +102,11 @@ pub fn sphere(
     crate::voxelize::sphere::surface(&s, sep, extent, sink).expect("test sphere");
 }
 
+/// [`sphere`], 6-separating, as a voxelizer for [`build`].
+pub fn ball(extent: Extent, centre: [i64; 3], radius: i64) -> impl Fn(&mut dyn VoxelSink) {
+    move |s| sphere(extent, centre, radius, Separation::Six, s)
+}
+
 /// Torus around the z axis, through the real voxelizer.
 pub fn torus(
     extent: Extent,
@@ -140,6 +145,27 @@ pub fn plate(
         v.reverse();
     }
     crate::voxelize::triangle::polygon(&v, sep, extent, sink).expect("test plate");
+}
+
+/// [`plate`] facing up (`+z`), 6-separating, over the voxels `span × span`
+/// at the mid-height of voxel layer `layer`, as a voxelizer for [`build`].
+pub fn level_plate(
+    extent: Extent,
+    layer: i64,
+    span: core::ops::Range<u32>,
+) -> impl Fn(&mut dyn VoxelSink) {
+    let z0 = layer * VOXEL + VOXEL / 2;
+    move |s| {
+        plate(
+            extent,
+            z0,
+            span.clone(),
+            span.clone(),
+            false,
+            Separation::Six,
+            s,
+        )
+    }
 }
 
 /// A built scene over owned storage.
