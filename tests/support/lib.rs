@@ -3,8 +3,10 @@
 //! oracle for discrete rays ([`oracle`]), the fuzz case types ([`fuzz`],
 //! [`packet_case`], [`voxelize_case`]), tunnel-freedom probes
 //! ([`tunnel::assert_tunnel_free`]), closed test meshes ([`mesh`]), the
-//! location of the shared data folder, and the `rrt` command line run
-//! in-process.
+//! float vectors of the test-side geometry ([`vec3`]), one object through
+//! both builder passes ([`store::OneObject`]), the location of the shared
+//! data folder, small helpers (random planes, soak counts, PSNR, fresh
+//! folders), and the `rrt` command line run in-process.
 
 pub mod fuzz;
 pub mod mesh;
