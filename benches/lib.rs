@@ -318,6 +318,19 @@ pub mod baseline {
         let [mut tx, mut ty, mut tz] = tmax;
         let mut idx = (x as usize + nu * (y as usize + nu * z as usize)) as isize;
         let mut steps = 0u64;
+        // One step along axis `$k`: coordinate `$c`, index offset `$d`,
+        // t-max `$t`; out of the loop when the ray leaves the box. (A macro:
+        // the same code inline in each branch, as the original.)
+        macro_rules! step {
+            ($c:ident, $k:literal, $d:ident, $t:ident) => {{
+                $c += st[$k];
+                if $c == out[$k] {
+                    break;
+                }
+                idx += $d;
+                $t += tdel[$k];
+            }};
+        }
         loop {
             steps += 1;
             if plane[idx as usize] & cell::OPAQUE != 0 {
@@ -328,34 +341,14 @@ pub mod baseline {
             }
             if tx < ty {
                 if tx < tz {
-                    x += st[0];
-                    if x == out[0] {
-                        break;
-                    }
-                    idx += dx;
-                    tx += tdel[0];
+                    step!(x, 0, dx, tx)
                 } else {
-                    z += st[2];
-                    if z == out[2] {
-                        break;
-                    }
-                    idx += dz;
-                    tz += tdel[2];
+                    step!(z, 2, dz, tz)
                 }
             } else if ty < tz {
-                y += st[1];
-                if y == out[1] {
-                    break;
-                }
-                idx += dy;
-                ty += tdel[1];
+                step!(y, 1, dy, ty)
             } else {
-                z += st[2];
-                if z == out[2] {
-                    break;
-                }
-                idx += dz;
-                tz += tdel[2];
+                step!(z, 2, dz, tz)
             }
         }
         Trace { steps, hit: None }

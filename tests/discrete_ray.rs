@@ -10,8 +10,8 @@ use rrt_core::discrete_ray::Connectivity;
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
-use rrt_tests::Rng;
 use rrt_tests::oracle::{Case, check_exact, make_ray};
+use rrt_tests::{Rng, env_count, random_opaque, replay_seed};
 
 const DIR_SCALES: [u32; 6] = [0, 1, 8, 16, 24, 31];
 
@@ -137,12 +137,8 @@ fn seed_of(i: u64) -> u64 {
 
 #[test]
 fn random_rays_match_the_exact_oracle() {
-    let n: u64 = std::env::var("RRT_RAYS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(100_000);
-    let replay: Option<u64> = std::env::var("RRT_SEED").ok().and_then(|v| v.parse().ok());
-    let seeds = replay.into_iter().chain((0..n).map(seed_of));
+    let n = env_count("RRT_RAYS").unwrap_or(100_000);
+    let seeds = replay_seed().into_iter().chain((0..n).map(seed_of));
     let mut hit_rays = 0u64;
     for seed in seeds {
         let mut rng = Rng::new(seed);
@@ -169,15 +165,7 @@ fn random_rays_adaptive_hits_equal_six_hits_with_proximity_flags() {
         let case = random_case(&mut rng);
         let e = Extent::new(case.dims[0], case.dims[1], case.dims[2]).unwrap();
         let density = 1 + rng.below(40);
-        let mut plane: Vec<u8> = (0..e.len())
-            .map(|_| {
-                if rng.below(400) < density {
-                    cell::OPAQUE
-                } else {
-                    0
-                }
-            })
-            .collect();
+        let mut plane = random_opaque(&mut rng, e.len(), density, 400);
         let mut rm = RasterMut::new(e, &mut plane).unwrap();
         flag_neighbourhood(&mut rm);
         let r = rm.as_raster();
@@ -358,15 +346,7 @@ fn skipping_changes_nothing_but_the_step_count() {
         case.dims = case.dims.map(|d| d * 4);
         let e = Extent::new(case.dims[0], case.dims[1], case.dims[2]).unwrap();
         let per_100k = rng.below(40);
-        let mut plane: Vec<u8> = (0..e.len())
-            .map(|_| {
-                if rng.below(100_000) < per_100k {
-                    cell::OPAQUE
-                } else {
-                    0
-                }
-            })
-            .collect();
+        let mut plane = random_opaque(&mut rng, e.len(), per_100k, 100_000);
         let mut rm = RasterMut::new(e, &mut plane).unwrap();
         distance_field(&mut rm);
         let r = rm.as_raster();

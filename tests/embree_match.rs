@@ -22,7 +22,7 @@ use rrt_host::scene::{Material, Scene};
 use rrt_host::shape::Shape;
 use rrt_host::trace::shading;
 use rrt_host::world::{Hit, Ray};
-use rrt_tests::shared_data;
+use rrt_tests::shared_spd;
 
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -154,23 +154,12 @@ fn read_ppm(path: &Path) -> (u32, u32, Vec<u8>) {
 
 /// PSNR in dB and the share of pixels with a channel off by more than 8.
 fn compare(a: &[u8], b: &[u8]) -> (f64, f64) {
-    let mse = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
-        .sum::<f64>()
-        / a.len() as f64;
     let off = a
         .chunks(3)
         .zip(b.chunks(3))
         .filter(|(p, q)| p.iter().zip(q.iter()).any(|(&x, &y)| x.abs_diff(y) > 8))
         .count();
-    let psnr = if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (255.0f64 * 255.0 / mse).log10()
-    };
-    (psnr, off as f64 / (a.len() / 3) as f64)
+    (rrt_tests::psnr(a, b), off as f64 / (a.len() / 3) as f64)
 }
 
 /// Renders `scene` at the reference image's size and compares; `counts`
@@ -232,13 +221,12 @@ fn tetra_matches_embree_nff() {
 /// Patches with interpolated normals, and open cylinders.
 #[test]
 fn teapot_and_rings_match_embree_nff() {
-    let Some(shared) = shared_data() else {
-        eprintln!("skipped: ../shared/data not present");
+    let Some(spd) = shared_spd() else {
         return;
     };
-    let teapot = Scene::load(shared.join("spd/teapot.nff")).unwrap();
+    let teapot = Scene::load(spd.join("teapot.nff")).unwrap();
     check(&teapot, "teapot-64.ppm", [4096, 6145, 3156, 3451], 50.0);
-    let rings = Scene::load(shared.join("spd/rings.nff")).unwrap();
+    let rings = Scene::load(spd.join("rings.nff")).unwrap();
     // Measured: 51.3 dB, 4 pixels off by more than 8 levels (f32 vs f64 edges).
     check(&rings, "rings-64.ppm", [4096, 13358, 1491, 4812], 45.0);
 }

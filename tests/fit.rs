@@ -12,7 +12,7 @@ use rrt_host::fit::{self, FitOptions, Fitted};
 use rrt_host::render::camera::Camera;
 use rrt_host::scene::Scene;
 use rrt_host::shape::{self, Surface};
-use rrt_tests::shared_data;
+use rrt_tests::shared_spd;
 
 fn test_data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -135,11 +135,9 @@ fn tetra_fits() {
 
 #[test]
 fn spd_scenes_fit_with_memory_estimates() {
-    let Some(data) = shared_data() else {
-        eprintln!("skipped: ../shared/data not present");
+    let Some(spd) = shared_spd() else {
         return;
     };
-    let spd = data.join("spd");
     for (name, objects) in [
         ("balls4.nff", 7381 + 2),
         ("teapot.nff", 240 + 4 * 2),

@@ -30,49 +30,47 @@ fn inputs(target: &str) -> Vec<(String, Vec<u8>)> {
     out
 }
 
-#[test]
-fn discrete_ray_inputs_replay() {
-    for (name, bytes) in inputs("discrete_ray") {
-        let case = RayCase::arbitrary_take_rest(Unstructured::new(&bytes))
+/// Replays the inputs of `target` as their `Arbitrary` decoding, each
+/// printed, through `run`.
+fn replay_decoded<T: for<'a> Arbitrary<'a> + std::fmt::Debug>(target: &str, run: impl Fn(T)) {
+    for (name, bytes) in inputs(target) {
+        let case = T::arbitrary_take_rest(Unstructured::new(&bytes))
             .unwrap_or_else(|e| panic!("{name}: does not decode: {e}"));
         eprintln!("{name}: {case:?}");
-        run_ray_case(&case);
+        run(case);
     }
+}
+
+/// Replays the inputs of `target` through the checker `check`.
+fn replay_checked(target: &str, check: fn(&[u8]) -> Result<(), String>) {
+    for (name, bytes) in inputs(target) {
+        if let Err(broken) = check(&bytes) {
+            panic!("{name}: {broken}");
+        }
+    }
+}
+
+#[test]
+fn discrete_ray_inputs_replay() {
+    replay_decoded("discrete_ray", |case: RayCase| run_ray_case(&case));
 }
 
 #[test]
 fn nff_inputs_replay() {
-    for (name, bytes) in inputs("nff") {
-        if let Err(broken) = rrt_host::check::nff_input(&bytes) {
-            panic!("{name}: {broken}");
-        }
-    }
+    replay_checked("nff", rrt_host::check::nff_input);
 }
 
 #[test]
 fn voxelize_inputs_replay() {
-    for (name, bytes) in inputs("voxelize") {
-        let input = rrt_tests::voxelize_case::Input::arbitrary_take_rest(Unstructured::new(&bytes))
-            .unwrap_or_else(|e| panic!("{name}: does not decode: {e}"));
-        eprintln!("{name}: {input:?}");
-        rrt_tests::voxelize_case::run(input);
-    }
+    replay_decoded("voxelize", rrt_tests::voxelize_case::run);
 }
 
 #[test]
 fn nrrd_inputs_replay() {
-    for (name, bytes) in inputs("nrrd") {
-        if let Err(broken) = rrt_host::check::nrrd_input(&bytes) {
-            panic!("{name}: {broken}");
-        }
-    }
+    replay_checked("nrrd", rrt_host::check::nrrd_input);
 }
 
 #[test]
 fn scene_toml_inputs_replay() {
-    for (name, bytes) in inputs("scene_toml") {
-        if let Err(broken) = rrt_host::check::toml_input(&bytes) {
-            panic!("{name}: {broken}");
-        }
-    }
+    replay_checked("scene_toml", rrt_host::check::toml_input);
 }

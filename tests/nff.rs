@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 use rrt_host::check;
 use rrt_host::scene::{Material, ParseOptions, Scene, SceneError, check_scene, nff};
-use rrt_tests::{Rng, shared_data};
+use rrt_tests::{Rng, shared_spd};
 
 /// A valid view block: seven lines, so the next line is line 8.
 const HEAD: &str = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 45\nhither 0.01\nresolution 64 48\n";
@@ -108,13 +108,12 @@ fn tetra_copy_parses_with_counts() {
 /// The committed copies equal the shared SPD files.
 #[test]
 fn test_data_copies_match_shared_spd() {
-    let Some(data) = shared_data() else {
-        eprintln!("skipped: ../shared/data not present");
+    let Some(spd) = shared_spd() else {
         return;
     };
     for name in ["balls1.nff", "tetra.nff"] {
         let ours = std::fs::read(test_data(name)).unwrap();
-        let theirs = std::fs::read(data.join("spd").join(name)).unwrap();
+        let theirs = std::fs::read(spd.join(name)).unwrap();
         assert!(
             ours == theirs,
             "tests/data/{name} differs from the shared copy"
@@ -124,11 +123,9 @@ fn test_data_copies_match_shared_spd() {
 
 #[test]
 fn every_spd_scene_parses_with_counts() {
-    let Some(data) = shared_data() else {
-        eprintln!("skipped: ../shared/data not present");
+    let Some(spd) = shared_spd() else {
         return;
     };
-    let spd = data.join("spd");
     let load = |name: &str| {
         let s = Scene::load(spd.join(name)).unwrap_or_else(|e| panic!("{e}"));
         check_scene(&s).unwrap();

@@ -11,7 +11,7 @@ use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::packet::{LANES, RayPacket8};
 use rrt_core::proximity::flag_neighbourhood;
 use rrt_core::raster::{Extent, Raster, RasterMut, cell};
-use rrt_tests::Rng;
+use rrt_tests::{Rng, env_count, random_opaque, replay_seed};
 
 /// What the lanes of one packet look like.
 #[derive(Clone, Copy, Debug)]
@@ -100,15 +100,7 @@ struct Packet {
 
 fn random_plane(rng: &mut Rng, e: Extent) -> Vec<u8> {
     let density = rng.below(30);
-    let mut plane: Vec<u8> = (0..e.len())
-        .map(|_| {
-            if rng.below(100) < density {
-                cell::OPAQUE
-            } else {
-                0
-            }
-        })
-        .collect();
+    let mut plane = random_opaque(rng, e.len(), density, 100);
     match rng.below(3) {
         // Proximity flags as the renderer sets them.
         0 => flag_neighbourhood(&mut RasterMut::new(e, &mut plane).unwrap()),
@@ -216,16 +208,12 @@ fn seed_of(i: u64) -> u64 {
 
 #[test]
 fn random_packets_equal_their_scalar_rays() {
-    let n: u64 = std::env::var("RRT_PACKETS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(100_000);
-    let replay: Option<u64> = std::env::var("RRT_SEED").ok().and_then(|v| v.parse().ok());
+    let n = env_count("RRT_PACKETS").unwrap_or(100_000);
     let mut lanes = 0u64;
     let mut hits = 0u64;
     let mut lane_walks = 0u64;
     let mut checked = 0u64;
-    for seed in replay.into_iter().chain((0..n).map(seed_of)) {
+    for seed in replay_seed().into_iter().chain((0..n).map(seed_of)) {
         let p = random_packet(seed);
         let e = Extent::new(p.dims[0], p.dims[1], p.dims[2]).unwrap();
         let r = Raster::new(e, &p.plane).unwrap();
@@ -250,10 +238,7 @@ fn random_packets_equal_their_scalar_rays() {
 /// on lanes in different states (fresh, part-way, done).
 #[test]
 fn random_walk_scripts_equal_their_scalar_rays() {
-    let n: u64 = std::env::var("RRT_PACKETS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .map_or(20_000, |v: u64| v / 5);
+    let n = env_count("RRT_PACKETS").map_or(20_000, |v| v / 5);
     for i in 0..n {
         let seed = seed_of(i) ^ 0x5C1;
         let p = random_packet(seed);

@@ -29,10 +29,7 @@ fn balls2() -> PathBuf {
 
 /// A fresh temporary folder for one test.
 fn temp_dir(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("rrt-test-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    rrt_tests::fresh_dir("rrt-test", test)
 }
 
 /// The paper's raster, for rays of connectivity `mode`.
@@ -73,20 +70,38 @@ fn cli(args: &[&str]) -> Result<String, String> {
     rrt_tests::run_cli(args)
 }
 
+/// `rrt render INPUT -o OUTPUT EXTRA…`, which must succeed.
+#[track_caller]
+fn render_to(input: &Path, output: &Path, extra: &[&str]) {
+    let args = [
+        "render",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ];
+    cli(&[&args[..], extra].concat()).unwrap();
+}
+
+/// The report of `rrt ray --raster RASTER --origin ORIGIN --dir 1,0,0
+/// EXTRA…`, which must succeed.
+#[track_caller]
+fn ray_along_x(raster: &Path, origin: &str, extra: &[&str]) -> String {
+    let args = [
+        "ray",
+        "--raster",
+        raster.to_str().unwrap(),
+        "--origin",
+        origin,
+        "--dir",
+        "1,0,0",
+    ];
+    cli(&[&args[..], extra].concat()).unwrap()
+}
+
 /// PSNR in dB of two RGB images of the same size.
 fn psnr(a: &[u8], b: &[u8]) -> f64 {
     assert_eq!(a.len(), b.len());
-    let mse = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
-        .sum::<f64>()
-        / a.len() as f64;
-    if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (255.0f64 * 255.0 / mse).log10()
-    }
+    rrt_tests::psnr(a, b)
 }
 
 fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
@@ -172,24 +187,12 @@ fn saved_raster_renders_like_the_scene() {
         "-q",
     ])
     .unwrap();
-    let mut a = vec![
-        "render",
-        s,
-        "-o",
-        direct.to_str().unwrap(),
-        "--raster",
-        "128",
-    ];
-    a.extend(common);
-    cli(&a).unwrap();
-    let mut b = vec![
-        "render",
-        rrt.to_str().unwrap(),
-        "-o",
-        saved.to_str().unwrap(),
-    ];
-    b.extend(common);
-    cli(&b).unwrap();
+    render_to(
+        &scene,
+        &direct,
+        &[&["--raster", "128"][..], &common].concat(),
+    );
+    render_to(&rrt, &saved, &common);
     assert_eq!(
         std::fs::read(&direct).unwrap(),
         std::fs::read(&saved).unwrap()
@@ -208,18 +211,8 @@ fn saved_raster_renders_like_the_scene() {
 
     // Another view of the saved raster.
     let moved = dir.join("moved.png");
-    let mut c = vec![
-        "render",
-        rrt.to_str().unwrap(),
-        "-o",
-        moved.to_str().unwrap(),
-        "--from",
-        "-2.1,1.3,1.7",
-        "--angle",
-        "50",
-    ];
-    c.extend(common);
-    cli(&c).unwrap();
+    let view_args = ["--from", "-2.1,1.3,1.7", "--angle", "50"];
+    render_to(&rrt, &moved, &[&view_args[..], &common].concat());
     assert_ne!(
         std::fs::read(&moved).unwrap(),
         std::fs::read(&saved).unwrap()
@@ -360,18 +353,7 @@ fn verification_rejects_known_false_hits() {
     // axis, so the continuous ray misses it, through the voxel (9, 17, 10),
     // whose centre segment along y crosses the sphere (from 7.04 to 8.03
     // voxels from its centre): a shell voxel.
-    let out = cli(&[
-        "ray",
-        "--raster",
-        rrt.to_str().unwrap(),
-        "--origin",
-        "0,17.99,10.95",
-        "--dir",
-        "1,0,0",
-        "--connectivity",
-        "six",
-    ])
-    .unwrap();
+    let out = ray_along_x(&rrt, "0,17.99,10.95", &["--connectivity", "six"]);
     let lines: Vec<&str> = out.lines().collect();
     assert!(
         lines
@@ -381,16 +363,7 @@ fn verification_rejects_known_false_hits() {
     );
     assert_eq!(lines.last(), Some(&"miss"), "{out}");
     // Through the middle: the first hit is accepted.
-    let out = cli(&[
-        "ray",
-        "--raster",
-        rrt.to_str().unwrap(),
-        "--origin",
-        "0,10.2,10.1",
-        "--dir",
-        "1,0,0",
-    ])
-    .unwrap();
+    let out = ray_along_x(&rrt, "0,10.2,10.1", &[]);
     assert!(
         out.lines()
             .last()

@@ -18,10 +18,7 @@ fn scenes_dir() -> PathBuf {
 }
 
 fn temp_dir(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("rrt-toml-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    rrt_tests::fresh_dir("rrt-toml", test)
 }
 
 fn built(scene: &Scene, raster: u32) -> VoxelScene {

@@ -7,15 +7,15 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use rrt_core::fixed::voxel_centre;
-use rrt_core::raster::{Extent, RasterMut};
-use rrt_core::store::{Counter, Limits, ObjectAttrs, Texture, directory_len};
-use rrt_core::voxel::VoxelRecord;
+use rrt_core::raster::Extent;
+use rrt_core::store::Texture;
 use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
 use rrt_host::assets::texture::{
     Blend, Checker, ImageTexture, Mapping, Marble, TextureError, Wood, WorldTexture, Wrap,
 };
 use rrt_host::frame::RasterFrame;
 use rrt_host::voxelize::texture::InRaster;
+use rrt_tests::store::OneObject;
 
 fn tmp(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("textures");
@@ -73,43 +73,44 @@ fn planar_mapping_through_the_raster_frame() {
     // Bilinear halfway between columns 1 and 2 of the top row.
     let mid = tex.world_color(DVec3::new(2.0, 1.5, 0.0), UP, [0; 3]);
     assert_eq!(mid, [90, 0, 7]);
-    // Scale 2 along u: two copies across the same 4 units.
+    // Scale 2 along u: two copies across the same 4 units; clamp and
+    // mirror outside [0, 1). Along the top row, at world x:
     let twice = tex.clone().with_transform([2.0, 1.0], [0.0, 0.0]).unwrap();
-    assert_eq!(
-        twice.world_color(DVec3::new(0.25, 1.5, 0.0), UP, [0; 3]),
-        pixel(0, 0)
-    );
-    assert_eq!(
-        twice.world_color(DVec3::new(2.25, 1.5, 0.0), UP, [0; 3]),
-        pixel(0, 0)
-    );
-    assert_eq!(
-        twice.world_color(DVec3::new(1.75, 1.5, 0.0), UP, [0; 3]),
-        pixel(3, 0)
-    );
-    // Clamp and mirror outside [0, 1).
     let clamp = tex.clone().with_wrap(Wrap::Clamp);
-    assert_eq!(
-        clamp.world_color(DVec3::new(-7.0, 1.5, 0.0), UP, [0; 3]),
-        pixel(0, 0)
-    );
-    assert_eq!(
-        clamp.world_color(DVec3::new(9.0, 1.5, 0.0), UP, [0; 3]),
-        pixel(3, 0)
-    );
     let mirror = tex.clone().with_wrap(Wrap::Mirror);
-    assert_eq!(
-        mirror.world_color(DVec3::new(4.5, 1.5, 0.0), UP, [0; 3]),
-        pixel(3, 0)
-    );
-    assert_eq!(
-        mirror.world_color(DVec3::new(7.5, 1.5, 0.0), UP, [0; 3]),
-        pixel(0, 0)
-    );
+    for (t, x, want) in [
+        (&twice, 0.25, pixel(0, 0)),
+        (&twice, 2.25, pixel(0, 0)),
+        (&twice, 1.75, pixel(3, 0)),
+        (&clamp, -7.0, pixel(0, 0)),
+        (&clamp, 9.0, pixel(3, 0)),
+        (&mirror, 4.5, pixel(3, 0)),
+        (&mirror, 7.5, pixel(0, 0)),
+    ] {
+        let p = DVec3::new(x, 1.5, 0.0);
+        assert_eq!(t.world_color(p, UP, [0; 3]), want, "x = {x}");
+    }
     // Modulate: texel × base / 255.
     let m = InRaster::new(tex, frame, Blend::Modulate);
     let c = [voxel_centre(3), voxel_centre(0), 0];
     assert_eq!(m.color(c, n, [255, 128, 0]), [180, 50, 0]);
+}
+
+/// `tex` shows pixel `(i, row)` at `point(i, angle, at)` for each column
+/// `i` (at angle `(i + ½)/4 · 2π`) and each `(at, row)` of `rows`.
+#[track_caller]
+fn assert_columns(tex: &ImageTexture, rows: &[(f64, u32)], point: impl Fn(u32, f64, f64) -> DVec3) {
+    for i in 0..4u32 {
+        let a = (f64::from(i) + 0.5) / 4.0 * TAU;
+        for &(at, row) in rows {
+            let p = point(i, a, at);
+            assert_eq!(
+                tex.world_color(p, UP, [0; 3]),
+                pixel(i, row),
+                "col {i} row {row} at {at}"
+            );
+        }
+    }
 }
 
 #[test]
@@ -126,18 +127,10 @@ fn cylindrical_and_spherical_mapping() {
     .unwrap();
     // Column i at angle (i + ½)/4 · 2π; row 0 (top) at v = 0.75 (z = 3),
     // row 1 at v = 0.25 (z = 1); any radius.
-    for i in 0..4u32 {
-        let a = (f64::from(i) + 0.5) / 4.0 * TAU;
-        for (z, row) in [(3.0, 0), (1.0, 1), (7.0, 0)] {
-            let r = 0.5 + f64::from(i);
-            let p = DVec3::new(1.0 + r * a.cos(), 1.0 + r * a.sin(), z);
-            assert_eq!(
-                cyl.world_color(p, UP, [0; 3]),
-                pixel(i, row),
-                "col {i} z {z}"
-            );
-        }
-    }
+    assert_columns(&cyl, &[(3.0, 0), (1.0, 1), (7.0, 0)], |i, a, z| {
+        let r = 0.5 + f64::from(i);
+        DVec3::new(1.0 + r * a.cos(), 1.0 + r * a.sin(), z)
+    });
     // On the axis there is no angle: the base colour.
     assert_eq!(
         cyl.world_color(DVec3::new(1.0, 1.0, 2.0), UP, [9; 3]),
@@ -155,22 +148,15 @@ fn cylindrical_and_spherical_mapping() {
     .unwrap();
     // Longitude from +y toward −x ((z × y) = −x); row 0 at 45° from the
     // north pole (v = 0.75), row 1 at 45° from the south pole.
-    for i in 0..4u32 {
-        let lon = (f64::from(i) + 0.5) / 4.0 * TAU;
-        for (polar, row) in [(PI / 4.0, 0), (3.0 * PI / 4.0, 1)] {
-            let dir = DVec3::new(
-                -polar.sin() * lon.sin(),
-                polar.sin() * lon.cos(),
-                polar.cos(),
-            );
-            let p = DVec3::new(0.0, 0.0, 10.0) + dir * 3.0;
-            assert_eq!(
-                sph.world_color(p, UP, [0; 3]),
-                pixel(i, row),
-                "col {i} row {row}"
-            );
-        }
-    }
+    let rows = [(PI / 4.0, 0), (3.0 * PI / 4.0, 1)];
+    assert_columns(&sph, &rows, |_, lon, polar| {
+        let dir = DVec3::new(
+            -polar.sin() * lon.sin(),
+            polar.sin() * lon.cos(),
+            polar.cos(),
+        );
+        DVec3::new(0.0, 0.0, 10.0) + dir * 3.0
+    });
     assert_eq!(
         sph.world_color(DVec3::new(0.0, 0.0, 10.0), UP, [9; 3]),
         [9; 3]
@@ -320,7 +306,7 @@ fn solid_textures() {
 /// a row of voxels through a checker of 2-voxel cells.
 #[test]
 fn texture_colours_land_in_voxel_records() {
-    fn row(sink: &mut impl VoxelSink) {
+    fn row(sink: &mut dyn VoxelSink) {
         for x in 0..8 {
             sink.offer(
                 [x, 3, 3],
@@ -343,30 +329,7 @@ fn texture_colours_land_in_voxel_records() {
         frame,
         Blend::Replace,
     );
-    let mut plane = vec![0u8; extent.len()];
-    let mut dir = vec![0u32; directory_len(extent).unwrap()];
-    let mut counter = Counter::new(RasterMut::new(extent, &mut plane).unwrap(), &mut dir).unwrap();
-    row(&mut counter);
-    let sizing = counter.finish().unwrap();
-    let mut records = vec![VoxelRecord::default(); sizing.records()];
-    let mut filler = sizing
-        .fill(
-            &mut records,
-            Limits {
-                objects: 1,
-                materials: 1,
-            },
-        )
-        .unwrap();
-    filler
-        .begin_object(ObjectAttrs {
-            object: 0,
-            material: 0,
-            color: [1, 2, 3],
-        })
-        .unwrap();
-    row(&mut filler.textured(&checker));
-    let built = filler.finish().unwrap();
+    let built = OneObject::textured(extent, [1, 2, 3], &checker, row);
     let store = built.store();
     // Voxel x has world x = −4 + 0.5·x + 0.25; y = z = −2.25 (cell −3,
     // odd): cells 2 voxels wide alternate starting with b at x = 0.

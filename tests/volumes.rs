@@ -118,15 +118,8 @@ fn headerless_raw() {
     assert_eq!(v.value(4, 3, 2), Some(59.0 * 7.0));
     assert_eq!(v.spacing(), [0.5, 0.5, 2.0]);
     // Wrong sizes either way: located at the end of the data or of the file.
-    let e = raw::read(
-        &p,
-        &RawSpec {
-            dims: [5, 4, 4],
-            ..spec
-        },
-        &Limits::default(),
-    )
-    .unwrap_err();
+    let with_dims = |dims| raw::read(&p, &RawSpec { dims, ..spec }, &Limits::default());
+    let e = with_dims([5, 4, 4]).unwrap_err();
     assert_eq!(
         e.to_string(),
         format!(
@@ -134,28 +127,12 @@ fn headerless_raw() {
             p.display()
         )
     );
-    let e = raw::read(
-        &p,
-        &RawSpec {
-            dims: [5, 4, 2],
-            ..spec
-        },
-        &Limits::default(),
-    )
-    .unwrap_err();
+    let e = with_dims([5, 4, 2]).unwrap_err();
     assert!(
         e.to_string().contains("byte 80: 40 bytes more than the 80"),
         "{e}"
     );
-    let e = raw::read(
-        &p,
-        &RawSpec {
-            dims: [0, 4, 2],
-            ..spec
-        },
-        &Limits::default(),
-    )
-    .unwrap_err();
+    let e = with_dims([0, 4, 2]).unwrap_err();
     assert!(
         e.to_string().contains("each dimension must be 1 to 65536"),
         "{e}"
@@ -164,6 +141,30 @@ fn headerless_raw() {
     let e = raw::read(&missing, &spec, &Limits::default()).unwrap_err();
     assert!(matches!(e, VolumeError::Io { .. }));
     assert!(e.to_string().contains("no-such.raw"), "{e}");
+}
+
+/// The NRRD volume `../shared/data/volumes/<name>`, which must have
+/// `dims` samples, or a skip message.
+#[track_caller]
+fn real_volume(name: &str, dims: [u32; 3]) -> Option<Volume> {
+    let v = nrrd::read(&real(name)?, &Limits::default()).unwrap();
+    assert_eq!(v.dims(), dims);
+    Some(v)
+}
+
+/// `v`'s samples range over `range` and average `mean` (to 1e-4).
+#[track_caller]
+fn assert_range_mean(v: &Volume, range: (f64, f64), mean: f64) {
+    assert_eq!(v.range(), range);
+    assert!((v.mean() - mean).abs() < 1e-4, "{}", v.mean());
+}
+
+/// `v` holds `want` at each sample `ijk` of `samples`.
+#[track_caller]
+fn assert_samples(v: &Volume, samples: &[([u32; 3], f64)]) {
+    for &(ijk, want) in samples {
+        assert_eq!(v.value(ijk[0], ijk[1], ijk[2]), Some(want), "{ijk:?}");
+    }
 }
 
 /// `../shared/data/volumes/<name>` or a skip message.
@@ -183,27 +184,25 @@ fn real(name: &str) -> Option<PathBuf> {
 
 #[test]
 fn real_mri_head() {
-    let Some(p) = real("mri_head_colin27.nrrd") else {
+    let Some(v) = real_volume("mri_head_colin27.nrrd", [181, 217, 181]) else {
         return;
     };
-    let v = nrrd::read(&p, &Limits::default()).unwrap();
-    assert_eq!(v.dims(), [181, 217, 181]);
     assert_eq!(v.sample_type(), SampleType::U8);
     assert_eq!(v.spacing(), [1.0; 3]);
     assert_eq!(v.origin(), DVec3::new(-90.0, -125.0, -71.0));
     assert!(v.is_cubic());
     // The data README: min 0, max 254, mean 44.6118.
-    assert_eq!(v.range(), (0.0, 254.0));
-    assert!((v.mean() - 44.6118).abs() < 1e-4, "{}", v.mean());
-    for (ijk, want) in [
-        ([0, 0, 0], 0.0),
-        ([90, 108, 90], 33.0),
-        ([100, 150, 60], 110.0),
-        ([45, 60, 120], 87.0),
-        ([180, 216, 180], 0.0),
-    ] {
-        assert_eq!(v.value(ijk[0], ijk[1], ijk[2]), Some(want), "{ijk:?}");
-    }
+    assert_range_mean(&v, (0.0, 254.0), 44.6118);
+    assert_samples(
+        &v,
+        &[
+            ([0, 0, 0], 0.0),
+            ([90, 108, 90], 33.0),
+            ([100, 150, 60], 110.0),
+            ([45, 60, 120], 87.0),
+            ([180, 216, 180], 0.0),
+        ],
+    );
     // Physical (mm) lookups land on the samples.
     assert_eq!(v.sample_physical(DVec3::new(0.0, -17.0, 19.0)), Some(33.0));
     // Threshold 20 separates head from air: 3,844,205 samples.
@@ -236,21 +235,15 @@ fn real_mri_head() {
     for vox in layer.0.keys().step_by(997) {
         let [i, j, k] = *vox;
         assert!(c.is_opaque(v.value(i, j, k).unwrap()));
-        let outside = [
-            [1i64, 0, 0],
-            [-1, 0, 0],
-            [0, 1, 0],
-            [0, -1, 0],
-            [0, 0, 1],
-            [0, 0, -1],
-        ]
-        .iter()
-        .any(|d| {
-            let p = [
-                i64::from(i) + d[0],
-                i64::from(j) + d[1],
-                i64::from(k) + d[2],
-            ];
+        // A face neighbour: one step along one axis, either way.
+        let neighbours = (0..3).flat_map(|axis| {
+            [-1, 1].map(|step| {
+                let mut p = [i, j, k].map(i64::from);
+                p[axis] += step;
+                p
+            })
+        });
+        let outside = neighbours.into_iter().any(|p| {
             p.iter().any(|x| *x < 0)
                 || v.value(p[0] as u32, p[1] as u32, p[2] as u32)
                     .is_none_or(|x| !c.is_opaque(x))
@@ -261,33 +254,29 @@ fn real_mri_head() {
 
 #[test]
 fn real_ct_engine() {
-    let Some(p) = real("ct_engine.nrrd") else {
+    let Some(v) = real_volume("ct_engine.nrrd", [256, 256, 110]) else {
         return;
     };
-    let v = nrrd::read(&p, &Limits::default()).unwrap();
-    assert_eq!(v.dims(), [256, 256, 110]);
     assert!(!v.geometry_known(), "the engine has no geometry fields");
     assert_eq!(v.spacing(), [1.0; 3]);
-    assert_eq!(v.range(), (0.0, 255.0));
-    assert!((v.mean() - 26.0058).abs() < 1e-4, "{}", v.mean());
-    for (ijk, want) in [
-        ([128, 128, 55], 16.0),
-        ([100, 60, 30], 6.0),
-        ([200, 180, 90], 143.0),
-        ([255, 255, 109], 0.0),
-    ] {
-        assert_eq!(v.value(ijk[0], ijk[1], ijk[2]), Some(want), "{ijk:?}");
-    }
+    assert_range_mean(&v, (0.0, 255.0), 26.0058);
+    assert_samples(
+        &v,
+        &[
+            ([128, 128, 55], 16.0),
+            ([100, 60, 30], 6.0),
+            ([200, 180, 90], 143.0),
+            ([255, 255, 109], 0.0),
+        ],
+    );
     assert_eq!(Classifier::iso(80.0).count(&v), 1_129_646);
 }
 
 #[test]
 fn real_density_map_resampled_to_cubic_voxels() {
-    let Some(p) = real("density_1jzv.nrrd") else {
+    let Some(v) = real_volume("density_1jzv.nrrd", [76, 96, 70]) else {
         return;
     };
-    let v = nrrd::read(&p, &Limits::default()).unwrap();
-    assert_eq!(v.dims(), [76, 96, 70]);
     assert_eq!(v.sample_type(), SampleType::F32);
     let s = v.spacing();
     assert!((s[0] - 0.545_238_095_238_095_2).abs() < 1e-15);

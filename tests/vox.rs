@@ -4,12 +4,11 @@
 //! core's builder, and damaged files.
 
 use dot_vox::{Color, Dict, DotVoxData, Frame, Model, SceneNode, ShapeModel, Size, Voxel};
-use rrt_core::raster::{Extent, RasterMut};
-use rrt_core::store::{Counter, Limits, ObjectAttrs, directory_len};
-use rrt_core::voxel::VoxelRecord;
+use rrt_core::raster::Extent;
 use rrt_core::voxelize::NORMAL_ONE;
 use rrt_host::assets::vox::{self, VoxError};
 use rrt_host::voxelize::vox::VoxPlacement;
+use rrt_tests::store::OneObject;
 
 const RED: [u8; 3] = [255, 0, 0];
 const GREEN: [u8; 3] = [0, 255, 0];
@@ -19,6 +18,28 @@ fn dict(pairs: &[(&str, &str)]) -> Dict {
         .iter()
         .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
         .collect()
+}
+
+/// A transform node: node `child` placed by the frame attributes `frame`,
+/// on layer `layer_id`.
+fn transform(frame: &[(&str, &str)], child: u32, layer_id: u32) -> SceneNode {
+    SceneNode::Transform {
+        attributes: dict(&[]),
+        frames: vec![Frame::new(dict(frame))],
+        child,
+        layer_id,
+    }
+}
+
+/// A shape node of model `model_id`.
+fn shape(model_id: u32) -> SceneNode {
+    SceneNode::Shape {
+        attributes: dict(&[]),
+        models: vec![ShapeModel {
+            model_id,
+            attributes: dict(&[]),
+        }],
+    }
 }
 
 /// Model 0: a full 3×3×3 cube, red except a green centre of the top face
@@ -56,42 +77,15 @@ fn data(scene: bool) -> DotVoxData {
     };
     let scenes = if scene {
         vec![
-            SceneNode::Transform {
-                attributes: dict(&[]),
-                frames: vec![Frame::new(dict(&[]))],
-                child: 1,
-                layer_id: u32::MAX,
-            },
+            transform(&[], 1, u32::MAX),
             SceneNode::Group {
                 attributes: dict(&[]),
                 children: vec![2, 4],
             },
-            SceneNode::Transform {
-                attributes: dict(&[]),
-                frames: vec![Frame::new(dict(&[("_t", "10 0 0")]))],
-                child: 3,
-                layer_id: 0,
-            },
-            SceneNode::Shape {
-                attributes: dict(&[]),
-                models: vec![ShapeModel {
-                    model_id: 0,
-                    attributes: dict(&[]),
-                }],
-            },
-            SceneNode::Transform {
-                attributes: dict(&[]),
-                frames: vec![Frame::new(dict(&[("_t", "0 20 5"), ("_r", "17")]))],
-                child: 5,
-                layer_id: 0,
-            },
-            SceneNode::Shape {
-                attributes: dict(&[]),
-                models: vec![ShapeModel {
-                    model_id: 1,
-                    attributes: dict(&[]),
-                }],
-            },
+            transform(&[("_t", "10 0 0")], 3, 0),
+            shape(0),
+            transform(&[("_t", "0 20 5"), ("_r", "17")], 5, 0),
+            shape(1),
         ]
     } else {
         vec![]
@@ -207,33 +201,14 @@ fn voxelized_into_the_raster() {
         scale: 2,
     };
     let extent = Extent::cube(64).unwrap();
-    let mut plane = vec![0u8; extent.len()];
-    let mut dir = vec![0u32; directory_len(extent).unwrap()];
-    let mut counter = Counter::new(RasterMut::new(extent, &mut plane).unwrap(), &mut dir).unwrap();
-    let offers = scene.voxelize(placement, &mut counter);
-    assert_eq!(offers, 36 * 8);
-    let sizing = counter.finish().unwrap();
-    assert_eq!(sizing.records(), 36 * 8);
-    let mut records = vec![VoxelRecord::default(); sizing.records()];
-    let mut filler = sizing
-        .fill(
-            &mut records,
-            Limits {
-                objects: 1,
-                materials: 1,
-            },
-        )
-        .unwrap();
-    filler
-        .begin_object(ObjectAttrs {
-            object: 0,
-            material: 0,
-            color: [9, 9, 9],
-        })
-        .unwrap();
     let colors = scene.colors(placement);
-    scene.voxelize(placement, &mut filler.textured(&colors));
-    let built = filler.finish().unwrap();
+    let offers = std::cell::RefCell::new(Vec::new());
+    let built = OneObject::textured(extent, [9, 9, 9], &colors, |sink| {
+        offers.borrow_mut().push(scene.voxelize(placement, sink));
+    });
+    // Both passes offer every voxel once.
+    assert_eq!(*offers.borrow(), [36 * 8; 2]);
+    assert_eq!(built.records.len(), 36 * 8);
     let store = built.store();
     // World cell (10, 0, 1) (green, top face centre: +z) is raster
     // 20 + 2·10 = 40.., 10.., 12..: all eight voxels.

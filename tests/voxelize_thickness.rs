@@ -12,11 +12,13 @@ use std::collections::HashSet;
 use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::{BezierPatch, Cone, Cuboid, Sphere, Torus, Triangle};
 use rrt_core::raster::Extent;
+use rrt_core::voxelize::error::VoxelizeError;
 use rrt_core::voxelize::volume::Block;
 use rrt_core::voxelize::{
     Separation, Surfel, VoxelSink, cone, cuboid, patch, sphere, torus, triangle, volume,
 };
 use rrt_tests::mesh::{fit, read_obj};
+use rrt_tests::vec3::{bezier, cross, length, triangle_normal};
 
 /// Unique voxels and total offers.
 #[derive(Default)]
@@ -34,7 +36,7 @@ impl VoxelSink for Unique {
 
 fn norm(sep: Separation, n: [f64; 3]) -> f64 {
     let a = n.map(f64::abs);
-    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    let l = length(a);
     match sep {
         Separation::Six => a[0].max(a[1]).max(a[2]) / l,
         Separation::TwentySix => (a[0] + a[1] + a[2]) / l,
@@ -53,12 +55,8 @@ fn integrate(sep: Separation, steps: u32, f: impl Fn(f64, f64) -> [f64; 3]) -> f
                 [0, 1, 2].map(|k| (f(u + h / 2.0, v)[k] - f(u - h / 2.0, v)[k]) / VOXEL as f64);
             let dv =
                 [0, 1, 2].map(|k| (f(u, v + h / 2.0)[k] - f(u, v - h / 2.0)[k]) / VOXEL as f64);
-            let c = [
-                du[1] * dv[2] - du[2] * dv[1],
-                du[2] * dv[0] - du[0] * dv[2],
-                du[0] * dv[1] - du[1] * dv[0],
-            ];
-            let area = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+            let c = cross(du, dv);
+            let area = length(c);
             if area > 0.0 {
                 s += area * norm(sep, c);
             }
@@ -96,6 +94,62 @@ impl Report {
             );
         }
     }
+
+    /// Records a case voxelized by `voxelize` with each separation, against
+    /// `minimum(sep)`.
+    fn case(
+        &mut self,
+        what: &str,
+        checked: bool,
+        voxelize: impl Fn(Separation, &mut Unique),
+        minimum: impl Fn(Separation) -> f64,
+    ) {
+        for sep in SEPS {
+            let mut u = Unique::default();
+            voxelize(sep, &mut u);
+            self.add(what, sep, &u, minimum(sep), checked);
+        }
+    }
+}
+
+/// The voxelizer of `shape` into `extent` as [`Report::case`] calls it.
+fn voxelizer<T>(
+    voxelize: fn(&T, Separation, Extent, &mut Unique) -> Result<u64, VoxelizeError>,
+    shape: &T,
+    extent: Extent,
+) -> impl Fn(Separation, &mut Unique) {
+    move |sep, u| {
+        voxelize(shape, sep, extent, u).unwrap();
+    }
+}
+
+/// The point at `(a, b)` of a sphere of radius `r` voxels about the origin
+/// (fixed units), `a` from pole to pole, `b` around the axis.
+fn on_sphere(r: f64) -> impl Fn(f64, f64) -> [f64; 3] {
+    let v = VOXEL as f64;
+    move |a, b| {
+        let (th, ph) = (a * std::f64::consts::PI, b * 2.0 * std::f64::consts::PI);
+        [
+            r * v * th.sin() * ph.cos(),
+            r * v * th.sin() * ph.sin(),
+            r * v * th.cos(),
+        ]
+    }
+}
+
+/// `∫ ‖n‖ dA` over the triangles `faces` of `verts` (fixed units), in
+/// voxels².
+fn mesh_minimum(sep: Separation, verts: &[[i64; 3]], faces: &[[u32; 3]]) -> f64 {
+    let v = VOXEL as f64;
+    let mut min = 0.0;
+    for f in faces {
+        let c = triangle_normal(f.map(|i| verts[i as usize].map(|c| c as f64 / v)));
+        let area = 0.5 * length(c);
+        if area > 0.0 {
+            min += area * norm(sep, c);
+        }
+    }
+    min
 }
 
 const SEPS: [Separation; 2] = [Separation::Six, Separation::TwentySix];
@@ -113,20 +167,13 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
             centre: [c, c - 777, c + 4321],
             radius: (r * v) as i64,
         };
-        for sep in SEPS {
-            let mut u = Unique::default();
-            sphere::surface(&s, sep, e, &mut u).unwrap();
-            let min = integrate(sep, 400, |a, b| {
-                let (th, ph) = (a * std::f64::consts::PI, b * 2.0 * std::f64::consts::PI);
-                [
-                    r * v * th.sin() * ph.cos(),
-                    r * v * th.sin() * ph.sin(),
-                    r * v * th.cos(),
-                ]
-            });
-            // Below 5 voxels the shell is mostly curvature: reported only.
-            rep.add(&format!("sphere r={r}"), sep, &u, min, r >= 5.0);
-        }
+        // Below 5 voxels the shell is mostly curvature: reported only.
+        rep.case(
+            &format!("sphere r={r}"),
+            r >= 5.0,
+            voxelizer(sphere::surface, &s, e),
+            |sep| integrate(sep, 400, on_sphere(r)),
+        );
     }
     // Boxes: faces in general position, exactly on voxel faces and exactly
     // through voxel centres (ties, decided by the infinitesimal shift: one
@@ -162,18 +209,10 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
             true,
         ),
     ] {
-        for sep in SEPS {
-            let mut u = Unique::default();
-            cuboid::surface(&b, sep, e, &mut u).unwrap();
-            let d = [0, 1, 2].map(|k| (b.max[k] - b.min[k]) as f64 / v);
-            rep.add(
-                what,
-                sep,
-                &u,
-                2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]),
-                checked,
-            );
-        }
+        let d = [0, 1, 2].map(|k| (b.max[k] - b.min[k]) as f64 / v);
+        rep.case(what, checked, voxelizer(cuboid::surface, &b, e), |_| {
+            2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
+        });
     }
     // A large tilted triangle.
     let t = Triangle {
@@ -185,20 +224,12 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
         normals: None,
     };
     let e = Extent::cube(96).unwrap();
-    for sep in SEPS {
-        let mut u = Unique::default();
-        triangle::triangle(&t, sep, e, &mut u).unwrap();
-        let f = t.vertices.map(|p| p.map(|c| c as f64 / v));
-        let e1 = [0, 1, 2].map(|k| f[1][k] - f[0][k]);
-        let e2 = [0, 1, 2].map(|k| f[2][k] - f[0][k]);
-        let c = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        let area = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-        rep.add("triangle (area ~4000)", sep, &u, area * norm(sep, c), true);
-    }
+    rep.case(
+        "triangle (area ~4000)",
+        true,
+        voxelizer(triangle::triangle, &t, e),
+        |sep| mesh_minimum(sep, &t.vertices, &[[0, 1, 2]]),
+    );
     // A torus.
     let (big, small) = (20.0, 7.0);
     let tz = Torus {
@@ -210,26 +241,18 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
     let e = Extent::cube(64).unwrap();
     let ax = [0.0, 300.0 / 583.095_189_484_53, 500.0 / 583.095_189_484_53];
     let uu = [1.0, 0.0, 0.0];
-    let vv = [
-        ax[1] * uu[2] - ax[2] * uu[1],
-        ax[2] * uu[0] - ax[0] * uu[2],
-        ax[0] * uu[1] - ax[1] * uu[0],
-    ];
-    for sep in SEPS {
-        let mut u = Unique::default();
-        torus::surface(&tz, sep, e, &mut u).unwrap();
-        let min = integrate(sep, 600, |a, b| {
-            let (th, ph) = (
-                a * 2.0 * std::f64::consts::PI,
-                b * 2.0 * std::f64::consts::PI,
-            );
-            let rho = big + small * ph.cos();
-            [0, 1, 2].map(|k| {
-                v * (rho * (th.cos() * uu[k] + th.sin() * vv[k]) + small * ph.sin() * ax[k])
-            })
-        });
-        rep.add("torus 20/7", sep, &u, min, true);
-    }
+    let vv = cross(ax, uu);
+    let ring = |a: f64, b: f64| {
+        let (th, ph) = (
+            a * 2.0 * std::f64::consts::PI,
+            b * 2.0 * std::f64::consts::PI,
+        );
+        let rho = big + small * ph.cos();
+        [0, 1, 2]
+            .map(|k| v * (rho * (th.cos() * uu[k] + th.sin() * vv[k]) + small * ph.sin() * ax[k]))
+    };
+    let surface = voxelizer(torus::surface, &tz, e);
+    rep.case("torus 20/7", true, surface, |sep| integrate(sep, 600, ring));
     // An open cylinder.
     let cy = Cone {
         base: [30 * VOXEL; 3],
@@ -239,25 +262,20 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
     };
     let e = Extent::cube(80).unwrap();
     let a = [20.0f64, 10.0, 30.0];
-    let al = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    let al = length(a);
     let w = a.map(|c| c / al);
     let p = [w[1], -w[0], 0.0];
     let pl = (p[0] * p[0] + p[1] * p[1]).sqrt();
     let p = p.map(|c| c / pl);
-    let q = [
-        w[1] * p[2] - w[2] * p[1],
-        w[2] * p[0] - w[0] * p[2],
-        w[0] * p[1] - w[1] * p[0],
-    ];
-    for sep in SEPS {
-        let mut u = Unique::default();
-        cone::surface(&cy, sep, e, &mut u).unwrap();
-        let min = integrate(sep, 600, |s, t| {
-            let th = t * 2.0 * std::f64::consts::PI;
-            [0, 1, 2].map(|k| v * (30.0 + s * a[k] + 12.0 * (th.cos() * p[k] + th.sin() * q[k])))
-        });
-        rep.add("open cylinder r=12", sep, &u, min, true);
-    }
+    let q = cross(w, p);
+    let wall = |s: f64, t: f64| {
+        let th = t * 2.0 * std::f64::consts::PI;
+        [0, 1, 2].map(|k| v * (30.0 + s * a[k] + 12.0 * (th.cos() * p[k] + th.sin() * q[k])))
+    };
+    let surface = voxelizer(cone::surface, &cy, e);
+    rep.case("open cylinder r=12", true, surface, |sep| {
+        integrate(sep, 600, wall)
+    });
     // A Bézier patch.
     let mut control = [[[0i64; 3]; 4]; 4];
     for (i, row) in control.iter_mut().enumerate() {
@@ -272,31 +290,12 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
     }
     let bp = BezierPatch { control };
     let e = Extent::cube(84).unwrap();
-    for sep in SEPS {
-        let mut u = Unique::default();
-        patch::surface(&bp, sep, e, &mut u).unwrap();
-        let min = integrate(sep, 400, |s, t| {
-            let b = |x: f64| {
-                [
-                    (1.0 - x).powi(3),
-                    3.0 * x * (1.0 - x).powi(2),
-                    3.0 * x * x * (1.0 - x),
-                    x.powi(3),
-                ]
-            };
-            let (bu, bv) = (b(s), b(t));
-            let mut out = [0.0; 3];
-            for a in 0..4 {
-                for c in 0..4 {
-                    for k in 0..3 {
-                        out[k] += bu[a] * bv[c] * control[a][c][k] as f64;
-                    }
-                }
-            }
-            out
-        });
-        rep.add("bezier patch ~75x80", sep, &u, min, true);
-    }
+    rep.case(
+        "bezier patch ~75x80",
+        true,
+        voxelizer(patch::surface, &bp, e),
+        |sep| integrate(sep, 400, |s, t| bezier(&control, s, t)),
+    );
     // A sampled ball (iso-radius 20).
     let n = 48u32;
     let mut s = Vec::new();
@@ -317,19 +316,14 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
         offset: [0; 3],
     };
     let thr = (30_000.0 - 50.0 * 400.0) as u16;
-    for sep in SEPS {
-        let mut u = Unique::default();
-        volume::boundary(&blk, thr, sep, Extent::cube(n).unwrap(), &mut u).unwrap();
-        let min = integrate(sep, 400, |a, b| {
-            let (th, ph) = (a * std::f64::consts::PI, b * 2.0 * std::f64::consts::PI);
-            [
-                20.0 * v * th.sin() * ph.cos(),
-                20.0 * v * th.sin() * ph.sin(),
-                20.0 * v * th.cos(),
-            ]
-        });
-        rep.add("volume ball iso r=20", sep, &u, min, true);
-    }
+    rep.case(
+        "volume ball iso r=20",
+        true,
+        |sep, u| {
+            volume::boundary(&blk, thr, sep, Extent::cube(n).unwrap(), u).unwrap();
+        },
+        |sep| integrate(sep, 400, on_sphere(20.0)),
+    );
     // The bunny, when the shared data is there.
     if let Some(data) = rrt_tests::shared_data()
         && let path = data.join("meshes/bunny.obj")
@@ -337,34 +331,14 @@ fn thickness_within_one_and_a_half_of_the_minimum() {
     {
         let (verts, faces) = read_obj(&path);
         let verts = fit(&verts, 160, 3);
-        for sep in SEPS {
-            let mut u = Unique::default();
-            triangle::mesh(
-                &verts,
-                None,
-                &faces,
-                sep,
-                Extent::cube(160).unwrap(),
-                &mut u,
-            )
-            .unwrap();
-            let mut min = 0.0;
-            for f in &faces {
-                let p = f.map(|i| verts[i as usize].map(|c| c as f64 / v));
-                let e1 = [0, 1, 2].map(|k| p[1][k] - p[0][k]);
-                let e2 = [0, 1, 2].map(|k| p[2][k] - p[0][k]);
-                let c = [
-                    e1[1] * e2[2] - e1[2] * e2[1],
-                    e1[2] * e2[0] - e1[0] * e2[2],
-                    e1[0] * e2[1] - e1[1] * e2[0],
-                ];
-                let area = 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-                if area > 0.0 {
-                    min += area * norm(sep, c);
-                }
-            }
-            rep.add("bunny mesh at 160", sep, &u, min, true);
-        }
+        rep.case(
+            "bunny mesh at 160",
+            true,
+            |sep, u| {
+                triangle::mesh(&verts, None, &faces, sep, Extent::cube(160).unwrap(), u).unwrap();
+            },
+            |sep| mesh_minimum(sep, &verts, &faces),
+        );
     } else {
         println!("SKIPPED: bunny (../shared/data/meshes/bunny.obj not found)");
     }

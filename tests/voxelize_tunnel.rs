@@ -13,6 +13,7 @@
 //! Every case derives from a printed seed: `RRT_SEED=<seed>` replays one;
 //! `RRT_SCALE=<k>` runs k times as many cases.
 
+use rrt_core::check_voxelize::PlaneSink;
 use rrt_core::discrete_ray::Connectivity;
 use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::{BezierPatch, Cone, Cuboid, Sphere, Torus, Triangle};
@@ -21,12 +22,42 @@ use rrt_core::voxelize::{NORMAL_ONE, Separation, cone, cuboid, patch, sphere, to
 use rrt_tests::Rng;
 use rrt_tests::mesh::{box_mesh, fit, inside_mesh, read_obj};
 use rrt_tests::tunnel::{Voxelized, assert_tunnel_free_both, origins, seeds};
+use rrt_tests::vec3::{bezier, cross, dot, length, sub, triangle_normal};
+
+/// Runs `case` for each of `n` seeds (see [`seeds`]) with a generator
+/// seeded `first + seed`, sums the rays each fires, prints the total and
+/// requires more than `at_least`.
+#[track_caller]
+fn soak(what: &str, n: u64, first: u64, at_least: u64, mut case: impl FnMut(u64, &mut Rng) -> u64) {
+    let mut rays = 0u64;
+    for seed in seeds(n) {
+        let mut rng = Rng::new(first + seed);
+        rays += case(seed, &mut rng);
+    }
+    println!("{what}: {rays} rays, all hit");
+    assert!(rays > at_least);
+}
+
+/// Voxelizes a closed shape with both separations (`voxelize`) and fires
+/// the tunnel probes from up to `n` origins in its box `lo..hi` (voxels
+/// whose centre satisfies `inside`). Returns the number of rays fired.
+#[track_caller]
+fn probe_closed(
+    extent: Extent,
+    (lo, hi): ([i64; 3], [i64; 3]),
+    n: usize,
+    rng: &mut Rng,
+    inside: impl Fn([i64; 3]) -> bool,
+    what: &str,
+    voxelize: impl Fn(Separation, &mut PlaneSink<'_>),
+) -> u64 {
+    let os = origins(extent, lo, hi, n, rng, &inside);
+    assert_tunnel_free_both(extent, &os, rng, &inside, what, voxelize)
+}
 
 #[test]
 fn spheres_are_tunnel_free() {
-    let mut rays = 0u64;
-    for seed in seeds(120) {
-        let mut rng = Rng::new(seed);
+    soak("spheres", 120, 0, 100_000, |seed, rng| {
         // Radii from half a voxel to 14 voxels, some on exact lattice values.
         let r = match seed % 4 {
             0 => rng.range(VOXEL / 2, 3 * VOXEL),
@@ -42,7 +73,7 @@ fn spheres_are_tunnel_free() {
             1 => mid + VOXEL / 2,
             _ => mid + rng.range(-VOXEL, VOXEL),
         };
-        let c = [jitter(&mut rng), jitter(&mut rng), jitter(&mut rng)];
+        let c = [jitter(rng), jitter(rng), jitter(rng)];
         let s = Sphere {
             centre: c,
             radius: r,
@@ -51,22 +82,19 @@ fn spheres_are_tunnel_free() {
             let d: i128 = (0..3).map(|k| i128::from(p[k] - c[k]).pow(2)).sum();
             d < i128::from(r).pow(2)
         };
-        let lo = c.map(|v| v - r);
-        let hi = c.map(|v| v + r);
-        let os = origins(extent, lo, hi, 4, &mut rng, inside);
-        rays += assert_tunnel_free_both(
+        let bounds = (c.map(|v| v - r), c.map(|v| v + r));
+        probe_closed(
             extent,
-            &os,
-            &mut rng,
-            &inside,
+            bounds,
+            4,
+            rng,
+            inside,
             &format!("seed {seed}: {s:?}"),
             |sep, sink| {
                 sphere::surface(&s, sep, extent, sink).unwrap();
             },
-        );
-    }
-    println!("spheres: {rays} rays, all hit");
-    assert!(rays > 100_000);
+        )
+    });
 }
 
 /// Unit icosahedron (vertices, outward faces) and octahedron.
@@ -115,24 +143,21 @@ fn platonic(ico: bool) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
         ];
         (v, f)
     } else {
-        let v = vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let f = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        // Vertices ±x, ±y, ±z; the faces around +z (4) and −z (5) follow
+        // the ring +x, +y, −x, −y counter-clockwise seen from outside.
+        let v = (0..6)
+            .map(|i| {
+                let mut c = [0.0; 3];
+                c[i / 2] = if i % 2 == 0 { 1.0 } else { -1.0 };
+                c
+            })
+            .collect();
+        let ring = [0, 2, 1, 3];
+        let edges = || (0..4).map(move |i| (ring[i], ring[(i + 1) % 4]));
+        let f = edges()
+            .map(|(a, b)| [a, b, 4])
+            .chain(edges().map(|(a, b)| [b, a, 5]))
+            .collect();
         (v, f)
     }
 }
@@ -148,8 +173,7 @@ fn check_mesh(
     let lo = [0, 1, 2].map(|k| verts.iter().map(|v| v[k]).min().unwrap());
     let hi = [0, 1, 2].map(|k| verts.iter().map(|v| v[k]).max().unwrap());
     let inside = |p: [i64; 3]| inside_mesh(verts, faces, p);
-    let os = origins(extent, lo, hi, 4, rng, inside);
-    assert_tunnel_free_both(extent, &os, rng, &inside, what, |sep, sink| {
+    probe_closed(extent, (lo, hi), 4, rng, inside, what, |sep, sink| {
         let r = triangle::mesh(verts, None, faces, sep, extent, sink).unwrap();
         assert_eq!(r.degenerate, 0);
     })
@@ -157,9 +181,7 @@ fn check_mesh(
 
 #[test]
 fn closed_meshes_are_tunnel_free() {
-    let mut rays = 0u64;
-    for seed in seeds(160) {
-        let mut rng = Rng::new(1000 + seed);
+    soak("polyhedra", 160, 1000, 100_000, |seed, rng| {
         let r = rng.range(3 * VOXEL / 2, 14 * VOXEL) as f64;
         let n = (2.0 * r / VOXEL as f64) as u32 + 6;
         let extent = Extent::cube(n).unwrap();
@@ -177,44 +199,32 @@ fn closed_meshes_are_tunnel_free() {
                 }
             })
             .collect();
-        rays += check_mesh(
-            &verts,
-            &faces,
-            extent,
-            &mut rng,
-            &format!("seed {seed}: polyhedron {verts:?}"),
-        );
+        let what = format!("seed {seed}: polyhedron {verts:?}");
+        check_mesh(&verts, &faces, extent, rng, &what)
+    });
+}
+
+/// `x` on a voxel face (`seed % 3 == 0`), on a voxel centre (1) or
+/// anywhere (2).
+fn snap(seed: u64, x: i64) -> i64 {
+    match seed % 3 {
+        0 => x / VOXEL * VOXEL,
+        1 => x / VOXEL * VOXEL + VOXEL / 2,
+        _ => x,
     }
-    println!("polyhedra: {rays} rays, all hit");
-    assert!(rays > 100_000);
 }
 
 #[test]
 fn box_meshes_are_tunnel_free() {
-    let mut rays = 0u64;
-    for seed in seeds(80) {
-        let mut rng = Rng::new(2000 + seed);
-        let n = 20u32;
-        let extent = Extent::cube(n).unwrap();
+    soak("box meshes", 80, 2000, 10_000, |seed, rng| {
+        let extent = Extent::cube(20).unwrap();
         // Corners on voxel faces, on voxel centres, or anywhere.
-        let snap = |x: i64| match seed % 3 {
-            0 => x / VOXEL * VOXEL,
-            1 => x / VOXEL * VOXEL + VOXEL / 2,
-            _ => x,
-        };
-        let lo = [0; 3].map(|_| snap(rng.range(2 * VOXEL, 8 * VOXEL)));
-        let hi = [0; 3].map(|_| snap(rng.range(10 * VOXEL, 17 * VOXEL)));
+        let lo = [0; 3].map(|_| snap(seed, rng.range(2 * VOXEL, 8 * VOXEL)));
+        let hi = [0; 3].map(|_| snap(seed, rng.range(10 * VOXEL, 17 * VOXEL)));
         let (verts, faces) = box_mesh(lo, hi);
-        rays += check_mesh(
-            &verts,
-            &faces,
-            extent,
-            &mut rng,
-            &format!("seed {seed}: box mesh {lo:?}..{hi:?}"),
-        );
-    }
-    println!("box meshes: {rays} rays, all hit");
-    assert!(rays > 10_000);
+        let what = format!("seed {seed}: box mesh {lo:?}..{hi:?}");
+        check_mesh(&verts, &faces, extent, rng, &what)
+    });
 }
 
 #[test]
@@ -247,40 +257,31 @@ fn bunny_is_tunnel_free() {
 
 #[test]
 fn boxes_are_tunnel_free() {
-    let mut rays = 0u64;
-    for seed in seeds(100) {
-        let mut rng = Rng::new(4000 + seed);
+    soak("boxes", 100, 4000, 50_000, |seed, rng| {
         let extent = Extent::cube(18).unwrap();
-        let snap = |x: i64| match seed % 3 {
-            0 => x / VOXEL * VOXEL,
-            1 => x / VOXEL * VOXEL + VOXEL / 2,
-            _ => x,
-        };
         // Thin boxes too: down to a fraction of a voxel.
-        let lo = [0; 3].map(|_| snap(rng.range(2 * VOXEL, 8 * VOXEL)));
-        let hi = [0, 1, 2].map(|k| lo[k] + 1 + snap(rng.range(VOXEL / 4, 8 * VOXEL)));
+        let lo = [0; 3].map(|_| snap(seed, rng.range(2 * VOXEL, 8 * VOXEL)));
+        let hi = [0, 1, 2].map(|k| lo[k] + 1 + snap(seed, rng.range(VOXEL / 4, 8 * VOXEL)));
         let b = Cuboid { min: lo, max: hi };
         let inside = |p: [i64; 3]| (0..3).all(|k| p[k] > lo[k] && p[k] < hi[k]);
-        let os = origins(extent, lo, hi, 4, &mut rng, inside);
-        rays += assert_tunnel_free_both(
+        probe_closed(
             extent,
-            &os,
-            &mut rng,
-            &inside,
+            (lo, hi),
+            4,
+            rng,
+            inside,
             &format!("seed {seed}: {b:?}"),
             |sep, sink| {
                 cuboid::surface(&b, sep, extent, sink).unwrap();
             },
-        );
-    }
-    println!("boxes: {rays} rays, all hit");
-    assert!(rays > 50_000);
+        )
+    });
 }
 
 fn unit_axis(rng: &mut Rng) -> [f64; 3] {
     loop {
         let a = [0; 3].map(|_| rng.range(-1000, 1000) as f64);
-        let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        let l = length(a);
         if l > 100.0 {
             return a.map(|c| c / l);
         }
@@ -289,9 +290,7 @@ fn unit_axis(rng: &mut Rng) -> [f64; 3] {
 
 #[test]
 fn tori_are_tunnel_free() {
-    let mut rays = 0u64;
-    for seed in seeds(60) {
-        let mut rng = Rng::new(5000 + seed);
+    soak("tori", 60, 5000, 50_000, |seed, rng| {
         let minor = rng.range(VOXEL, 4 * VOXEL);
         let major = minor + rng.range(VOXEL / 2, 8 * VOXEL);
         let n = u32::try_from(2 * (major + minor) / VOXEL + 6).unwrap();
@@ -300,7 +299,7 @@ fn tori_are_tunnel_free() {
         let a = if seed % 3 == 0 {
             [0.0, 0.0, 1.0]
         } else {
-            unit_axis(&mut rng)
+            unit_axis(rng)
         };
         let t = Torus {
             centre: [mid; 3],
@@ -310,39 +309,34 @@ fn tori_are_tunnel_free() {
         };
         let inside = |p: [i64; 3]| {
             let w = [0, 1, 2].map(|k| (p[k] - mid) as f64);
-            let h = w[0] * a[0] + w[1] * a[1] + w[2] * a[2];
-            let rho = ((w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) - h * h)
-                .max(0.0)
-                .sqrt();
+            let h = dot(w, a);
+            let rho = (dot(w, w) - h * h).max(0.0).sqrt();
             // Keep a 1/16 voxel margin: the tessellation lies inside.
             ((rho - major as f64).powi(2) + h * h).sqrt() < minor as f64 - VOXEL as f64 / 16.0
         };
         let r = major + minor;
-        let os = origins(extent, [mid - r; 3], [mid + r; 3], 5, &mut rng, inside);
-        rays += assert_tunnel_free_both(
+        let bounds = ([mid - r; 3], [mid + r; 3]);
+        probe_closed(
             extent,
-            &os,
-            &mut rng,
-            &inside,
+            bounds,
+            5,
+            rng,
+            inside,
             &format!("seed {seed}: {t:?}"),
             |sep, sink| {
                 torus::surface(&t, sep, extent, sink).unwrap();
             },
-        );
-    }
-    println!("tori: {rays} rays, all hit");
-    assert!(rays > 50_000);
+        )
+    });
 }
 
 #[test]
 fn capped_cones_are_tunnel_free() {
-    let mut rays = 0u64;
-    for seed in seeds(80) {
-        let mut rng = Rng::new(6000 + seed);
+    soak("capped cones", 80, 6000, 50_000, |seed, rng| {
         let n = 24u32;
         let extent = Extent::cube(n).unwrap();
         let pt = |rng: &mut Rng| [0; 3].map(|_| rng.range(7 * VOXEL, 17 * VOXEL));
-        let (b, a) = (pt(&mut rng), pt(&mut rng));
+        let (b, a) = (pt(rng), pt(rng));
         let r0 = rng.range(if seed % 4 == 0 { 0 } else { VOXEL / 2 }, 6 * VOXEL);
         let r1 = if seed % 5 == 0 {
             r0
@@ -356,70 +350,94 @@ fn capped_cones_are_tunnel_free() {
             apex_radius: r1,
         };
         let axis = [0, 1, 2].map(|k| (a[k] - b[k]) as f64);
-        let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let len = length(axis);
         if len < VOXEL as f64 {
-            continue;
+            return 0;
         }
         let inside = |p: [i64; 3]| {
             let w = [0, 1, 2].map(|k| (p[k] - b[k]) as f64);
-            let t = (w[0] * axis[0] + w[1] * axis[1] + w[2] * axis[2]) / len;
-            let rho = ((w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) - t * t)
-                .max(0.0)
-                .sqrt();
+            let t = dot(w, axis) / len;
+            let rho = (dot(w, w) - t * t).max(0.0).sqrt();
             let r = r0 as f64 + (r1 - r0) as f64 * t / len;
             t > 0.0 && t < len && rho < r - VOXEL as f64 / 16.0
         };
-        let os = origins(
+        let bounds = ([0; 3], [i64::from(n) * VOXEL - 1; 3]);
+        probe_closed(
             extent,
-            [0; 3],
-            [i64::from(n) * VOXEL - 1; 3],
+            bounds,
             5,
-            &mut rng,
+            rng,
             inside,
-        );
-        rays += assert_tunnel_free_both(
-            extent,
-            &os,
-            &mut rng,
-            &inside,
             &format!("seed {seed}: {c:?}"),
             |sep, sink| {
                 cone::capped(&c, sep, extent, sink).unwrap();
             },
-        );
-    }
-    println!("capped cones: {rays} rays, all hit");
-    assert!(rays > 50_000);
+        )
+    });
 }
 
-/// Fires rays across an open surface through points `p` (fixed units) with
-/// unit normal `nrm`, at angles of at least `min_deg` to the surface,
-/// starting 3 voxels before it; each must hit. Returns rays fired.
+/// Fires rays across the open surface `voxelize` makes with each
+/// separation, in each connectivity it must stop (6-separating surfaces
+/// stop six and adaptive rays, 26-separating ones twenty-six rays), through
+/// 20 points per separation that `sample` draws (a point in fixed units and
+/// the unit normal there, or `None` to pass). Each ray must hit; `what`
+/// names the case otherwise. Returns the number of rays fired.
+fn probe_open(
+    extent: Extent,
+    rng: &mut Rng,
+    voxelize: impl Fn(Separation, &mut PlaneSink<'_>),
+    mut sample: impl FnMut(&mut Rng) -> Option<([f64; 3], [f64; 3])>,
+    what: &dyn Fn(Separation, Connectivity) -> String,
+) -> u64 {
+    let mut rays = 0;
+    for sep in [Separation::Six, Separation::TwentySix] {
+        let v = Voxelized::new(extent, |sink| voxelize(sep, sink));
+        let flagged = v.flagged();
+        let r = Raster::new(extent, &flagged).unwrap();
+        let modes: &[Connectivity] = match sep {
+            Separation::Six => &[Connectivity::Six, Connectivity::Adaptive],
+            Separation::TwentySix => &[Connectivity::TwentySix],
+        };
+        for _ in 0..20 {
+            if let Some((p, nrm)) = sample(rng) {
+                rays += cross_open(&r, modes, p, nrm, rng, &|mode| what(sep, mode));
+            }
+        }
+    }
+    rays
+}
+
+/// Fires rays of each connectivity in `modes` across an open surface
+/// through point `p` (fixed units) with unit normal `nrm`, within 45° of
+/// the normal, starting 3 voxels before the surface; each must hit
+/// (`what(mode)` names the case otherwise). Returns rays fired.
 fn cross_open(
     raster: &Raster<'_>,
-    mode: Connectivity,
+    modes: &[Connectivity],
     p: [f64; 3],
     nrm: [f64; 3],
     rng: &mut Rng,
-    what: &str,
+    what: &dyn Fn(Connectivity) -> String,
 ) -> u64 {
     let mut fired = 0;
-    for _ in 0..8 {
-        // A direction within 45° of the normal, either side.
-        let t = unit_axis(rng);
-        let side = if rng.chance(1, 2) { 1.0 } else { -1.0 };
-        let mut d = [0, 1, 2].map(|k| side * nrm[k] + 0.9 * t[k]);
-        let dn = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
-        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        if (dn / l).abs() < std::f64::consts::FRAC_1_SQRT_2 {
-            continue;
-        }
-        d = d.map(|c| c / l);
-        let o = [0, 1, 2].map(|k| (p[k] - 3.0 * VOXEL as f64 * d[k]) as i64);
-        let dir = d.map(|c| (c * f64::from(1 << 24)) as i32);
-        match rrt_core::check_voxelize::ray_hits(raster, o, dir, mode) {
-            Ok(_) => fired += 1,
-            Err(v) => panic!("{what}: ray through {p:?} missed: {v:?}"),
+    for &mode in modes {
+        for _ in 0..8 {
+            // A direction within 45° of the normal, either side.
+            let t = unit_axis(rng);
+            let side = if rng.chance(1, 2) { 1.0 } else { -1.0 };
+            let mut d = [0, 1, 2].map(|k| side * nrm[k] + 0.9 * t[k]);
+            let dn = dot(d, nrm);
+            let l = length(d);
+            if (dn / l).abs() < std::f64::consts::FRAC_1_SQRT_2 {
+                continue;
+            }
+            d = d.map(|c| c / l);
+            let o = [0, 1, 2].map(|k| (p[k] - 3.0 * VOXEL as f64 * d[k]) as i64);
+            let dir = d.map(|c| (c * f64::from(1 << 24)) as i32);
+            match rrt_core::check_voxelize::ray_hits(raster, o, dir, mode) {
+                Ok(_) => fired += 1,
+                Err(v) => panic!("{}: ray through {p:?} missed: {v:?}", what(mode)),
+            }
         }
     }
     fired
@@ -427,90 +445,61 @@ fn cross_open(
 
 #[test]
 fn open_triangles_are_hit_away_from_their_boundary() {
-    let mut rays = 0u64;
-    for seed in seeds(150) {
-        let mut rng = Rng::new(7000 + seed);
-        let n = 32u32;
-        let extent = Extent::cube(n).unwrap();
+    soak("open triangles", 150, 7000, 10_000, |seed, rng| {
+        let extent = Extent::cube(32).unwrap();
         let pt = |rng: &mut Rng| [0; 3].map(|_| rng.range(6 * VOXEL, 26 * VOXEL));
-        let vs = [pt(&mut rng), pt(&mut rng), pt(&mut rng)];
+        let vs = [pt(rng), pt(rng), pt(rng)];
         let f = vs.map(|v| v.map(|c| c as f64));
-        let e1 = [0, 1, 2].map(|k| f[1][k] - f[0][k]);
-        let e2 = [0, 1, 2].map(|k| f[2][k] - f[0][k]);
-        let c = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        let cl = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        let (e1, e2) = (sub(f[1], f[0]), sub(f[2], f[0]));
+        let c = triangle_normal(f);
+        let cl = length(c);
         if cl < 1.0 {
-            continue;
+            return 0;
         }
         let nrm = c.map(|x| x / cl);
         let t = Triangle {
             vertices: vs,
             normals: None,
         };
-        for sep in [Separation::Six, Separation::TwentySix] {
-            let v = Voxelized::new(extent, |sink| {
-                triangle::triangle(&t, sep, extent, sink).unwrap();
-            });
-            let flagged = v.flagged();
-            let r = Raster::new(extent, &flagged).unwrap();
-            let modes: &[Connectivity] = match sep {
-                Separation::Six => &[Connectivity::Six, Connectivity::Adaptive],
-                Separation::TwentySix => &[Connectivity::TwentySix],
+        // Points at least 1.25 voxels (> √3/2 / sin 45°) from every edge.
+        let sample = |rng: &mut Rng| {
+            let (a, b) = (
+                rng.range(0, 1000) as f64 / 1000.0,
+                rng.range(0, 1000) as f64 / 1000.0,
+            );
+            let (a, b) = if a + b > 1.0 {
+                (1.0 - a, 1.0 - b)
+            } else {
+                (a, b)
             };
-            for _ in 0..20 {
-                // A point at least 1.25 voxels (> √3/2 / sin 45°) from every edge.
-                let (a, b) = (
-                    rng.range(0, 1000) as f64 / 1000.0,
-                    rng.range(0, 1000) as f64 / 1000.0,
-                );
-                let (a, b) = if a + b > 1.0 {
-                    (1.0 - a, 1.0 - b)
-                } else {
-                    (a, b)
-                };
-                let p = [0, 1, 2].map(|k| f[0][k] + a * e1[k] + b * e2[k]);
-                let edge_dist = (0..3)
-                    .map(|i| {
-                        let (s, e) = (f[i], f[(i + 1) % 3]);
-                        let d = [0, 1, 2].map(|k| e[k] - s[k]);
-                        let w = [0, 1, 2].map(|k| p[k] - s[k]);
-                        let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                        let tt = ((w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / dd).clamp(0.0, 1.0);
-                        let q = [0, 1, 2].map(|k| w[k] - tt * d[k]);
-                        (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt()
-                    })
-                    .fold(f64::INFINITY, f64::min);
-                if edge_dist < 1.25 * VOXEL as f64 {
-                    continue;
-                }
-                for &mode in modes {
-                    rays += cross_open(
-                        &r,
-                        mode,
-                        p,
-                        nrm,
-                        &mut rng,
-                        &format!("seed {seed} {sep:?} {mode:?}: {t:?}"),
-                    );
-                }
+            let p = [0, 1, 2].map(|k| f[0][k] + a * e1[k] + b * e2[k]);
+            let edge_dist = (0..3)
+                .map(|i| {
+                    let (s, e) = (f[i], f[(i + 1) % 3]);
+                    let d = sub(e, s);
+                    let w = sub(p, s);
+                    let tt = (dot(w, d) / dot(d, d)).clamp(0.0, 1.0);
+                    length([0, 1, 2].map(|k| w[k] - tt * d[k]))
+                })
+                .fold(f64::INFINITY, f64::min);
+            if edge_dist < 1.25 * VOXEL as f64 {
+                return None;
             }
-        }
-    }
-    println!("open triangles: {rays} rays, all hit");
-    assert!(rays > 10_000);
+            Some((p, nrm))
+        };
+        let voxelize = |sep, sink: &mut PlaneSink<'_>| {
+            triangle::triangle(&t, sep, extent, sink).unwrap();
+        };
+        let what =
+            |sep: Separation, mode: Connectivity| format!("seed {seed} {sep:?} {mode:?}: {t:?}");
+        probe_open(extent, rng, voxelize, sample, &what)
+    });
 }
 
 #[test]
 fn patches_are_hit_away_from_their_boundary() {
-    let mut rays = 0u64;
-    for seed in seeds(40) {
-        let mut rng = Rng::new(8000 + seed);
-        let n = 32u32;
-        let extent = Extent::cube(n).unwrap();
+    soak("patches", 40, 8000, 3_000, |seed, rng| {
+        let extent = Extent::cube(32).unwrap();
         let mut control = [[[0i64; 3]; 4]; 4];
         for (i, row) in control.iter_mut().enumerate() {
             for (j, q) in row.iter_mut().enumerate() {
@@ -522,65 +511,24 @@ fn patches_are_hit_away_from_their_boundary() {
             }
         }
         let bp = BezierPatch { control };
-        let eval = |u: f64, v: f64| -> [f64; 3] {
-            let b = |t: f64| {
-                [
-                    (1.0 - t).powi(3),
-                    3.0 * t * (1.0 - t).powi(2),
-                    3.0 * t * t * (1.0 - t),
-                    t.powi(3),
-                ]
-            };
-            let (bu, bv) = (b(u), b(v));
-            let mut out = [0.0; 3];
-            for a in 0..4 {
-                for c in 0..4 {
-                    for k in 0..3 {
-                        out[k] += bu[a] * bv[c] * control[a][c][k] as f64;
-                    }
-                }
-            }
-            out
+        let eval = |u: f64, v: f64| bezier(&control, u, v);
+        let sample = |rng: &mut Rng| {
+            let (u, w) = (
+                rng.range(25, 75) as f64 / 100.0,
+                rng.range(25, 75) as f64 / 100.0,
+            );
+            let h = 1e-4;
+            let pu = sub(eval(u + h, w), eval(u - h, w));
+            let pv = sub(eval(u, w + h), eval(u, w - h));
+            let c = cross(pu, pv);
+            let cl = length(c);
+            Some((eval(u, w), c.map(|x| x / cl)))
         };
-        for sep in [Separation::Six, Separation::TwentySix] {
-            let v = Voxelized::new(extent, |sink| {
-                patch::surface(&bp, sep, extent, sink).unwrap();
-            });
-            let flagged = v.flagged();
-            let r = Raster::new(extent, &flagged).unwrap();
-            let modes: &[Connectivity] = match sep {
-                Separation::Six => &[Connectivity::Six, Connectivity::Adaptive],
-                Separation::TwentySix => &[Connectivity::TwentySix],
-            };
-            for _ in 0..20 {
-                let (u, w) = (
-                    rng.range(25, 75) as f64 / 100.0,
-                    rng.range(25, 75) as f64 / 100.0,
-                );
-                let p = eval(u, w);
-                let h = 1e-4;
-                let pu = [0, 1, 2].map(|k| eval(u + h, w)[k] - eval(u - h, w)[k]);
-                let pv = [0, 1, 2].map(|k| eval(u, w + h)[k] - eval(u, w - h)[k]);
-                let c = [
-                    pu[1] * pv[2] - pu[2] * pv[1],
-                    pu[2] * pv[0] - pu[0] * pv[2],
-                    pu[0] * pv[1] - pu[1] * pv[0],
-                ];
-                let cl = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-                let nrm = c.map(|x| x / cl);
-                for &mode in modes {
-                    rays += cross_open(
-                        &r,
-                        mode,
-                        p,
-                        nrm,
-                        &mut rng,
-                        &format!("seed {seed} {sep:?} {mode:?}: patch"),
-                    );
-                }
-            }
-        }
-    }
-    println!("patches: {rays} rays, all hit");
-    assert!(rays > 3_000);
+        let voxelize = |sep, sink: &mut PlaneSink<'_>| {
+            patch::surface(&bp, sep, extent, sink).unwrap();
+        };
+        let what =
+            |sep: Separation, mode: Connectivity| format!("seed {seed} {sep:?} {mode:?}: patch");
+        probe_open(extent, rng, voxelize, sample, &what)
+    });
 }

@@ -18,7 +18,8 @@ use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
 use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::{Point, Sphere, Triangle};
 use rrt_core::raster::{Extent, cell};
@@ -51,11 +52,39 @@ fn timed<T>(mut f: impl FnMut() -> T) -> (T, f64, f64) {
     (out, wall / f64::from(runs), cpu / f64::from(runs))
 }
 
+/// Registers `run` in `group` as `id`, at `offers` elements a run.
+fn bench_offers(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    id: String,
+    offers: u64,
+    mut run: impl FnMut() -> u64,
+) {
+    group.throughput(Throughput::Elements(offers));
+    group.bench_function(id, |b| b.iter(&mut run));
+}
+
 /// Counts offers and marks voxels opaque in a plane.
 struct CountingSink<'a> {
     extent: Extent,
     plane: &'a mut [u8],
     offers: u64,
+}
+
+impl CountingSink<'_> {
+    /// The offers `voxelize` makes into `plane` (of `extent`).
+    fn count(
+        extent: Extent,
+        plane: &mut [u8],
+        voxelize: impl FnOnce(&mut CountingSink<'_>),
+    ) -> u64 {
+        let mut sink = CountingSink {
+            extent,
+            plane,
+            offers: 0,
+        };
+        voxelize(&mut sink);
+        sink.offers
+    }
 }
 
 impl VoxelSink for CountingSink<'_> {
@@ -221,15 +250,11 @@ fn table2(c: &mut Criterion) {
         for count in [10usize, 100, 200, 400, 1000, 5000] {
             let spheres = random_spheres(count);
             let run = |plane: &mut [u8]| {
-                let mut sink = CountingSink {
-                    extent,
-                    plane,
-                    offers: 0,
-                };
-                for s in &spheres {
-                    sphere::surface(black_box(s), sep, extent, &mut sink).unwrap();
-                }
-                sink.offers
+                CountingSink::count(extent, plane, |sink| {
+                    for s in &spheres {
+                        sphere::surface(black_box(s), sep, extent, sink).unwrap();
+                    }
+                })
             };
             let _ = run(&mut plane); // warm up
             let (offers, wall, cpu) = timed(|| run(&mut plane));
@@ -239,8 +264,9 @@ fn table2(c: &mut Criterion) {
                 cpu * 1e3,
                 cpu * 1e9 / offers as f64
             );
-            group.throughput(Throughput::Elements(offers));
-            group.bench_function(format!("{sep:?}/{count}"), |b| b.iter(|| run(&mut plane)));
+            bench_offers(&mut group, format!("{sep:?}/{count}"), offers, || {
+                run(&mut plane)
+            });
         }
     }
     group.finish();
@@ -260,13 +286,9 @@ fn spd(c: &mut Criterion) {
             let scene = fit(&nff, n);
             let mut plane = vec![0u8; scene.extent.len()];
             let run = |plane: &mut [u8]| {
-                let mut sink = CountingSink {
-                    extent: scene.extent,
-                    plane,
-                    offers: 0,
-                };
-                scene.voxelize(Separation::TwentySix, &mut sink);
-                sink.offers
+                CountingSink::count(scene.extent, plane, |sink| {
+                    scene.voxelize(Separation::TwentySix, sink);
+                })
             };
             let (offers, wall, cpu) = timed(|| run(&mut plane));
             let opaque = plane.iter().filter(|c| **c & cell::OPAQUE != 0).count();
@@ -278,8 +300,9 @@ fn spd(c: &mut Criterion) {
                 cpu * 1e3,
                 cpu * 1e9 / offers as f64
             );
-            group.throughput(Throughput::Elements(offers));
-            group.bench_function(format!("{name}/{n}"), |b| b.iter(|| run(&mut plane)));
+            bench_offers(&mut group, format!("{name}/{n}"), offers, || {
+                run(&mut plane)
+            });
         }
     }
     group.finish();

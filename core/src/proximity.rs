@@ -35,10 +35,7 @@ use crate::raster::{LINE_CELLS, Raster, RasterMut, cell, check_line_count, to_us
 /// assert_eq!(r.cell([0, 2, 2]).unwrap() & cell::PROXIMITY, 0);
 /// ```
 pub fn flag_neighbourhood(raster: &mut RasterMut<'_>) {
-    let [nx, ny, _] = raster.extent().dims().map(to_usize);
-    // Both non-zero and their product fits (it divides the plane length);
-    // checked anyway so that no chunking below can be asked for size 0.
-    let Some(slice) = nx.checked_mul(ny).filter(|&s| s != 0 && nx != 0) else {
+    let Some(([nx, _, _], slice)) = layout(raster) else {
         return;
     };
     let plane = raster.plane_mut();
@@ -60,6 +57,17 @@ pub fn flag_neighbourhood(raster: &mut RasterMut<'_>) {
     }
     // Along z: whole slices.
     dilate_lines(plane, slice);
+}
+
+/// The raster's dimensions and the cells of one z-slice; `None` for a
+/// slice of no cells. Both dimensions are non-zero and their product fits
+/// (it divides the plane length); checked anyway so that no chunking can be
+/// asked for size 0.
+fn layout(raster: &RasterMut<'_>) -> Option<([usize; 3], usize)> {
+    let dims = raster.extent().dims().map(to_usize);
+    let [nx, ny, _] = dims;
+    let slice = nx.checked_mul(ny).filter(|&s| s != 0 && nx != 0)?;
+    Some((dims, slice))
 }
 
 /// Dilates the PROXIMITY bit by one unit along an axis whose consecutive
@@ -236,8 +244,7 @@ pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), Raste
 /// assert_ne!(r.cell([5, 3, 4]).unwrap() & cell::PROXIMITY, 0);
 /// ```
 pub fn distance_field(raster: &mut RasterMut<'_>) {
-    let [nx, ny, nz] = raster.extent().dims().map(to_usize);
-    let Some(slice) = nx.checked_mul(ny).filter(|&s| s != 0 && nx != 0) else {
+    let Some(([nx, ny, nz], slice)) = layout(raster) else {
         return;
     };
     let plane = raster.plane_mut();

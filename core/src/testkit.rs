@@ -12,6 +12,7 @@ use crate::geometry::{Sphere, Torus};
 use crate::raster::{Extent, RasterMut};
 use crate::store::{Counter, Limits, ObjectAttrs, directory_len};
 use crate::voxel::VoxelRecord;
+use crate::voxelize::error::VoxelizeError;
 use crate::voxelize::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 
 pub use crate::rng::Rng;
@@ -31,6 +32,64 @@ impl VoxelSink for Offers {
     }
 }
 
+/// A voxelizer's entry point, over the recording sink.
+pub type Voxelizer<T> = fn(&T, Separation, Extent, &mut Offers) -> Result<u64, VoxelizeError>;
+
+/// What `voxelize` makes of `shape` with `sep` in `extent`: its result and
+/// the offers.
+pub fn voxelized<T>(
+    voxelize: Voxelizer<T>,
+    shape: &T,
+    sep: Separation,
+    extent: Extent,
+) -> (Result<u64, VoxelizeError>, Offers) {
+    let mut offers = Offers::default();
+    let r = voxelize(shape, sep, extent, &mut offers);
+    (r, offers)
+}
+
+/// What `voxelize` makes of `shape` with `sep` in a 4³ raster.
+pub fn voxelized_in_4<T>(
+    voxelize: Voxelizer<T>,
+    shape: &T,
+    sep: Separation,
+) -> Result<u64, VoxelizeError> {
+    voxelized(voxelize, shape, sep, Extent::cube(4).unwrap()).0
+}
+
+/// `voxelize` refuses `shape` (6-separating, in a 4³ raster) with `want`.
+#[track_caller]
+pub fn assert_refused<T>(voxelize: Voxelizer<T>, shape: &T, want: VoxelizeError) {
+    assert_eq!(voxelized_in_4(voxelize, shape, Separation::Six), Err(want));
+}
+
+/// `offers` are the voxels of `e` that `contains` accepts, each offered
+/// once; `what` names the case.
+#[track_caller]
+pub fn assert_offers_are(
+    offers: &Offers,
+    e: Extent,
+    contains: impl Fn([u32; 3]) -> bool,
+    what: &str,
+) {
+    assert!(offers.0.values().all(|o| o.1 == 1), "{what}: offered twice");
+    let [nx, ny, nz] = e.dims();
+    let mut want = Vec::new();
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                if contains([x, y, z]) {
+                    want.push([x, y, z]);
+                }
+            }
+        }
+    }
+    for v in &want {
+        assert!(offers.0.contains_key(v), "{what}: missing {v:?}");
+    }
+    assert_eq!(offers.0.len(), want.len(), "{what}: extra voxels");
+}
+
 /// Sphere surface, through the real voxelizer.
 pub fn sphere(
     extent: Extent,
@@ -41,6 +100,11 @@ pub fn sphere(
 ) {
     let s = Sphere { centre, radius };
     crate::voxelize::sphere::surface(&s, sep, extent, sink).expect("test sphere");
+}
+
+/// [`sphere`], 6-separating, as a voxelizer for [`build`].
+pub fn ball(extent: Extent, centre: [i64; 3], radius: i64) -> impl Fn(&mut dyn VoxelSink) {
+    move |s| sphere(extent, centre, radius, Separation::Six, s)
 }
 
 /// Torus around the z axis, through the real voxelizer.
@@ -81,6 +145,27 @@ pub fn plate(
         v.reverse();
     }
     crate::voxelize::triangle::polygon(&v, sep, extent, sink).expect("test plate");
+}
+
+/// [`plate`] facing up (`+z`), 6-separating, over the voxels `span × span`
+/// at the mid-height of voxel layer `layer`, as a voxelizer for [`build`].
+pub fn level_plate(
+    extent: Extent,
+    layer: i64,
+    span: core::ops::Range<u32>,
+) -> impl Fn(&mut dyn VoxelSink) {
+    let z0 = layer * VOXEL + VOXEL / 2;
+    move |s| {
+        plate(
+            extent,
+            z0,
+            span.clone(),
+            span.clone(),
+            false,
+            Separation::Six,
+            s,
+        )
+    }
 }
 
 /// A built scene over owned storage.

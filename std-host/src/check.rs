@@ -17,6 +17,26 @@ use crate::scene::{ParseOptions, nff};
 
 pub use crate::scene::check_scene;
 
+/// What a reader of the file `name` made of fuzz input: `Some` of what it
+/// read, `None` when it refused the input with an error naming the file;
+/// an error that does not name it is a broken guarantee.
+fn read_or_refused<T, E: std::fmt::Display>(
+    name: &str,
+    read: Result<T, E>,
+) -> Result<Option<T>, String> {
+    match read {
+        Ok(v) => Ok(Some(v)),
+        Err(e) => {
+            let msg = e.to_string();
+            if msg.starts_with(name) {
+                Ok(None)
+            } else {
+                Err(format!("error without its file: {msg}"))
+            }
+        }
+    }
+}
+
 /// Feeds arbitrary bytes (as the file `fuzz.nff`) to the NFF parser, then
 /// to the camera and a 32-voxel raster fit, and checks: an error names the
 /// file; a parsed scene keeps the guarantees of
@@ -32,16 +52,9 @@ pub fn nff_input(data: &[u8]) -> Result<(), String> {
         max_vertices: 1 << 16,
         max_file_bytes: 1 << 20,
     };
-    let scene = match nff::parse_bytes("fuzz.nff", data, &opts) {
-        Ok(scene) => scene,
-        Err(e) => {
-            let msg = e.to_string();
-            return if msg.starts_with("fuzz.nff") {
-                Ok(())
-            } else {
-                Err(format!("error without its file: {msg}"))
-            };
-        }
+    let Some(scene) = read_or_refused("fuzz.nff", nff::parse_bytes("fuzz.nff", data, &opts))?
+    else {
+        return Ok(());
     };
     check_scene(&scene).map_err(|e| format!("parsed scene breaks a guarantee: {e}"))?;
     let [w, h] = scene.view.resolution;
@@ -119,16 +132,12 @@ pub const FUZZ_LIMITS: Limits = Limits {
 /// # Errors
 /// The first broken invariant.
 pub fn nrrd_input(data: &[u8]) -> Result<(), String> {
-    let v = match nrrd::parse_bytes("fuzz.nrrd", data, &FUZZ_LIMITS) {
-        Ok(v) => v,
-        Err(e) => {
-            let msg = e.to_string();
-            return if msg.starts_with("fuzz.nrrd") {
-                Ok(())
-            } else {
-                Err(format!("error without its file: {msg}"))
-            };
-        }
+    let Some(v) = read_or_refused(
+        "fuzz.nrrd",
+        nrrd::parse_bytes("fuzz.nrrd", data, &FUZZ_LIMITS),
+    )?
+    else {
+        return Ok(());
     };
     let dims = v.dims();
     let count = sample_count(dims);

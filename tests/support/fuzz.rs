@@ -13,14 +13,15 @@ use rrt_core::raster::{Extent, RasterMut, cell, line_count};
 
 use crate::oracle::{Case, check_exact};
 
-/// One fixed-point coordinate, biased towards the interesting ones.
+/// One fixed-point coordinate, biased towards the interesting ones (the
+/// discrete-ray and the packet fuzz cases').
 #[derive(Arbitrary, Debug, Clone, Copy)]
 pub enum Coord {
-    /// Any value (mostly out of the accepted range: must be refused).
+    /// Any value (mostly beyond `ORIGIN_LIMIT`: must be refused).
     Raw(i64),
     /// Near the box, in fixed units.
     Near(i32),
-    /// On a voxel boundary.
+    /// On a voxel boundary (faces, edges and corners).
     Lattice(i8),
     /// At a voxel centre.
     Centre(i8),
@@ -44,7 +45,7 @@ pub enum Component {
     Raw(i32),
     /// A small value (±1 of the last fractional bit and around).
     Small(i8),
-    /// Whole voxels.
+    /// Whole voxels (equal magnitudes give exact diagonals).
     Voxels(i8),
 }
 
@@ -56,6 +57,38 @@ impl Component {
             Self::Voxels(v) => i32::from(v) * (1 << 16),
         }
     }
+}
+
+/// The ray a fuzz case describes, with its origin and direction in fixed
+/// point: from `origin` along `dir`, or with `segment` the segment from
+/// `origin` to `origin + dir`.
+pub(crate) fn decode_ray(
+    extent: Extent,
+    origin: [Coord; 3],
+    dir: [Component; 3],
+    segment: bool,
+) -> ([i64; 3], [i32; 3], Result<Option<DiscreteRay>, RayError>) {
+    let origin = origin.map(Coord::fixed);
+    let dir = dir.map(Component::fixed);
+    let ray = if segment {
+        let to = [0, 1, 2].map(|k| origin[k].wrapping_add(i64::from(dir[k])));
+        DiscreteRay::segment(extent, origin, to)
+    } else {
+        DiscreteRay::new(extent, origin, dir)
+    };
+    (origin, dir, ray)
+}
+
+/// A plane of `len` cells: the OPAQUE and PROXIMITY bits of `cells`,
+/// repeated (empty for no cells).
+pub(crate) fn repeated_cells(cells: &[u8], len: usize) -> Vec<u8> {
+    (0..len)
+        .map(|i| {
+            cells
+                .get(i % cells.len().max(1))
+                .map_or(0, |b| b & (cell::OPAQUE | cell::PROXIMITY))
+        })
+        .collect()
 }
 
 /// A discrete ray through a small raster with random cells.
@@ -80,8 +113,7 @@ pub fn run_ray_case(case: &RayCase) {
     let Ok(extent) = Extent::new(dims[0], dims[1], dims[2]) else {
         unreachable!("dims in 1..=32")
     };
-    let origin = case.origin.map(Coord::fixed);
-    let dir = case.dir.map(Component::fixed);
+    let (origin, dir, set_up) = decode_ray(extent, case.origin, case.dir, case.segment);
     let c = Case {
         dims,
         origin,
@@ -89,24 +121,12 @@ pub fn run_ray_case(case: &RayCase) {
         segment: case.segment,
     };
     // Out-of-range inputs must be refused with the documented errors.
-    let set_up = if c.segment {
-        let to = [0, 1, 2].map(|k| origin[k].wrapping_add(i64::from(dir[k])));
-        DiscreteRay::segment(extent, origin, to)
-    } else {
-        DiscreteRay::new(extent, origin, dir)
-    };
     match set_up {
         Ok(_) => {}
         Err(RayError::OriginOutOfRange { .. } | RayError::SegmentTooLong { .. }) => return,
         Err(e) => panic!("setup failed for an accepted input: {e:?} {c:?}"),
     }
-    let mut plane: Vec<u8> = (0..extent.len())
-        .map(|i| {
-            case.cells
-                .get(i % case.cells.len().max(1))
-                .map_or(0, |b| b & (cell::OPAQUE | cell::PROXIMITY))
-        })
-        .collect();
+    let mut plane = repeated_cells(&case.cells, extent.len());
     check_exact(&c, Some(&plane), "fuzz");
     // With proper proximity flags, Adaptive must hit what Six hits.
     let mut raster = RasterMut::new(extent, &mut plane).expect("plane length");

@@ -3,14 +3,18 @@
 //! oracle for discrete rays ([`oracle`]), the fuzz case types ([`fuzz`],
 //! [`packet_case`], [`voxelize_case`]), tunnel-freedom probes
 //! ([`tunnel::assert_tunnel_free`]), closed test meshes ([`mesh`]), the
-//! location of the shared data folder, and the `rrt` command line run
-//! in-process.
+//! float vectors of the test-side geometry ([`vec3`]), one object through
+//! both builder passes ([`store::OneObject`]), the location of the shared
+//! data folder, small helpers (random planes, soak counts, PSNR, fresh
+//! folders), and the `rrt` command line run in-process.
 
 pub mod fuzz;
 pub mod mesh;
 pub mod oracle;
 pub mod packet_case;
+pub mod store;
 pub mod tunnel;
+pub mod vec3;
 pub mod voxelize_case;
 
 use std::path::PathBuf;
@@ -20,11 +24,78 @@ use std::path::PathBuf;
 /// printed with it.
 pub use rrt_core::rng::Rng;
 
+/// The number the environment variable `var` holds, if it is set to one
+/// (the case counts of the soak tests).
+#[must_use]
+pub fn env_count(var: &str) -> Option<u64> {
+    std::env::var(var).ok().and_then(|v| v.parse().ok())
+}
+
+/// The seed `RRT_SEED` names, if any: a failure a test replays first.
+#[must_use]
+pub fn replay_seed() -> Option<u64> {
+    env_count("RRT_SEED")
+}
+
+/// A plane of `len` cells, each opaque (and nothing else) with probability
+/// `num / den`.
+pub fn random_opaque(rng: &mut Rng, len: usize, num: u64, den: u64) -> Vec<u8> {
+    (0..len)
+        .map(|_| {
+            if rng.chance(num, den) {
+                rrt_core::raster::cell::OPAQUE
+            } else {
+                0
+            }
+        })
+        .collect()
+}
+
+/// The peak signal-to-noise ratio in dB of two 8-bit images (∞ for equal
+/// ones), over the pixels both have.
+#[must_use]
+pub fn psnr(a: &[u8], b: &[u8]) -> f64 {
+    let mse = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2))
+        .sum::<f64>()
+        / a.len() as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0f64 * 255.0 / mse).log10()
+    }
+}
+
+/// A fresh, empty temporary folder `<prefix>-<process id>-<test>`.
+///
+/// # Panics
+/// If it cannot be made.
+#[must_use]
+pub fn fresh_dir(prefix: &str, test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("{prefix}-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
 /// `../shared/data` beside the repository, if present.
 #[must_use]
 pub fn shared_data() -> Option<PathBuf> {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
     p.is_dir().then_some(p)
+}
+
+/// `../shared/data/spd` (the SPD scenes), or `None` with a skip message
+/// when the shared data is absent.
+#[must_use]
+pub fn shared_spd() -> Option<PathBuf> {
+    let Some(data) = shared_data() else {
+        eprintln!("skipped: ../shared/data not present");
+        return None;
+    };
+    Some(data.join("spd"))
 }
 
 /// Runs the `rrt` command line with `args` (without the program name):

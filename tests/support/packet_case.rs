@@ -7,55 +7,11 @@ use arbitrary::Arbitrary;
 use rrt_core::check_packet::{Walk, check_packet, check_packet_script};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::error::RayError;
-use rrt_core::fixed::VOXEL;
 use rrt_core::packet::{LANES, RayPacket8};
 use rrt_core::proximity::flag_neighbourhood;
-use rrt_core::raster::{Extent, Raster, RasterMut, cell};
+use rrt_core::raster::{Extent, Raster, RasterMut};
 
-/// One fixed-point coordinate, biased towards the interesting ones.
-#[derive(Arbitrary, Debug, Clone, Copy)]
-pub enum At {
-    /// Any value (beyond `ORIGIN_LIMIT` it must be refused).
-    Raw(i64),
-    /// Near the box, in fixed units.
-    Near(i32),
-    /// On a voxel boundary (faces, edges and corners).
-    Lattice(i8),
-    /// At a voxel centre.
-    Centre(i8),
-}
-
-impl At {
-    fn fixed(self) -> i64 {
-        match self {
-            Self::Raw(v) => v,
-            Self::Near(v) => i64::from(v),
-            Self::Lattice(v) => i64::from(v) * VOXEL,
-            Self::Centre(v) => i64::from(v) * VOXEL + VOXEL / 2,
-        }
-    }
-}
-
-/// One direction component.
-#[derive(Arbitrary, Debug, Clone, Copy)]
-pub enum Towards {
-    /// Any `i32`.
-    Raw(i32),
-    /// A few units of the last fractional bit (0 and ±1 included).
-    Small(i8),
-    /// Whole voxels (equal magnitudes give exact diagonals).
-    Voxels(i8),
-}
-
-impl Towards {
-    fn fixed(self) -> i32 {
-        match self {
-            Self::Raw(v) => v,
-            Self::Small(v) => i32::from(v),
-            Self::Voxels(v) => i32::from(v) * (1 << 16),
-        }
-    }
-}
+use crate::fuzz::{Component, Coord, decode_ray, repeated_cells};
 
 /// A walk: connectivity (mod 3), budget (255 = unlimited) and hit bits.
 #[derive(Arbitrary, Debug, Clone, Copy)]
@@ -87,9 +43,9 @@ impl WalkCase {
 #[derive(Arbitrary, Debug, Clone)]
 pub struct LaneCase {
     /// Origin (or segment start).
-    pub origin: [At; 3],
+    pub origin: [Coord; 3],
     /// Direction (or segment extent).
-    pub dir: [Towards; 3],
+    pub dir: [Component; 3],
     /// A segment rather than a half-line.
     pub segment: bool,
     /// A scalar walk taken before packing.
@@ -120,27 +76,14 @@ pub fn run_packet_case(case: &PacketCase) {
     let Ok(extent) = Extent::new(dims[0], dims[1], dims[2]) else {
         unreachable!("dims in 1..=16")
     };
-    let mut plane: Vec<u8> = (0..extent.len())
-        .map(|i| {
-            case.cells
-                .get(i % case.cells.len().max(1))
-                .map_or(0, |b| b & (cell::OPAQUE | cell::PROXIMITY))
-        })
-        .collect();
+    let mut plane = repeated_cells(&case.cells, extent.len());
     if case.flag {
         flag_neighbourhood(&mut RasterMut::new(extent, &mut plane).expect("plane length"));
     }
     let raster = Raster::new(extent, &plane).expect("plane length");
     let rays: [Option<DiscreteRay>; LANES] = std::array::from_fn(|lane| {
         let l = case.lanes[lane].as_ref()?;
-        let origin = l.origin.map(At::fixed);
-        let dir = l.dir.map(Towards::fixed);
-        let set_up = if l.segment {
-            let to = [0, 1, 2].map(|k| origin[k].wrapping_add(i64::from(dir[k])));
-            DiscreteRay::segment(extent, origin, to)
-        } else {
-            DiscreteRay::new(extent, origin, dir)
-        };
+        let (_, _, set_up) = decode_ray(extent, l.origin, l.dir, l.segment);
         let mut ray = match set_up {
             Ok(ray) => ray?,
             Err(RayError::OriginOutOfRange { .. } | RayError::SegmentTooLong { .. }) => {

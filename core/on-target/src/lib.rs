@@ -27,6 +27,52 @@ use rrt_core::raster::Raster;
 
 use crate::digest::{Digest, Line};
 
+/// A buffer of `$len` values `$init` that lives for the whole run, as a
+/// `&'static mut`: on a thumb target a static array of the firmware (one
+/// per expansion, taken with [`take!`]: evaluate each expansion once, from
+/// `main`), on the host a leaked vector.
+#[cfg(target_os = "none")]
+#[macro_export]
+macro_rules! buffer {
+    ($ty:ty = $init:expr; $len:expr) => {{
+        static mut BUFFER: [$ty; $len] = [$init; $len];
+        $crate::take!(BUFFER)
+    }};
+}
+
+/// A buffer of `$len` values `$init` that lives for the whole run, as a
+/// `&'static mut`: on a thumb target a static array of the firmware, on the
+/// host a leaked vector.
+#[cfg(not(target_os = "none"))]
+#[macro_export]
+macro_rules! buffer {
+    ($ty:ty = $init:expr; $len:expr) => {
+        ::std::vec::Vec::<$ty>::leak(::std::vec![$init; $len])
+    };
+}
+
+/// The scene's buffers, a [`scene::Storage`] of [`buffer!`]s (static
+/// arrays on a thumb target: evaluate it once, from `main`).
+#[macro_export]
+macro_rules! scene_storage {
+    () => {
+        $crate::scene::Storage {
+            plane: $crate::buffer!(u8 = 0; $crate::scene::PLANE_LEN),
+            lines: $crate::buffer!(u8 = 0; $crate::scene::LINES_LEN),
+            dir: $crate::buffer!(u32 = 0; $crate::scene::DIR_LEN),
+            records: $crate::buffer!(
+                ::rrt_core::voxel::VoxelRecord = $crate::scene::RECORD_INIT;
+                $crate::scene::MAX_RECORDS
+            ),
+            objects: $crate::buffer!(
+                ::rrt_core::object_table::Object = ::rrt_core::object_table::Object::UNUSED;
+                $crate::scene::MAX_OBJECTS
+            ),
+            patches: $crate::buffer!(::rrt_core::geometry::BezierPatch = $crate::scene::PATCH_INIT; 1),
+        }
+    };
+}
+
 /// The buffers of the whole suite (static arrays on the target).
 #[derive(Debug)]
 pub struct Buffers<'a> {

@@ -1,25 +1,25 @@
 //! SplitMix64: the seeded generator both sides draw their inputs from.
 
-/// A SplitMix64 generator (Steele, Lea & Flood 2014): 64-bit state, one
-/// multiply-xorshift finalizer per output, identical on every target.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Rng(u64);
+/// The core's SplitMix64 generator ([`rrt_core::rng::Rng`], Steele, Lea &
+/// Flood 2014: 64-bit state, one multiply-xorshift finalizer per output,
+/// identical on every target) with independent streams and the draws the
+/// ray set and the checks use.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Rng(rrt_core::rng::Rng);
 
 impl Rng {
     /// The generator for `seed`, stream `stream` (independent streams for
     /// item `i` of a set, so that items can be drawn in any order).
     #[must_use]
     pub const fn new(seed: u64, stream: u64) -> Self {
-        Self(seed ^ stream.wrapping_mul(0x9e37_79b9_7f4a_7c15).rotate_left(17))
+        Self(rrt_core::rng::Rng::new(
+            seed ^ stream.wrapping_mul(0x9e37_79b9_7f4a_7c15).rotate_left(17),
+        ))
     }
 
     /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// A value in `0..n` (`0` for `n == 0`), by the high bits of a 64×64

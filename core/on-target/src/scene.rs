@@ -53,16 +53,8 @@ pub const PATCH_INIT: BezierPatch = BezierPatch {
     control: [[[0; 3]; 4]; 4],
 };
 
-/// A filler value for the record storage.
-pub const RECORD_INIT: VoxelRecord = VoxelRecord {
-    object: 0,
-    normal: [0; 2],
-    color: [0; 3],
-    illum: [0; 3],
-    lights: 0,
-    material: 0,
-    key: 0,
-};
+/// A filler value for the record storage: the zero record.
+pub const RECORD_INIT: VoxelRecord = bytemuck::zeroed();
 
 /// The ray connectivity the scene is built and traced for.
 pub const MODE: Connectivity = Connectivity::Adaptive;
@@ -101,31 +93,23 @@ pub enum SceneError {
     Capacity,
 }
 
-impl From<RasterError> for SceneError {
-    fn from(e: RasterError) -> Self {
-        Self::Raster(e)
-    }
+/// `From` each error the scene's calls return, as its variant.
+macro_rules! from_errors {
+    ($($variant:ident($error:ty)),+) => {
+        $(impl From<$error> for SceneError {
+            fn from(e: $error) -> Self {
+                Self::$variant(e)
+            }
+        })+
+    };
 }
-impl From<BuildError> for SceneError {
-    fn from(e: BuildError) -> Self {
-        Self::Build(e)
-    }
-}
-impl From<StoreError> for SceneError {
-    fn from(e: StoreError) -> Self {
-        Self::Store(e)
-    }
-}
-impl From<LightError> for SceneError {
-    fn from(e: LightError) -> Self {
-        Self::Light(e)
-    }
-}
-impl From<RayError> for SceneError {
-    fn from(e: RayError) -> Self {
-        Self::Ray(e)
-    }
-}
+from_errors!(
+    Raster(RasterError),
+    Build(BuildError),
+    Store(StoreError),
+    Light(LightError),
+    Ray(RayError)
+);
 
 /// What building the scene did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -288,28 +272,14 @@ fn material(id: u32) -> u16 {
 
 /// The object table entries, in id order.
 fn push_objects(t: &mut ObjectTable<'_>) -> Result<(), SceneError> {
-    let cap = |_| SceneError::Capacity;
-    let obj = |shape| Object { shape, material: 0 };
-    t.push(Object {
-        material: 0,
-        ..obj(Shape::Cuboid(FLOOR))
-    })
-    .map_err(cap)?;
-    t.push(Object {
-        material: 1,
-        ..obj(Shape::Sphere(BALL))
-    })
-    .map_err(cap)?;
-    t.push(Object {
-        material: 2,
-        ..obj(Shape::Torus(RING))
-    })
-    .map_err(cap)?;
-    t.push(Object {
-        material: 3,
-        ..obj(Shape::Cone(CONE))
-    })
-    .map_err(cap)?;
+    for (shape, material) in [
+        (Shape::Cuboid(FLOOR), 0),
+        (Shape::Sphere(BALL), 1),
+        (Shape::Torus(RING), 2),
+        (Shape::Cone(CONE), 3),
+    ] {
+        push(t, shape, material)?;
+    }
     t.push_patch(canopy(), 4)
         .map_err(|_| SceneError::Capacity)?;
     for f in PYRAMID_FACES {
@@ -317,28 +287,22 @@ fn push_objects(t: &mut ObjectTable<'_>) -> Result<(), SceneError> {
             vertices: f.map(|k| PYRAMID[k]),
             normals: None,
         };
-        t.push(Object {
-            material: 5,
-            ..obj(Shape::Triangle(tri))
-        })
-        .map_err(cap)?;
+        push(t, Shape::Triangle(tri), 5)?;
     }
     let lo = BLOB_OFFSET.map(|o| o * VOXEL);
     let bounds = Cuboid {
         min: lo,
         max: core::array::from_fn(|k| lo[k] + i64::from(BLOB_DIMS[k]) * VOXEL),
     };
-    t.push(Object {
-        material: 6,
-        ..obj(Shape::Volume(VolumeRef { volume: 0, bounds }))
-    })
-    .map_err(cap)?;
-    t.push(Object {
-        material: 7,
-        ..obj(Shape::Voxels)
-    })
-    .map_err(cap)?;
-    Ok(())
+    push(t, Shape::Volume(VolumeRef { volume: 0, bounds }), 6)?;
+    push(t, Shape::Voxels, 7)
+}
+
+/// One object table entry.
+fn push(t: &mut ObjectTable<'_>, shape: Shape, material: u16) -> Result<(), SceneError> {
+    t.push(Object { shape, material })
+        .map(|_| ())
+        .map_err(|_| SceneError::Capacity)
 }
 
 fn materials() -> Result<Materials<8>, SceneError> {

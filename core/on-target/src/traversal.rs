@@ -2,7 +2,7 @@
 //! static buffer, scalar and packet, in all three connectivities.
 
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, Face, Hit, WalkEnd};
-use rrt_core::error::RasterError;
+use rrt_core::error::{RasterError, RayError};
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::geometry::{Cuboid, Sphere};
 use rrt_core::packet::{LANES, RayPacket8};
@@ -258,57 +258,46 @@ pub fn voxels(d: &mut Digest, raster: &Raster<'_>, r: DiscreteRay, mode: Connect
 
 /// Ray `r`'s hits in `mode`, resumed after each, with the whole state
 /// after each and at the end, into `d`.
-pub fn hits(
-    d: &mut Digest,
-    raster: &Raster<'_>,
-    mut r: DiscreteRay,
-    mode: Connectivity,
-    skip: bool,
-) {
-    for _ in 0..walk_limit(&r) {
+pub fn hits(d: &mut Digest, raster: &Raster<'_>, r: DiscreteRay, mode: Connectivity, skip: bool) {
+    resumed(d, r, |d, r| {
         let h = if skip {
-            r.first_hit_skipping(raster, mode)
+            r.first_hit_skipping(raster, mode)?
         } else {
-            r.first_hit(raster, mode)
+            r.first_hit(raster, mode)?
         };
-        match h {
-            Ok(Some(h)) => {
-                d.item();
-                hit(d, &h);
-                state(d, &r, mode);
-            }
-            Ok(None) => {
-                state(d, &r, mode);
-                return;
-            }
-            Err(e) => {
-                d.debug(&e);
-                return;
-            }
+        if let Some(h) = h {
+            d.item();
+            hit(d, &h);
         }
-    }
-    d.word(u64::MAX);
+        state(d, r, mode);
+        Ok(h.is_none())
+    });
 }
 
 /// Ray `r`'s budgeted walks with [`walk_test`] until it exits: each
 /// outcome, the current voxel and the whole state, into `d`.
-pub fn walks(
+pub fn walks(d: &mut Digest, raster: &Raster<'_>, r: DiscreteRay, mode: Connectivity, budget: u32) {
+    resumed(d, r, |d, r| {
+        let e = r.walk(raster, mode, budget, walk_test)?;
+        d.item();
+        d.word(end_word(e));
+        state(d, r, mode);
+        Ok(e == WalkEnd::Exit)
+    });
+}
+
+/// Ray `r` resumed up to [`walk_limit`] times by `step`, which records its
+/// outcome into `d` and says whether the ray is done; an error ends the
+/// record with the error, running out of the limit with `u64::MAX`.
+fn resumed(
     d: &mut Digest,
-    raster: &Raster<'_>,
     mut r: DiscreteRay,
-    mode: Connectivity,
-    budget: u32,
+    mut step: impl FnMut(&mut Digest, &mut DiscreteRay) -> Result<bool, RayError>,
 ) {
     for _ in 0..walk_limit(&r) {
-        match r.walk(raster, mode, budget, walk_test) {
-            Ok(e) => {
-                d.item();
-                d.word(end_word(e));
-                state(d, &r, mode);
-                if e == WalkEnd::Exit {
-                    return;
-                }
-            }
+        match step(d, &mut r) {
+            Ok(false) => {}
+            Ok(true) => return,
             Err(e) => {
                 d.debug(&e);
                 return;
@@ -406,83 +395,75 @@ fn packet_limit(p: &RayPacket8) -> u32 {
 }
 
 /// Per lane, the record [`hits`] makes for its ray.
-fn packet_hits(raster: &Raster<'_>, mut p: RayPacket8, mode: Connectivity) -> [Digest; LANES] {
-    let mut d = [Digest::new(); LANES];
-    let mut pending = p.lanes();
-    for _ in 0..packet_limit(&p) {
-        match p.first_hit(raster, mode) {
-            Ok(mask) => {
-                for (l, dl) in d.iter_mut().enumerate() {
-                    if mask & (1 << l) != 0 {
-                        if let (Some(h), Some(r)) = (p.hit(l), p.lane_ray(l)) {
-                            dl.item();
-                            hit(dl, &h);
-                            state(dl, &r, mode);
-                        }
-                    } else if pending & (1 << l) != 0 {
-                        // This lane exited.
-                        if let Some(r) = p.lane_ray(l) {
-                            state(dl, &r, mode);
-                        }
-                        pending &= !(1 << l);
-                    }
+fn packet_hits(raster: &Raster<'_>, p: RayPacket8, mode: Connectivity) -> [Digest; LANES] {
+    packet_resumed(p, |p, d, pending| {
+        let mask = p.first_hit(raster, mode)?;
+        for (l, dl) in d.iter_mut().enumerate() {
+            if mask & (1 << l) != 0 {
+                if let (Some(h), Some(r)) = (p.hit(l), p.lane_ray(l)) {
+                    dl.item();
+                    hit(dl, &h);
+                    state(dl, &r, mode);
                 }
-                if pending == 0 {
-                    return d;
+            } else if *pending & (1 << l) != 0 {
+                // This lane exited.
+                if let Some(r) = p.lane_ray(l) {
+                    state(dl, &r, mode);
                 }
-            }
-            Err(e) => {
-                for dl in &mut d {
-                    dl.debug(&e);
-                }
-                return d;
+                *pending &= !(1 << l);
             }
         }
-    }
-    for (l, dl) in d.iter_mut().enumerate() {
-        if pending & (1 << l) != 0 {
-            dl.word(u64::MAX);
-        }
-    }
-    d
+        Ok(())
+    })
 }
 
 /// Per lane, the record [`walks`] makes for its ray.
 fn packet_walks(
     raster: &Raster<'_>,
-    mut p: RayPacket8,
+    p: RayPacket8,
     mode: Connectivity,
     budget: u32,
+) -> [Digest; LANES] {
+    packet_resumed(p, |p, d, live| {
+        let end = p.walk(raster, mode, budget, |_, i, c| walk_test(i, c))?;
+        for (l, dl) in d.iter_mut().enumerate() {
+            if *live & (1 << l) == 0 {
+                continue;
+            }
+            let (Some(e), Some(r)) = (end.lane(l), p.lane_ray(l)) else {
+                continue;
+            };
+            dl.item();
+            dl.word(end_word(e));
+            state(dl, &r, mode);
+            if e == WalkEnd::Exit {
+                *live &= !(1 << l);
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Per lane, the record of packet `p` resumed up to [`packet_limit`]
+/// times by `step`, which records the outcome of the lanes still live (a
+/// mask it clears lanes from as they finish); an error ends every lane's
+/// record with the error, running out of the limit the records of the
+/// lanes still live with `u64::MAX`.
+fn packet_resumed(
+    mut p: RayPacket8,
+    mut step: impl FnMut(&mut RayPacket8, &mut [Digest; LANES], &mut u8) -> Result<(), RayError>,
 ) -> [Digest; LANES] {
     let mut d = [Digest::new(); LANES];
     let mut live = p.lanes();
     for _ in 0..packet_limit(&p) {
-        match p.walk(raster, mode, budget, |_, i, c| walk_test(i, c)) {
-            Ok(end) => {
-                for (l, dl) in d.iter_mut().enumerate() {
-                    if live & (1 << l) == 0 {
-                        continue;
-                    }
-                    let (Some(e), Some(r)) = (end.lane(l), p.lane_ray(l)) else {
-                        continue;
-                    };
-                    dl.item();
-                    dl.word(end_word(e));
-                    state(dl, &r, mode);
-                    if e == WalkEnd::Exit {
-                        live &= !(1 << l);
-                    }
-                }
-                if live == 0 {
-                    return d;
-                }
+        if let Err(e) = step(&mut p, &mut d, &mut live) {
+            for dl in &mut d {
+                dl.debug(&e);
             }
-            Err(e) => {
-                for dl in &mut d {
-                    dl.debug(&e);
-                }
-                return d;
-            }
+            return d;
+        }
+        if live == 0 {
+            return d;
         }
     }
     for (l, dl) in d.iter_mut().enumerate() {

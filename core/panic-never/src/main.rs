@@ -12,7 +12,6 @@
 #![no_main]
 
 use core::panic::PanicInfo;
-use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use rrt_core::packet::RayPacket8;
@@ -30,42 +29,9 @@ fn panic(_: &PanicInfo<'_>) -> ! {
     unsafe { rrt_core_reachable_panic() }
 }
 
-/// Opaque inputs: the optimizer must assume any bytes here.
-static mut INPUT: [u8; 256] = [0; 256];
-/// The raster plane.
-static mut PLANE: [u8; 16384] = [0; 16384];
-/// Results, so nothing is optimized away.
-static mut SINK: u64 = 0;
-
-fn input<const N: usize>(at: usize) -> [u8; N] {
-    let mut out = [0u8; N];
-    for (i, b) in out.iter_mut().enumerate() {
-        // SAFETY: in-bounds volatile reads of a static byte array.
-        *b = unsafe { read_volatile(addr_of!(INPUT).cast::<u8>().add((at + i) % 256)) };
-    }
-    out
-}
-fn u32_at(at: usize) -> u32 {
-    u32::from_le_bytes(input(at))
-}
-fn i32_at(at: usize) -> i32 {
-    i32::from_le_bytes(input(at))
-}
-fn i64_at(at: usize) -> i64 {
-    i64::from_le_bytes(input(at))
-}
-fn sink(v: u64) {
-    // SAFETY: a volatile write to a static.
-    unsafe { write_volatile(addr_of_mut!(SINK), read_volatile(addr_of!(SINK)) ^ v) };
-}
-
-fn mode(b: u8) -> Connectivity {
-    match b % 3 {
-        0 => Connectivity::Six,
-        1 => Connectivity::TwentySix,
-        _ => Connectivity::Adaptive,
-    }
-}
+// The flash-size firmwares' opaque inputs, sink, plane and mode input.
+include!("../../on-target/src/bin/size/input.rs");
+include!("../../on-target/src/bin/size/plane.rs");
 
 fn drive() {
     let Ok(extent) = Extent::new(u32_at(0), u32_at(4), u32_at(8)) else {
@@ -88,9 +54,9 @@ fn drive() {
     // SAFETY: as above.
     let plane: &[u8] = unsafe { &*addr_of!(PLANE) };
     let raster = Raster::new(extent, &plane[..len]);
-    let origin = [i64_at(32), i64_at(40), i64_at(48)];
+    let origin = point_at(32);
     let dir = [i32_at(56), i32_at(60), i32_at(64)];
-    let end = [i64_at(68), i64_at(76), i64_at(84)];
+    let end = point_at(68);
     let m = mode(input::<1>(92)[0]);
     let budget = u32_at(96);
     let rays = [

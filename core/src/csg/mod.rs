@@ -293,20 +293,8 @@ impl Solid for Cone {
         if self.base_radius == 0 && self.apex_radius == 0 {
             return None;
         }
-        let lo: Point = core::array::from_fn(|k| {
-            self.base
-                .get(k)
-                .copied()
-                .unwrap_or(0)
-                .min(self.apex.get(k).copied().unwrap_or(0))
-        });
-        let hi: Point = core::array::from_fn(|k| {
-            self.base
-                .get(k)
-                .copied()
-                .unwrap_or(0)
-                .max(self.apex.get(k).copied().unwrap_or(0))
-        });
+        let lo = per_axis(self.base, self.apex, i64::min);
+        let hi = per_axis(self.base, self.apex, i64::max);
         Some(widen(lo, hi, self.base_radius.max(self.apex_radius)))
     }
 }
@@ -539,36 +527,23 @@ impl<'a> CsgTree<'a> {
     }
 }
 
+/// `f` of `a` and `b` on each axis.
+fn per_axis(a: Point, b: Point, f: fn(i64, i64) -> i64) -> Point {
+    core::array::from_fn(|k| {
+        f(
+            a.get(k).copied().unwrap_or(0),
+            b.get(k).copied().unwrap_or(0),
+        )
+    })
+}
+
 fn hull(p: (Point, Point), q: (Point, Point)) -> (Point, Point) {
-    (
-        core::array::from_fn(|k| {
-            p.0.get(k)
-                .copied()
-                .unwrap_or(0)
-                .min(q.0.get(k).copied().unwrap_or(0))
-        }),
-        core::array::from_fn(|k| {
-            p.1.get(k)
-                .copied()
-                .unwrap_or(0)
-                .max(q.1.get(k).copied().unwrap_or(0))
-        }),
-    )
+    (per_axis(p.0, q.0, i64::min), per_axis(p.1, q.1, i64::max))
 }
 
 fn overlap(p: (Point, Point), q: (Point, Point)) -> Option<(Point, Point)> {
-    let lo: Point = core::array::from_fn(|k| {
-        p.0.get(k)
-            .copied()
-            .unwrap_or(0)
-            .max(q.0.get(k).copied().unwrap_or(0))
-    });
-    let hi: Point = core::array::from_fn(|k| {
-        p.1.get(k)
-            .copied()
-            .unwrap_or(0)
-            .min(q.1.get(k).copied().unwrap_or(0))
-    });
+    let lo = per_axis(p.0, q.0, i64::max);
+    let hi = per_axis(p.1, q.1, i64::min);
     lo.iter()
         .zip(hi.iter())
         .all(|(a, b)| a <= b)

@@ -26,18 +26,33 @@ impl CsgSink for Collect {
     }
 }
 
-fn ball() -> Sphere {
-    Sphere {
-        centre: [32 * V + V / 2; 3],
-        radius: 20 * V,
-    }
+const BALL: Sphere = Sphere {
+    centre: [32 * V + V / 2; 3],
+    radius: 20 * V,
+};
+
+const CUTTER: Cuboid = Cuboid {
+    min: [40 * V, 0, 0],
+    max: [80 * V; 3],
+};
+
+/// The tree of the paper's cut: leaf 0 minus leaf 1.
+const CUT: [CsgNode; 3] = [
+    CsgNode::Leaf(0),
+    CsgNode::Leaf(1),
+    CsgNode::Difference(0, 1),
+];
+
+/// The paper's cut as a tree: [`BALL`] minus [`CUTTER`].
+fn cut() -> CsgTree<'static> {
+    CsgTree::new(&CUT, &[&BALL, &CUTTER]).unwrap()
 }
 
-fn cutter() -> Cuboid {
-    Cuboid {
-        min: [40 * V, 0, 0],
-        max: [80 * V; 3],
-    }
+/// Every voxel `tree` offers in `e`, and the report.
+fn collect(tree: &CsgTree<'_>, e: Extent) -> (CsgReport, Collect) {
+    let mut got = Collect::default();
+    let rep = voxelize(tree, e, &mut got);
+    (rep, got)
 }
 
 /// The paper's cut: a sphere minus a box. Cut-face voxels carry the box's
@@ -45,16 +60,9 @@ fn cutter() -> Cuboid {
 #[test]
 fn sphere_minus_box_normals() {
     let e = Extent::cube(64).unwrap();
-    let (s, b) = (ball(), cutter());
-    let leaves: [&dyn Solid; 2] = [&s, &b];
-    let nodes = [
-        CsgNode::Leaf(0),
-        CsgNode::Leaf(1),
-        CsgNode::Difference(0, 1),
-    ];
-    let tree = CsgTree::new(&nodes, &leaves).unwrap();
-    let mut got = Collect::default();
-    let rep = voxelize(&tree, e, &mut got);
+    let (s, b) = (BALL, CUTTER);
+    let tree = cut();
+    let (rep, got) = collect(&tree, e);
     assert_eq!(rep.voxels as usize, got.0.len());
     let (mut cut, mut round) = (0, 0);
     for (v, (leaf, sf)) in &got.0 {
@@ -99,14 +107,7 @@ fn sphere_minus_box_normals() {
 #[test]
 fn rays_from_outside_hit_the_cut() {
     let e = Extent::cube(64).unwrap();
-    let (s, b) = (ball(), cutter());
-    let leaves: [&dyn Solid; 2] = [&s, &b];
-    let nodes = [
-        CsgNode::Leaf(0),
-        CsgNode::Leaf(1),
-        CsgNode::Difference(0, 1),
-    ];
-    let tree = CsgTree::new(&nodes, &leaves).unwrap();
+    let tree = cut();
 
     let mut plane = vec![0u8; e.len()];
     let mut dir = vec![0u32; directory_len(e).unwrap()];
@@ -273,8 +274,8 @@ fn boundary_layer_matches_brute_force_on_random_trees() {
 #[test]
 fn solid_distances_are_lipschitz() {
     let solids: [&dyn Solid; 4] = [
-        &ball(),
-        &cutter(),
+        &BALL,
+        &CUTTER,
         &Torus {
             centre: [10 * V; 3],
             axis: normalize([1, 2, 3]).unwrap(),
@@ -316,7 +317,7 @@ fn solid_normals_point_out() {
     assert_eq!((s.distance, s.normal), (V, [0, 0, -NORMAL_ONE]));
     let s = cone.sample([V, 0, 9 * V]).unwrap();
     assert_eq!((s.distance, s.normal), (-V, [0, 0, NORMAL_ONE]));
-    let bx = cutter();
+    let bx = CUTTER;
     let s = bx.sample([41 * V, 50 * V, 50 * V]).unwrap();
     assert_eq!((s.distance, s.normal), (-V, [-NORMAL_ONE, 0, 0]));
     let s = bx.sample([38 * V, 50 * V, 50 * V]).unwrap();
@@ -325,7 +326,7 @@ fn solid_normals_point_out() {
 
 #[test]
 fn bad_trees_and_degenerate_solids_are_refused() {
-    let s = ball();
+    let s = BALL;
     let zero = Sphere {
         centre: [0; 3],
         radius: 0,
@@ -375,8 +376,7 @@ fn bad_trees_and_degenerate_solids_are_refused() {
         CsgNode::Intersection(0, 1),
     ];
     let t = CsgTree::new(&nodes, &leaves2).unwrap();
-    let mut got = Collect::default();
-    let rep = voxelize(&t, Extent::cube(64).unwrap(), &mut got);
+    let (rep, mut got) = collect(&t, Extent::cube(64).unwrap());
     assert_eq!(rep.voxels, 0);
     // A solid wholly outside the raster: clipped to nothing.
     let t = CsgTree::new(&nodes[1..2], &leaves2).unwrap();
@@ -391,8 +391,7 @@ fn bad_trees_and_degenerate_solids_are_refused() {
     };
     let leaves3: [&dyn Solid; 1] = [&edge];
     let t = CsgTree::new(&[CsgNode::Leaf(0)], &leaves3).unwrap();
-    let mut got = Collect::default();
-    let rep = voxelize(&t, Extent::cube(64).unwrap(), &mut got);
+    let (rep, got) = collect(&t, Extent::cube(64).unwrap());
     assert!(rep.voxels > 100);
     assert!(got.0.keys().all(|v| v.iter().all(|c| *c < 12)));
 }

@@ -13,6 +13,14 @@ fn centre(v: [u32; 3]) -> [i64; 3] {
     v.map(voxel_centre)
 }
 
+/// Zero cells, enough for every empty raster of these tests.
+static EMPTY: [u8; 4096] = [0; 4096];
+
+/// The empty raster of extent `e` (at most 4096 voxels).
+fn empty(e: Extent) -> Raster<'static> {
+    Raster::new(e, &EMPTY[..e.len()]).unwrap()
+}
+
 #[track_caller]
 fn path(raster: &Raster<'_>, ray: DiscreteRay, mode: Connectivity) -> Vec<[u32; 3]> {
     ray.voxels(raster, mode)
@@ -24,8 +32,7 @@ fn path(raster: &Raster<'_>, ray: DiscreteRay, mode: Connectivity) -> Vec<[u32; 
 #[test]
 fn axis_parallel_rays_visit_one_row() {
     let e = Extent::new(5, 4, 3).unwrap();
-    let plane = vec![0u8; e.len()];
-    let r = Raster::new(e, &plane).unwrap();
+    let r = empty(e);
     for (dir, want) in [
         (
             [1, 0, 0],
@@ -53,8 +60,7 @@ fn axis_parallel_rays_visit_one_row() {
 fn diagonal_through_corners_uses_the_tie_rule() {
     // Exactly through voxel corners: x steps before y before z.
     let e = Extent::cube(3).unwrap();
-    let plane = vec![0u8; e.len()];
-    let r = Raster::new(e, &plane).unwrap();
+    let r = empty(e);
     let ray = DiscreteRay::new(e, [0, 0, 0], [1, 1, 1]).unwrap().unwrap();
     assert_eq!(ray.entry_face(), Some(Face::ZMin));
     assert_eq!(
@@ -81,8 +87,7 @@ fn diagonal_through_corners_uses_the_tie_rule() {
 #[test]
 fn twenty_six_takes_the_first_six_voxel_of_each_slice_away_from_ties() {
     let e = Extent::cube(16).unwrap();
-    let plane = vec![0u8; e.len()];
-    let r = Raster::new(e, &plane).unwrap();
+    let r = empty(e);
     let ray = DiscreteRay::segment(
         e,
         [VOXEL / 3, 5 * VOXEL / 7, 2 * VOXEL + 11],
@@ -105,8 +110,7 @@ fn twenty_six_takes_the_first_six_voxel_of_each_slice_away_from_ties() {
 #[test]
 fn lattice_endpoints_give_the_papers_counts() {
     let e = Extent::new(20, 17, 9).unwrap();
-    let plane = vec![0u8; e.len()];
-    let r = Raster::new(e, &plane).unwrap();
+    let r = empty(e);
     for (a, b) in [
         ([0, 0, 0], [19, 16, 8]),
         ([3, 4, 5], [3, 4, 5]),
@@ -120,8 +124,7 @@ fn lattice_endpoints_give_the_papers_counts() {
 #[test]
 fn zero_direction_visits_its_origin_voxel_only() {
     let e = Extent::cube(4).unwrap();
-    let plane = vec![0u8; e.len()];
-    let r = Raster::new(e, &plane).unwrap();
+    let r = empty(e);
     let ray = DiscreteRay::new(e, centre([1, 2, 3]), [0, 0, 0])
         .unwrap()
         .unwrap();

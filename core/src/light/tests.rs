@@ -12,6 +12,16 @@ use crate::store::{Limits, ObjectAttrs, RecordStore, RecordStoreMut};
 use crate::testkit::{self, Scene};
 use crate::voxelize::{Separation, VoxelSink};
 
+/// An object-table entry of material 0 that no shadow ray can meet (a
+/// degenerate triangle): for objects whose own surface does not matter.
+const NOWHERE: Object = Object {
+    shape: Shape::Triangle(Triangle {
+        vertices: [[0; 3]; 3],
+        normals: None,
+    }),
+    material: 0,
+};
+
 fn vox(v: [i64; 3]) -> [i64; 3] {
     v.map(|c| c * VOXEL)
 }
@@ -242,39 +252,9 @@ fn a_small_sphere_shadows_a_big_one() {
 fn an_opaque_blocker_behind_a_translucent_one_occludes() {
     let e = Extent::cube(64).unwrap();
     let light = vox([32, 32, 1000]);
-    let floor = |s: &mut dyn VoxelSink| {
-        testkit::plate(
-            e,
-            10 * VOXEL + VOXEL / 2,
-            20..44,
-            20..44,
-            false,
-            Separation::Six,
-            s,
-        )
-    };
-    let glass = |s: &mut dyn VoxelSink| {
-        testkit::plate(
-            e,
-            30 * VOXEL + VOXEL / 2,
-            28..36,
-            28..36,
-            false,
-            Separation::Six,
-            s,
-        )
-    };
-    let lid = |s: &mut dyn VoxelSink| {
-        testkit::plate(
-            e,
-            40 * VOXEL + VOXEL / 2,
-            30..34,
-            30..34,
-            false,
-            Separation::Six,
-            s,
-        )
-    };
+    let floor = testkit::level_plate(e, 10, 20..44);
+    let glass = testkit::level_plate(e, 30, 28..36);
+    let lid = testkit::level_plate(e, 40, 30..34);
     let mut scene = testkit::build(
         e,
         &[
@@ -284,13 +264,7 @@ fn an_opaque_blocker_behind_a_translucent_one_occludes() {
         ],
         LIM,
     );
-    let tri = Object {
-        shape: Shape::Triangle(Triangle {
-            vertices: [[0; 3]; 3],
-            normals: None,
-        }),
-        material: 0,
-    };
+    let tri = NOWHERE;
     let mut w = World::new(&[light]);
     w.objects.extend([tri, Object { material: 1, ..tri }, tri]);
     w.run(&mut scene);
@@ -306,17 +280,7 @@ fn open_surfaces_lit_from_behind_see_the_light_from_their_back() {
     let e = Extent::cube(32).unwrap();
     // A plate facing up, the light below it, another plate in between for
     // half of it.
-    let top = |s: &mut dyn VoxelSink| {
-        testkit::plate(
-            e,
-            20 * VOXEL + VOXEL / 2,
-            4..28,
-            4..28,
-            false,
-            Separation::Six,
-            s,
-        )
-    };
+    let top = testkit::level_plate(e, 20, 4..28);
     let mid = |s: &mut dyn VoxelSink| {
         testkit::plate(
             e,
@@ -329,13 +293,7 @@ fn open_surfaces_lit_from_behind_see_the_light_from_their_back() {
         )
     };
     let mut scene = testkit::build(e, &[(attrs(0, 0), &top), (attrs(1, 0), &mid)], LIM);
-    let tri = Object {
-        shape: Shape::Triangle(Triangle {
-            vertices: [[0; 3]; 3],
-            normals: None,
-        }),
-        material: 0,
-    };
+    let tri = NOWHERE;
     let mut w = World::new(&[vox([16, 16, -2000])]);
     w.objects.extend([tri, tri]);
     let rep = w.run(&mut scene);
@@ -374,13 +332,7 @@ fn adjacent_pieces_of_one_surface_do_not_shadow_each_other() {
         testkit::plate(e, z, 48..96, 0..32, false, Separation::TwentySix, s)
     };
     let mut scene = testkit::build(e, &[(attrs(0, 0), &a), (attrs(1, 0), &b)], LIM);
-    let tri = Object {
-        shape: Shape::Triangle(Triangle {
-            vertices: [[0; 3]; 3],
-            normals: None,
-        }),
-        material: 0,
-    };
+    let tri = NOWHERE;
     // tan 4° ≈ 0.07: 100 000 voxels away, 7 000 up.
     let mut w = World::new(&[vox([-100_000, 16, 7_000])]);
     w.objects.extend([tri, tri]);
@@ -392,34 +344,10 @@ fn adjacent_pieces_of_one_surface_do_not_shadow_each_other() {
 #[test]
 fn a_sphere_on_a_floor_casts_a_contact_shadow() {
     let e = Extent::cube(64).unwrap();
-    let floor = |s: &mut dyn VoxelSink| {
-        testkit::plate(
-            e,
-            10 * VOXEL + VOXEL / 2,
-            0..64,
-            0..64,
-            false,
-            Separation::Six,
-            s,
-        )
-    };
-    let ball = |s: &mut dyn VoxelSink| {
-        testkit::sphere(
-            e,
-            vox([32, 32, 20]).map(|c| c + VOXEL / 2),
-            10 * VOXEL,
-            Separation::Six,
-            s,
-        )
-    };
+    let floor = testkit::level_plate(e, 10, 0..64);
+    let ball = testkit::ball(e, vox([32, 32, 20]).map(|c| c + VOXEL / 2), 10 * VOXEL);
     let mut scene = testkit::build(e, &[(attrs(0, 0), &floor), (attrs(1, 0), &ball)], LIM);
-    let tri = Object {
-        shape: Shape::Triangle(Triangle {
-            vertices: [[0; 3]; 3],
-            normals: None,
-        }),
-        material: 0,
-    };
+    let tri = NOWHERE;
     let mut w = World::new(&[vox([32, 32, 5000])]);
     w.objects.extend([tri, sphere_obj([32, 32, 20], 10)]);
     w.run(&mut scene);
@@ -481,12 +409,18 @@ fn a_torus_shadows_itself() {
     assert_eq!(outer_near.light(0), LightVisibility::Visible);
 }
 
+/// A 16³ raster holding a ball of radius 4 voxels about voxel (8, 8, 8)'s
+/// corner, object `object` of material 0.
+fn small_ball(object: u32) -> Scene {
+    let e = Extent::cube(16).unwrap();
+    let ball = testkit::ball(e, vox([8, 8, 8]), 4 * VOXEL);
+    testkit::build(e, &[(attrs(object, 0), &ball)], LIM)
+}
+
 #[test]
 fn missing_tables_and_extent_mismatch() {
     let e = Extent::cube(16).unwrap();
-    let vz =
-        |s: &mut dyn VoxelSink| testkit::sphere(e, vox([8, 8, 8]), 4 * VOXEL, Separation::Six, s);
-    let mut scene = testkit::build(e, &[(attrs(3, 0), &vz)], LIM);
+    let mut scene = small_ball(3);
     // Object 3 is not in the (empty) table: counted, not a panic.
     let mut w = World::new(&[vox([8, 8, 100])]);
     let rep = w.run(&mut scene);
@@ -514,10 +448,7 @@ fn missing_tables_and_extent_mismatch() {
 
 #[test]
 fn far_lights_and_huge_coordinates_do_not_fail() {
-    let e = Extent::cube(16).unwrap();
-    let vz =
-        |s: &mut dyn VoxelSink| testkit::sphere(e, vox([8, 8, 8]), 4 * VOXEL, Separation::Six, s);
-    let mut scene = testkit::build(e, &[(attrs(0, 0), &vz)], LIM);
+    let mut scene = small_ball(0);
     let mut w = World::new(&[
         [i64::MAX, i64::MIN, 0],
         [1 << 40, 1 << 41, -(1 << 45)],

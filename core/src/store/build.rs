@@ -178,17 +178,32 @@ fn local(voxel: [u32; 3], slab: Option<u32>) -> Option<[u32; 3]> {
     }
 }
 
+/// The cell of `voxel` (of the larger raster, in a slab starting at layer
+/// `slab`) in `raster`, with the voxel's local coordinates and its brick;
+/// `None`, counted in `outside`, for a voxel outside the raster.
+#[inline]
+fn cell_of<'r>(
+    raster: &'r mut RasterMut<'_>,
+    slab: Option<u32>,
+    voxel: [u32; 3],
+    outside: &mut u64,
+) -> Option<([u32; 3], usize, &'r mut u8)> {
+    let extent = raster.extent();
+    let found = local(voxel, slab).and_then(|v| {
+        let b = brick_of(extent, v);
+        raster.cell_mut(v).map(|c| (v, b, c))
+    });
+    if found.is_none() {
+        *outside = outside.saturating_add(1);
+    }
+    found
+}
+
 impl VoxelSink for Counter<'_, '_> {
     fn offer(&mut self, voxel: [u32; 3], _surfel: Surfel) {
         self.report.offers = self.report.offers.saturating_add(1);
-        let extent = self.raster.extent();
-        let Some(voxel) = local(voxel, self.slab) else {
-            self.report.outside = self.report.outside.saturating_add(1);
-            return;
-        };
-        let b = brick_of(extent, voxel);
-        let Some(c) = self.raster.cell_mut(voxel) else {
-            self.report.outside = self.report.outside.saturating_add(1);
+        let outside = &mut self.report.outside;
+        let Some((_, b, c)) = cell_of(&mut self.raster, self.slab, voxel, outside) else {
             return;
         };
         if *c & cell::OPAQUE != 0 {
@@ -521,14 +536,8 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
             self.no_object = self.no_object.saturating_add(1);
             return;
         };
-        let extent = self.raster.extent();
-        let Some(v) = local(global, self.slab) else {
-            self.report.outside = self.report.outside.saturating_add(1);
-            return;
-        };
-        let b = brick_of(extent, v);
-        let Some(c) = self.raster.cell_mut(v) else {
-            self.report.outside = self.report.outside.saturating_add(1);
+        let outside = &mut self.report.outside;
+        let Some((v, b, c)) = cell_of(&mut self.raster, self.slab, global, outside) else {
             return;
         };
         if *c & cell::OPAQUE == 0 {

@@ -357,7 +357,7 @@ impl<'a> RecordStoreMut<'a> {
         records: &'a mut [VoxelRecord],
         lists: &'a [u32],
     ) -> Result<Self, StoreError> {
-        validate(extent, dir, records, lists)?;
+        RecordStore::with_lists(extent, dir, records, lists)?;
         Ok(Self {
             extent,
             dir,

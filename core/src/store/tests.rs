@@ -145,16 +145,21 @@ fn geometry_of_bricks() {
     assert_eq!(voxel_at([8, 16, 8], brick_position([9, 17, 8])), [9, 17, 8]);
 }
 
+/// A random extent of 1 to `max` voxels along each axis.
+fn random_extent(rng: &mut Rng, max: u32) -> Extent {
+    Extent::new(
+        1 + rng.below_u32(max),
+        1 + rng.below_u32(max),
+        1 + rng.below_u32(max),
+    )
+    .unwrap()
+}
+
 #[test]
 fn lookups_match_brute_force_on_random_sparse_rasters() {
     for seed in 0..20u64 {
         let mut rng = Rng(seed);
-        let extent = Extent::new(
-            1 + rng.below_u32(40),
-            1 + rng.below_u32(40),
-            1 + rng.below_u32(40),
-        )
-        .unwrap();
+        let extent = random_extent(&mut rng, 40);
         let objects = 1 + rng.below_u32(4) as usize;
         let offers = rng.below_u32(3000) as usize;
         let script = random_script(extent, objects, offers, seed.wrapping_mul(77));
@@ -367,26 +372,27 @@ fn build_errors() {
         BuildError::OfferWithoutObject { offers: 1 }
     );
 
-    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
-    f.begin_object(ObjectAttrs { object: 1, ..attrs }).unwrap();
-    f.offer([1, 1, 1], surfel(0));
-    f.offer([9, 1, 1], surfel(0));
-    f.offer([2, 1, 1], surfel(0));
-    assert_eq!(
-        f.finish().unwrap_err(),
-        BuildError::PassMismatch { uncounted: 1 }
-    );
-
-    let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
-    f.begin_object(ObjectAttrs { object: 1, ..attrs }).unwrap();
-    f.offer([1, 1, 1], surfel(0));
-    assert_eq!(
-        f.finish().unwrap_err(),
-        BuildError::FillIncomplete {
-            filled: 1,
-            expected: 2
+    // Object 1 offers an extra voxel, or misses one.
+    for (offered, want) in [
+        (
+            &[[1, 1, 1], [9, 1, 1], [2, 1, 1]][..],
+            BuildError::PassMismatch { uncounted: 1 },
+        ),
+        (
+            &[[1, 1, 1]][..],
+            BuildError::FillIncomplete {
+                filled: 1,
+                expected: 2,
+            },
+        ),
+    ] {
+        let mut f = start(e, &mut plane, &mut dir).fill(&mut recs, lim).unwrap();
+        f.begin_object(ObjectAttrs { object: 1, ..attrs }).unwrap();
+        for &v in offered {
+            f.offer(v, surfel(0));
         }
-    );
+        assert_eq!(f.finish().unwrap_err(), want);
+    }
 }
 
 /// Identity helper: reborrows a `Vec` as a slice (keeps the closures above
@@ -486,12 +492,7 @@ fn corrupt_directories_are_rejected() {
 fn proximity_after_build_is_the_26_neighbourhood() {
     for seed in 0..12u64 {
         let mut rng = Rng(seed + 100);
-        let extent = Extent::new(
-            1 + rng.below_u32(30),
-            1 + rng.below_u32(30),
-            1 + rng.below_u32(30),
-        )
-        .unwrap();
+        let extent = random_extent(&mut rng, 30);
         // Even seeds sparse (per-record pass), odd seeds dense (whole plane).
         let offers = if seed % 2 == 0 {
             rng.below_u32(200) as usize
@@ -563,12 +564,7 @@ fn store_mut_updates_in_place() {
 fn hinted_lookups_are_plain_lookups() {
     for seed in 0..12u64 {
         let mut rng = Rng(seed ^ 0xabcd);
-        let extent = Extent::new(
-            1 + rng.below_u32(40),
-            1 + rng.below_u32(40),
-            1 + rng.below_u32(40),
-        )
-        .unwrap();
+        let extent = random_extent(&mut rng, 40);
         // Dense enough that bricks hold well over 64 records.
         let offers = rng.below_u32(40_000) as usize;
         let script = random_script(extent, 2, offers, seed.wrapping_mul(31));
@@ -630,12 +626,7 @@ fn offering_objects(script: &Script) -> HashMap<[u32; 3], Vec<u32>> {
 fn object_lists_hold_every_offering_object_once_owner_first() {
     for seed in 0..40u64 {
         let mut rng = Rng(seed ^ 0x5eed);
-        let extent = Extent::new(
-            1 + rng.below_u32(24),
-            1 + rng.below_u32(24),
-            1 + rng.below_u32(24),
-        )
-        .unwrap();
+        let extent = random_extent(&mut rng, 24);
         let objects = 1 + rng.below_u32(7) as usize;
         let offers = rng.below_u32(4000) as usize;
         let mut script = random_script(extent, objects, offers, seed.wrapping_mul(91));

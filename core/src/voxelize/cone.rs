@@ -221,7 +221,7 @@ fn run<S: VoxelSink + ?Sized>(
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
-    use crate::testkit::Offers;
+    use crate::testkit::{Offers, assert_refused, voxelized_in_4};
     use crate::voxelize::fixmath::V;
 
     #[test]
@@ -263,44 +263,32 @@ mod tests {
 
     #[test]
     fn bad_input() {
-        let e = Extent::cube(4).unwrap();
-        let mut col = Offers::default();
         let z = Cone {
             base: [0; 3],
             base_radius: 0,
             apex: [0, 0, VOXEL],
             apex_radius: 0,
         };
-        assert_eq!(
-            surface(&z, Separation::Six, e, &mut col),
-            Err(VoxelizeError::NonPositiveRadius)
-        );
+        assert_refused(surface, &z, VoxelizeError::NonPositiveRadius);
         let n = Cone {
-            base: [0; 3],
             base_radius: -1,
-            apex: [0, 0, VOXEL],
             apex_radius: 5,
+            ..z
         };
-        assert_eq!(
-            capped(&n, Separation::Six, e, &mut col),
-            Err(VoxelizeError::NonPositiveRadius)
-        );
+        assert_refused(capped, &n, VoxelizeError::NonPositiveRadius);
         let d = Cone {
-            base: [0; 3],
             base_radius: 9,
             apex: [0; 3],
             apex_radius: 5,
+            ..z
         };
-        assert_eq!(
-            surface(&d, Separation::Six, e, &mut col),
-            Err(VoxelizeError::Degenerate)
-        );
+        assert_refused(surface, &d, VoxelizeError::Degenerate);
         let far = Cone {
             base: [1 << 40; 3],
             base_radius: 1 << 40,
             apex: [-(1 << 40); 3],
             apex_radius: 1 << 39,
         };
-        assert!(capped(&far, Separation::TwentySix, e, &mut col).is_ok());
+        assert!(voxelized_in_4(capped, &far, Separation::TwentySix).is_ok());
     }
 }

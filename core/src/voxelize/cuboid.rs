@@ -294,8 +294,8 @@ fn surfel(lo: [i128; 3], hi: [i128; 3], v: [u32; 3]) -> Surfel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testkit::{Offers, Rng};
-    use std::vec::Vec;
+    use crate::testkit::{Offers, Rng, assert_offers_are, assert_refused, voxelized};
+    use std::format;
 
     #[test]
     fn scan_matches_membership() {
@@ -318,27 +318,10 @@ mod tests {
             }
             let b = Cuboid { min: lo, max: hi };
             for sep in [Separation::Six, Separation::TwentySix] {
-                let mut c = Offers::default();
-                surface(&b, sep, e, &mut c).unwrap();
-                assert!(c.0.values().all(|v| v.1 == 1));
-                let [nx, ny, nz] = e.dims();
-                let mut want = Vec::new();
-                for z in 0..nz {
-                    for y in 0..ny {
-                        for x in 0..nx {
-                            if contains(&b, sep, [x, y, z]).unwrap() {
-                                want.push([x, y, z]);
-                            }
-                        }
-                    }
-                }
-                for v in &want {
-                    assert!(
-                        c.0.contains_key(v),
-                        "case {case} {sep:?}: missing {v:?} of {b:?}"
-                    );
-                }
-                assert_eq!(c.0.len(), want.len(), "case {case} {sep:?}");
+                let (r, c) = voxelized(surface, &b, sep, e);
+                r.unwrap();
+                let inside = |v| contains(&b, sep, v).unwrap();
+                assert_offers_are(&c, e, inside, &format!("case {case} {sep:?} {b:?}"));
                 let mut s = Offers::default();
                 solid(&b, sep, e, &mut s).unwrap();
                 for (v, (sf, _)) in &s.0 {
@@ -376,15 +359,10 @@ mod tests {
             [0, 0, 3],
         );
         assert!(s.normal[0] < 0 && s.normal[1] < 0 && s.normal[2] == 0);
-        let e = Extent::cube(4).unwrap();
-        let mut c = Offers::default();
         let flat = Cuboid {
             min: [0; 3],
             max: [v, 0, v],
         };
-        assert_eq!(
-            surface(&flat, Separation::Six, e, &mut c),
-            Err(VoxelizeError::Degenerate)
-        );
+        assert_refused(surface, &flat, VoxelizeError::Degenerate);
     }
 }

@@ -243,6 +243,20 @@ pub(crate) fn cross(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
     ]
 }
 
+/// The unit lattice vector along the axis on which `v` is smallest in
+/// magnitude (the first of equals): a direction never parallel to `v`.
+#[inline]
+pub(crate) fn least_axis(v: [i128; 3]) -> [i128; 3] {
+    let a = v.map(i128::unsigned_abs);
+    if a[0] <= a[1] && a[0] <= a[2] {
+        [1, 0, 0]
+    } else if a[1] <= a[2] {
+        [0, 1, 0]
+    } else {
+        [0, 0, 1]
+    }
+}
+
 /// `a × b`, or `None` if a product or difference overflows.
 #[inline]
 pub(crate) fn checked_cross(a: [i128; 3], b: [i128; 3]) -> Option<[i128; 3]> {

@@ -39,7 +39,9 @@
 //! voxels offered (plus a logarithmic term for the 26-connected clip).
 
 use super::error::VoxelizeError;
-use super::fixmath::{Counter, H, V, centre, check_point, cross, dist_u32, dot, length, sub, unit};
+use super::fixmath::{
+    Counter, H, V, centre, check_point, cross, dist_u32, dot, least_axis, length, sub, unit,
+};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Segment;
 use crate::raster::Extent;
@@ -274,15 +276,7 @@ impl Line {
         let normal = unit(r)
             .or_else(|| {
                 // On the segment: any perpendicular, d × (the axis of least |d|).
-                let ad = self.d.map(i128::saturating_abs);
-                let e = if ad[0] <= ad[1] && ad[0] <= ad[2] {
-                    [1, 0, 0]
-                } else if ad[1] <= ad[2] {
-                    [0, 1, 0]
-                } else {
-                    [0, 0, 1]
-                };
-                unit(cross(self.d, e))
+                unit(cross(self.d, least_axis(self.d)))
             })
             .unwrap_or([0, 0, NORMAL_ONE]);
         Surfel {

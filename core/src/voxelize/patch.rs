@@ -298,7 +298,7 @@ fn normal(p: &[[[i128; 3]; 4]; 4], i: u32, j: u32, n: u32) -> Option<UnitVector>
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
-    use crate::testkit::Offers;
+    use crate::testkit::{assert_refused, voxelized};
     use crate::voxelize::fixmath::centre;
 
     /// `N⁶ · patch(a/N, b/N)`, exactly.
@@ -341,14 +341,9 @@ mod tests {
             }
         }
         let bp = BezierPatch { control };
-        let mut c = Offers::default();
-        surface(
-            &bp,
-            Separation::TwentySix,
-            Extent::cube(20).unwrap(),
-            &mut c,
-        )
-        .unwrap();
+        let e = Extent::cube(20).unwrap();
+        let (r, c) = voxelized(surface, &bp, Separation::TwentySix, e);
+        r.unwrap();
         assert!(c.0.len() > 300);
         // Every voxel lies within half a cube diagonal (+ tolerance) of the
         // patch: check against a dense exact sampling (N = 60).
@@ -372,9 +367,6 @@ mod tests {
         let flat = BezierPatch {
             control: [[[5; 3]; 4]; 4],
         };
-        assert_eq!(
-            surface(&flat, Separation::Six, Extent::cube(4).unwrap(), &mut c),
-            Err(VoxelizeError::Degenerate)
-        );
+        assert_refused(surface, &flat, VoxelizeError::Degenerate);
     }
 }

@@ -82,17 +82,7 @@ pub fn surface<S: VoxelSink + ?Sized>(
     extent: Extent,
     sink: &mut S,
 ) -> Result<u64, VoxelizeError> {
-    let b = Ball::new(sphere, extent)?;
-    let mut n = Counter::default();
-    match separation {
-        Separation::TwentySix => b.twenty_six(sink, &mut n, false),
-        Separation::Six => {
-            for axis in 0..3 {
-                b.six_axis(axis, sink, &mut n);
-            }
-        }
-    }
-    Ok(n.0)
+    shell(sphere, separation, extent, sink, false)
 }
 
 /// Voxelizes the solid ball: the surface shell of [`surface`] plus every
@@ -107,15 +97,28 @@ pub fn solid<S: VoxelSink + ?Sized>(
     extent: Extent,
     sink: &mut S,
 ) -> Result<u64, VoxelizeError> {
+    shell(sphere, separation, extent, sink, true)
+}
+
+/// [`surface`], and with `fill` the voxels inside too ([`solid`]).
+fn shell<S: VoxelSink + ?Sized>(
+    sphere: &Sphere,
+    separation: Separation,
+    extent: Extent,
+    sink: &mut S,
+    fill: bool,
+) -> Result<u64, VoxelizeError> {
     let b = Ball::new(sphere, extent)?;
     let mut n = Counter::default();
     match separation {
-        Separation::TwentySix => b.twenty_six(sink, &mut n, true),
+        Separation::TwentySix => b.twenty_six(sink, &mut n, fill),
         Separation::Six => {
             for axis in 0..3 {
                 b.six_axis(axis, sink, &mut n);
             }
-            b.six_interior(sink, &mut n);
+            if fill {
+                b.six_interior(sink, &mut n);
+            }
         }
     }
     Ok(n.0)
@@ -437,7 +440,7 @@ fn near_far(c: i128, i: u32) -> (i128, i128) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testkit::{Offers, Rng};
+    use crate::testkit::{Offers, Rng, assert_refused, voxelized_in_4};
     use std::vec::Vec;
 
     fn brute(s: &Sphere, sep: Separation, e: Extent) -> Vec<[u32; 3]> {
@@ -539,28 +542,20 @@ mod tests {
 
     #[test]
     fn bad_input() {
-        let e = Extent::cube(4).unwrap();
-        let mut c = Offers::default();
         let z = Sphere {
             centre: [0; 3],
             radius: 0,
         };
-        assert_eq!(
-            surface(&z, Separation::Six, e, &mut c),
-            Err(VoxelizeError::NonPositiveRadius)
-        );
+        assert_refused(surface, &z, VoxelizeError::NonPositiveRadius);
         let big = Sphere {
             centre: [i64::MAX, 0, 0],
             radius: 5,
         };
-        assert_eq!(
-            solid(&big, Separation::Six, e, &mut c),
-            Err(VoxelizeError::OutOfRange)
-        );
+        assert_refused(solid, &big, VoxelizeError::OutOfRange);
         let far = Sphere {
             centre: [1 << 40, 1 << 40, 1 << 40],
             radius: 1 << 40,
         };
-        assert_eq!(surface(&far, Separation::TwentySix, e, &mut c), Ok(0));
+        assert_eq!(voxelized_in_4(surface, &far, Separation::TwentySix), Ok(0));
     }
 }

@@ -10,7 +10,7 @@
 //! [`super::triangle`] makes its voxelization tunnel-free.
 
 use super::error::VoxelizeError;
-use super::fixmath::{Counter, V, bounds, cross, isqrt, round_div, unit};
+use super::fixmath::{Counter, V, bounds, cross, isqrt, least_axis, round_div, unit};
 use super::triangle::Tri;
 use super::{Separation, Surfel, VoxelSink};
 use crate::geometry::UnitVector;
@@ -64,15 +64,7 @@ pub(crate) fn quarter_segments(radius: i128) -> u32 {
 /// `None` for a zero axis.
 pub(crate) fn frame(axis: [i128; 3]) -> Option<[[i128; 3]; 3]> {
     let w = unit(axis)?.map(i128::from);
-    let a = w.map(i128::unsigned_abs);
-    let e = if a[0] <= a[1] && a[0] <= a[2] {
-        [1, 0, 0]
-    } else if a[1] <= a[2] {
-        [0, 1, 0]
-    } else {
-        [0, 0, 1]
-    };
-    let u = unit(cross(w, e))?.map(i128::from);
+    let u = unit(cross(w, least_axis(w)))?.map(i128::from);
     let v = unit(cross(w, u))?.map(i128::from);
     Some([u, v, w])
 }

@@ -140,7 +140,7 @@ pub fn surface<S: VoxelSink + ?Sized>(
 mod tests {
     use super::*;
     use crate::fixed::VOXEL;
-    use crate::testkit::Offers;
+    use crate::testkit::{assert_refused, voxelized, voxelized_in_4};
 
     #[test]
     fn surfels_match_the_true_torus() {
@@ -151,14 +151,9 @@ mod tests {
             major: 7 * VOXEL,
             minor: 3 * VOXEL + 99,
         };
-        let mut col = Offers::default();
-        surface(
-            &t,
-            Separation::TwentySix,
-            Extent::cube(25).unwrap(),
-            &mut col,
-        )
-        .unwrap();
+        let e = Extent::cube(25).unwrap();
+        let (r, col) = voxelized(surface, &t, Separation::TwentySix, e);
+        r.unwrap();
         for (v, (s, _)) in &col.0 {
             let p = [0, 1, 2].map(|k| centre(v[k]) - i128::from(c));
             let rho = isqrt(p[0] * p[0] + p[1] * p[1]);
@@ -175,41 +170,27 @@ mod tests {
 
     #[test]
     fn bad_input() {
-        let e = Extent::cube(4).unwrap();
-        let mut col = Offers::default();
         let base = Torus {
             centre: [0; 3],
             axis: [0, 0, NORMAL_ONE],
             major: VOXEL,
             minor: VOXEL,
         };
-        assert_eq!(
-            surface(&Torus { minor: 0, ..base }, Separation::Six, e, &mut col),
-            Err(VoxelizeError::NonPositiveRadius)
+        let refused = |t: Torus, want| assert_refused(surface, &t, want);
+        refused(Torus { minor: 0, ..base }, VoxelizeError::NonPositiveRadius);
+        refused(
+            Torus {
+                axis: [0; 3],
+                ..base
+            },
+            VoxelizeError::Degenerate,
         );
-        assert_eq!(
-            surface(
-                &Torus {
-                    axis: [0; 3],
-                    ..base
-                },
-                Separation::Six,
-                e,
-                &mut col
-            ),
-            Err(VoxelizeError::Degenerate)
-        );
-        assert_eq!(
-            surface(
-                &Torus {
-                    major: 1 << 41,
-                    ..base
-                },
-                Separation::Six,
-                e,
-                &mut col
-            ),
-            Err(VoxelizeError::OutOfRange)
+        refused(
+            Torus {
+                major: 1 << 41,
+                ..base
+            },
+            VoxelizeError::OutOfRange,
         );
         let huge = Torus {
             centre: [1 << 39; 3],
@@ -217,6 +198,6 @@ mod tests {
             major: 1 << 39,
             minor: 1 << 30,
         };
-        assert!(surface(&huge, Separation::TwentySix, e, &mut col).is_ok());
+        assert!(voxelized_in_4(surface, &huge, Separation::TwentySix).is_ok());
     }
 }

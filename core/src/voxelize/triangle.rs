@@ -695,7 +695,8 @@ fn centre_range(p: i128, q: i128, lo: i128, hi: i128) -> Option<(i128, i128)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testkit::{Offers, Rng};
+    use crate::testkit::{Offers, Rng, assert_offers_are, voxelized};
+    use std::format;
     use std::vec::Vec;
 
     #[test]
@@ -729,27 +730,10 @@ mod tests {
                 continue;
             }
             for sep in [Separation::Six, Separation::TwentySix] {
-                let mut c = Offers::default();
-                triangle(&t, sep, e, &mut c).unwrap();
-                assert!(c.0.values().all(|o| o.1 == 1), "case {case}: offered twice");
-                let [nx, ny, nz] = e.dims();
-                let mut want = Vec::new();
-                for z in 0..nz {
-                    for y in 0..ny {
-                        for x in 0..nx {
-                            if contains(&t, sep, [x, y, z]).unwrap() {
-                                want.push([x, y, z]);
-                            }
-                        }
-                    }
-                }
-                for v in &want {
-                    assert!(
-                        c.0.contains_key(v),
-                        "case {case} {sep:?}: missing {v:?} of {t:?}"
-                    );
-                }
-                assert_eq!(c.0.len(), want.len(), "case {case} {sep:?}: extra voxels");
+                let (r, c) = voxelized(triangle, &t, sep, e);
+                r.unwrap();
+                let inside = |v| contains(&t, sep, v).unwrap();
+                assert_offers_are(&c, e, inside, &format!("case {case} {sep:?} {t:?}"));
             }
         }
     }

@@ -116,6 +116,25 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
         arg: "--dims",
         message: e.to_string(),
     })?;
+    let Some(ray) = start(args, extent, out)? else {
+        return Ok(());
+    };
+    // Without a saved raster the voxels are empty: list the path.
+    for v in ray.path(args.connectivity.into()) {
+        let [x, y, z] = extent.coord(v.index).unwrap_or_default();
+        writeln!(out, "{x} {y} {z}")?;
+    }
+    writeln!(out, "miss")?;
+    Ok(())
+}
+
+/// The report's first line (the ray in fixed point) and the ray through
+/// `extent`; `None`, reported as `miss`, when it misses the raster.
+fn start(
+    args: &RayArgs,
+    extent: Extent,
+    out: &mut impl Write,
+) -> Result<Option<DiscreteRay>, CliError> {
     let [ox, oy, oz] = args.origin;
     let [dx, dy, dz] = args.dir;
     writeln!(
@@ -126,17 +145,10 @@ pub fn run(args: &RayArgs, out: &mut impl Write) -> Result<(), CliError> {
         arg: "--origin",
         message: e.to_string(),
     })?;
-    let Some(ray) = ray else {
+    if ray.is_none() {
         writeln!(out, "miss")?;
-        return Ok(());
-    };
-    // Without a saved raster the voxels are empty: list the path.
-    for v in ray.path(args.connectivity.into()) {
-        let [x, y, z] = extent.coord(v.index).unwrap_or_default();
-        writeln!(out, "{x} {y} {z}")?;
     }
-    writeln!(out, "miss")?;
-    Ok(())
+    Ok(ray)
 }
 
 /// `rrt ray --raster FILE.rrt`: the voxels up to each hit, then
@@ -157,18 +169,7 @@ fn run_saved(args: &RayArgs, path: &std::path::Path, out: &mut impl Write) -> Re
         return Err(crate::trace::TraceError::Separation.into());
     }
     let extent = scene.extent();
-    let [ox, oy, oz] = args.origin;
-    let [dx, dy, dz] = args.dir;
-    writeln!(
-        out,
-        "origin_fx={ox},{oy},{oz} dir_fx={dx},{dy},{dz} frac_bits={FRAC_BITS} voxel=corner"
-    )?;
-    let ray = DiscreteRay::new(extent, args.origin, args.dir).map_err(|e| CliError::Arg {
-        arg: "--origin",
-        message: e.to_string(),
-    })?;
-    let Some(ray) = ray else {
-        writeln!(out, "miss")?;
+    let Some(ray) = start(args, extent, out)? else {
         return Ok(());
     };
     let raster = scene

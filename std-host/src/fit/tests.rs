@@ -76,18 +76,22 @@ fn explicit_bounds_are_used_exactly() {
 #[test]
 fn absurd_raster_sizes() {
     let s = scene("s 0 0 0 1\n");
-    assert_eq!(
-        frame(&s, &opts(0)).unwrap_err().to_string(),
-        "raster 0: expected 1 to 65536 voxels along the longest axis"
-    );
-    assert_eq!(
-        frame(&s, &opts(65537)).unwrap_err().to_string(),
-        "raster 65537: expected 1 to 65536 voxels along the longest axis"
-    );
-    assert_eq!(
-        frame(&s, &opts(4)).unwrap_err().to_string(),
-        "raster 4: too small for a margin of 2 voxels on each side; use at least 5"
-    );
+    for (n, want) in [
+        (
+            0,
+            "raster 0: expected 1 to 65536 voxels along the longest axis",
+        ),
+        (
+            65537,
+            "raster 65537: expected 1 to 65536 voxels along the longest axis",
+        ),
+        (
+            4,
+            "raster 4: too small for a margin of 2 voxels on each side; use at least 5",
+        ),
+    ] {
+        assert_eq!(frame(&s, &opts(n)).unwrap_err().to_string(), want);
+    }
     assert_eq!(frame(&s, &opts(5)).unwrap().dims(), [5, 5, 5]);
     assert_eq!(frame(&s, &opts(65536)).unwrap().dims(), [65536; 3]);
 }

@@ -187,6 +187,14 @@ impl Buf {
         self.f64(v.y);
         self.f64(v.z);
     }
+    /// A section of one entry per item, each written by `write`.
+    fn entries<T>(items: &[T], mut write: impl FnMut(&mut Self, &T)) -> Vec<u8> {
+        let mut b = Self::default();
+        for item in items {
+            write(&mut b, item);
+        }
+        b.0
+    }
 }
 
 /// Little-endian reader over a section.
@@ -221,6 +229,12 @@ impl<'a> Cursor<'a> {
     }
     fn vec(&mut self) -> DVec3 {
         DVec3::new(self.f64(), self.f64(), self.f64())
+    }
+    /// Each `len`-byte entry of section `b`, read by `read`.
+    fn entries<T>(b: &'a [u8], len: u64, mut read: impl FnMut(&mut Self) -> T) -> Vec<T> {
+        b.chunks_exact(len as usize)
+            .map(|entry| read(&mut Cursor::new(entry)))
+            .collect()
     }
 }
 
@@ -262,36 +276,30 @@ fn meta_bytes(s: &VoxelScene) -> Vec<u8> {
 }
 
 fn objects_bytes(s: &VoxelScene) -> Vec<u8> {
-    let mut b = Buf::default();
-    for o in &s.objects {
+    Buf::entries(&s.objects, |b, o| {
         let (kind, slots) = o.shape.save();
         b.u32(kind);
         b.u32(u32::from(o.material));
         for v in slots {
             b.f64(v);
         }
-    }
-    b.0
+    })
 }
 
 fn materials_bytes(s: &VoxelScene) -> Vec<u8> {
-    let mut b = Buf::default();
-    for m in &s.materials {
+    Buf::entries(&s.materials, |b, m| {
         b.vec(m.colour);
         for v in [m.kd, m.ks, m.shine, m.transmittance, m.ior] {
             b.f64(v);
         }
-    }
-    b.0
+    })
 }
 
 fn lights_bytes(s: &VoxelScene) -> Vec<u8> {
-    let mut b = Buf::default();
-    for l in &s.lights {
+    Buf::entries(&s.lights, |b, l| {
         b.vec(l.position);
         b.vec(l.colour);
-    }
-    b.0
+    })
 }
 
 fn record_bytes(r: &VoxelRecord, out: &mut Vec<u8>) {
@@ -958,21 +966,15 @@ fn directory_from(b: &[u8]) -> Vec<u32> {
 
 /// The materials section, each value in range.
 fn materials_from(b: &[u8]) -> Result<Vec<Material>, String> {
-    let materials: Vec<Material> = b
-        .chunks_exact(MATERIAL_LEN as usize)
-        .map(|chunk| {
-            let mut c = Cursor::new(chunk);
-            Material {
-                colour: c.vec(),
-                kd: c.f64(),
-                ks: c.f64(),
-                shine: c.f64(),
-                transmittance: c.f64(),
-                ior: c.f64(),
-                loc: None,
-            }
-        })
-        .collect();
+    let materials = Cursor::entries(b, MATERIAL_LEN, |c| Material {
+        colour: c.vec(),
+        kd: c.f64(),
+        ks: c.f64(),
+        shine: c.f64(),
+        transmittance: c.f64(),
+        ior: c.f64(),
+        loc: None,
+    });
     for (i, mt) in materials.iter().enumerate() {
         let ok = mt.colour.is_finite()
             && [mt.kd, mt.ks, mt.shine, mt.transmittance, mt.ior]
@@ -1012,16 +1014,10 @@ fn objects_from(b: &[u8], materials: usize) -> Result<Vec<WorldObject>, String> 
 
 /// The lights section, every number finite.
 fn lights_from(b: &[u8]) -> Result<Vec<WorldLight>, String> {
-    let lights: Vec<WorldLight> = b
-        .chunks_exact(LIGHT_LEN as usize)
-        .map(|chunk| {
-            let mut c = Cursor::new(chunk);
-            WorldLight {
-                position: c.vec(),
-                colour: c.vec(),
-            }
-        })
-        .collect();
+    let lights = Cursor::entries(b, LIGHT_LEN, |c| WorldLight {
+        position: c.vec(),
+        colour: c.vec(),
+    });
     if lights
         .iter()
         .any(|l| !(l.position.is_finite() && l.colour.is_finite()))

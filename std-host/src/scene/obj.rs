@@ -303,36 +303,24 @@ mod tests {
     fn indices_are_checked_with_their_line() {
         let ok = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf -3 -2 -1\n";
         let m = parse("t.obj", ok).unwrap();
+        let refused = |text: &str| parse("t.obj", text).unwrap_err().to_string();
         assert_eq!(m.triangles.len(), 2);
         assert_eq!(m.normals, None);
-        let e = parse("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n")
-            .unwrap_err()
-            .to_string();
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
         assert!(
             e.starts_with("t.obj:4:7: OBJ: face vertex index out of range"),
             "{e}"
         );
-        let e = parse("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n")
-            .unwrap_err()
-            .to_string();
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
         assert!(e.starts_with("t.obj:4:3: OBJ: face vertex index"), "{e}");
-        let e = parse("t.obj", "v 0 0 0\nf -2 1 1\nv 1 0 0\nv 0 1 0\n")
-            .unwrap_err()
-            .to_string();
+        let e = refused("v 0 0 0\nf -2 1 1\nv 1 0 0\nv 0 1 0\n");
         assert!(e.starts_with("t.obj:2:3:"), "{e}");
-        let e = parse(
-            "t.obj",
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//0 3//1\n",
-        )
-        .unwrap_err()
-        .to_string();
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//0 3//1\n");
         // The column of the face vertex `2//0` that holds the bad index.
         assert!(e.starts_with("t.obj:5:8: OBJ: face normal index"), "{e}");
-        let e = parse("t.obj", "v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n")
-            .unwrap_err()
-            .to_string();
+        let e = refused("v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n");
         assert_eq!(e, "t.obj:2:1: OBJ: malformed vertex position");
-        let e = parse("t.obj", "# nothing\n").unwrap_err().to_string();
+        let e = refused("# nothing\n");
         assert!(e.contains("no faces"), "{e}");
     }
 

@@ -71,6 +71,14 @@ fn close3(a: DVec3, b: DVec3, tol: f64) {
     assert!((a - b).length() <= tol, "{a} vs {b} (tol {tol})");
 }
 
+/// `h` is a hit at `t` with unit normal `normal`, both within `tol`.
+#[track_caller]
+fn assert_hit(h: Option<Hit>, t: f64, normal: DVec3, tol: f64) {
+    let h = h.unwrap();
+    close(h.t, t, tol);
+    close3(h.normal, normal, tol);
+}
+
 fn ray(o: [f64; 3], d: [f64; 3]) -> Ray {
     Ray::new(DVec3::from(o), DVec3::from(d))
 }
@@ -117,51 +125,25 @@ fn march(r: &Ray, f: impl Fn(DVec3) -> f64, lo: f64, hi: f64, steps: usize) -> O
 
 // ------------------------------------------------------------------ sphere
 
+/// The unit sphere about the origin, from `o` along `d`, over `(0, ∞)`.
+fn unit_sphere(o: [f64; 3], d: [f64; 3]) -> Option<Hit> {
+    sphere(&ray(o, d), DVec3::ZERO, 1.0, 0.0, INF)
+}
+
 #[test]
 fn sphere_known_values() {
-    let h = sphere(
-        &ray([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]),
-        DVec3::ZERO,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
+    let h = unit_sphere([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]).unwrap();
     assert_eq!(h.t, 4.0);
     assert_eq!(h.normal, -DVec3::Z);
     // t is in units of the direction.
-    let h = sphere(
-        &ray([0.0, 0.0, -5.0], [0.0, 0.0, 2.0]),
-        DVec3::ZERO,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
+    let h = unit_sphere([0.0, 0.0, -5.0], [0.0, 0.0, 2.0]).unwrap();
     assert_eq!(h.t, 2.0);
     // Off-centre: x = 0.6 meets the unit sphere at z = −0.8.
-    let h = sphere(
-        &ray([0.6, 0.0, -5.0], [0.0, 0.0, 1.0]),
-        DVec3::ZERO,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 4.2, 1e-15);
-    close3(h.normal, DVec3::new(0.6, 0.0, -0.8), 1e-15);
+    let h = unit_sphere([0.6, 0.0, -5.0], [0.0, 0.0, 1.0]);
+    assert_hit(h, 4.2, DVec3::new(0.6, 0.0, -0.8), 1e-15);
     // Pointing away, or the interval excludes both roots (open bounds).
     let r = ray([0.0, 0.0, -5.0], [0.0, 0.0, 1.0]);
-    assert!(
-        sphere(
-            &ray([0.0, 0.0, -5.0], [0.0, 0.0, -1.0]),
-            DVec3::ZERO,
-            1.0,
-            0.0,
-            INF
-        )
-        .is_none()
-    );
+    assert!(unit_sphere([0.0, 0.0, -5.0], [0.0, 0.0, -1.0]).is_none());
     assert!(sphere(&r, DVec3::ZERO, 1.0, 0.0, 4.0).is_none());
     assert_eq!(sphere(&r, DVec3::ZERO, 1.0, 4.0, INF).unwrap().t, 6.0);
 }
@@ -186,34 +168,10 @@ fn sphere_inside_start_hits_far_side_with_outward_normal() {
 #[test]
 fn sphere_grazing() {
     // Tangent at (0, 1, 0): a double root, a hit.
-    let h = sphere(
-        &ray([-5.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
-        DVec3::ZERO,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 5.0, 1e-14);
-    close3(h.normal, DVec3::Y, 1e-14);
-    assert!(
-        sphere(
-            &ray([-5.0, 1.0 + 1e-9, 0.0], [1.0, 0.0, 0.0]),
-            DVec3::ZERO,
-            1.0,
-            0.0,
-            INF
-        )
-        .is_none()
-    );
-    let h = sphere(
-        &ray([-5.0, 1.0 - 1e-9, 0.0], [1.0, 0.0, 0.0]),
-        DVec3::ZERO,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
+    let h = unit_sphere([-5.0, 1.0, 0.0], [1.0, 0.0, 0.0]);
+    assert_hit(h, 5.0, DVec3::Y, 1e-14);
+    assert!(unit_sphere([-5.0, 1.0 + 1e-9, 0.0], [1.0, 0.0, 0.0]).is_none());
+    let h = unit_sphere([-5.0, 1.0 - 1e-9, 0.0], [1.0, 0.0, 0.0]).unwrap();
     close(h.t, 5.0, 1e-4);
 }
 
@@ -271,36 +229,18 @@ fn triangle_interpolates_vertex_normals() {
         DVec3::new(1.0, 0.0, 1.0),
         DVec3::new(0.0, 1.0, 1.0),
     ];
-    let h = triangle(
-        &ray([0.25, 0.5, 1.0], [0.0, 0.0, -1.0]),
-        v,
-        Some(n),
-        0.0,
-        INF,
-    )
-    .unwrap();
+    // Straight down onto the triangle with vertex normals `n`.
+    let down =
+        |x: f64, y: f64, n| triangle(&ray([x, y, 1.0], [0.0, 0.0, -1.0]), v, Some(n), 0.0, INF);
+    let h = down(0.25, 0.5, n).unwrap();
     let expect = (n[0] * 0.25 + n[1] * 0.25 + n[2] * 0.5).normalize();
     close3(h.normal, expect, 1e-15);
     // At a vertex, that vertex's normal.
-    let h = triangle(
-        &ray([1.0, 0.0, 1.0], [0.0, 0.0, -1.0]),
-        v,
-        Some(n),
-        0.0,
-        INF,
-    )
-    .unwrap();
+    let h = down(1.0, 0.0, n).unwrap();
     close3(h.normal, n[1].normalize(), 1e-15);
     // Normals that cancel fall back to the face normal.
     let opposite = [DVec3::Z, -DVec3::Z, DVec3::Z];
-    let h = triangle(
-        &ray([0.5, 0.0, 1.0], [0.0, 0.0, -1.0]),
-        v,
-        Some([opposite[0], opposite[1], DVec3::ZERO]),
-        0.0,
-        INF,
-    )
-    .unwrap();
+    let h = down(0.5, 0.0, [opposite[0], opposite[1], DVec3::ZERO]).unwrap();
     assert_eq!(h.normal, DVec3::Z);
 }
 
@@ -346,170 +286,62 @@ fn triangle_random_rays_against_plane_and_barycentrics() {
 
 // -------------------------------------------------------------------- cone
 
+/// The cylinder of radius 1 from the origin to (0, 0, 2), open at both
+/// ends, from `o` along `d`, over `(0, ∞)`.
+fn cylinder(o: [f64; 3], d: [f64; 3]) -> Option<Hit> {
+    cone(&ray(o, d), DVec3::ZERO, 1.0, TOP, 1.0, 0.0, INF)
+}
+
+/// The top of [`cylinder`].
+const TOP: DVec3 = DVec3::new(0.0, 0.0, 2.0);
+
+/// The cone of radius 1 at z = 0 narrowing to a point at z = 1, from `o`
+/// along `d`, over `(0, ∞)`.
+fn pointed(o: [f64; 3], d: [f64; 3]) -> Option<Hit> {
+    cone(&ray(o, d), DVec3::ZERO, 1.0, DVec3::Z, 0.0, 0.0, INF)
+}
+
 #[test]
 fn cylinder_known_values_inside_start_and_open_ends() {
-    let (b, a) = (DVec3::ZERO, DVec3::new(0.0, 0.0, 2.0));
-    let h = cone(
-        &ray([-5.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
-        b,
-        1.0,
-        a,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 4.0, 1e-15);
-    close3(h.normal, -DVec3::X, 1e-15);
+    let h = cylinder([-5.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    assert_hit(h, 4.0, -DVec3::X, 1e-15);
     // Inside: the far wall, normal outward.
-    let h = cone(
-        &ray([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
-        b,
-        1.0,
-        a,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 1.0, 1e-15);
-    close3(h.normal, DVec3::X, 1e-15);
+    let h = cylinder([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    assert_hit(h, 1.0, DVec3::X, 1e-15);
     // Along the axis inside: out through the open ends.
-    assert!(
-        cone(
-            &ray([0.0, 0.0, 1.0], [0.0, 0.0, 1.0]),
-            b,
-            1.0,
-            a,
-            1.0,
-            0.0,
-            INF
-        )
-        .is_none()
-    );
+    assert!(cylinder([0.0, 0.0, 1.0], [0.0, 0.0, 1.0]).is_none());
     // Above or below the finite cylinder: misses.
-    assert!(
-        cone(
-            &ray([-5.0, 0.0, 2.5], [1.0, 0.0, 0.0]),
-            b,
-            1.0,
-            a,
-            1.0,
-            0.0,
-            INF
-        )
-        .is_none()
-    );
+    assert!(cylinder([-5.0, 0.0, 2.5], [1.0, 0.0, 0.0]).is_none());
     // Entering through the open top end, then hitting the wall inside.
-    let h = cone(
-        &ray([0.0, 0.0, 3.0], [0.5, 0.0, -1.0]),
-        b,
-        1.0,
-        a,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 2.0, 1e-15);
-    close3(h.normal, DVec3::X, 1e-15);
+    let h = cylinder([0.0, 0.0, 3.0], [0.5, 0.0, -1.0]);
+    assert_hit(h, 2.0, DVec3::X, 1e-15);
     // Radii sign as embree_nff: absolute values.
-    let h = cone(
-        &ray([-5.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
-        b,
-        -1.0,
-        a,
-        -1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
+    let r = ray([-5.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    let h = cone(&r, DVec3::ZERO, -1.0, TOP, -1.0, 0.0, INF).unwrap();
     close(h.t, 4.0, 1e-15);
 }
 
 #[test]
 fn cylinder_grazing() {
-    let (b, a) = (DVec3::ZERO, DVec3::new(0.0, 0.0, 2.0));
-    let h = cone(
-        &ray([-5.0, 1.0, 1.0], [1.0, 0.0, 0.0]),
-        b,
-        1.0,
-        a,
-        1.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 5.0, 1e-12);
-    close3(h.normal, DVec3::Y, 1e-12);
-    assert!(
-        cone(
-            &ray([-5.0, 1.0 + 1e-9, 1.0], [1.0, 0.0, 0.0]),
-            b,
-            1.0,
-            a,
-            1.0,
-            0.0,
-            INF
-        )
-        .is_none()
-    );
+    let h = cylinder([-5.0, 1.0, 1.0], [1.0, 0.0, 0.0]);
+    assert_hit(h, 5.0, DVec3::Y, 1e-12);
+    assert!(cylinder([-5.0, 1.0 + 1e-9, 1.0], [1.0, 0.0, 0.0]).is_none());
     // Parallel to the axis, on the wall: no isolated intersection.
-    assert!(
-        cone(
-            &ray([1.0, 0.0, -1.0], [0.0, 0.0, 1.0]),
-            b,
-            1.0,
-            a,
-            1.0,
-            0.0,
-            INF
-        )
-        .is_none()
-    );
+    assert!(cylinder([1.0, 0.0, -1.0], [0.0, 0.0, 1.0]).is_none());
 }
 
 #[test]
 fn cone_known_values() {
     // Radius 1 at z = 0 down to a point at z = 1.
-    let (b, a) = (DVec3::ZERO, DVec3::Z);
-    let h = cone(
-        &ray([-5.0, 0.0, 0.5], [1.0, 0.0, 0.0]),
-        b,
-        1.0,
-        a,
-        0.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 4.5, 1e-15);
-    close3(h.normal, DVec3::new(-1.0, 0.0, 1.0).normalize(), 1e-15);
+    let h = pointed([-5.0, 0.0, 0.5], [1.0, 0.0, 0.0]);
+    assert_hit(h, 4.5, DVec3::new(-1.0, 0.0, 1.0).normalize(), 1e-15);
     // A ray lying on a generator (x = z − 1): no isolated intersection.
-    let h = cone(
-        &ray([-2.0, 0.0, -1.0], [1.0, 0.0, 1.0]),
-        b,
-        1.0,
-        a,
-        0.0,
-        0.0,
-        INF,
-    );
+    let h = pointed([-2.0, 0.0, -1.0], [1.0, 0.0, 1.0]);
     assert!(h.is_none(), "{h:?}");
     // Parallel to that generator, inside it (x = z − 0.5): the quadratic
     // degenerates to a linear equation; the far side at z = 0.75, t = 2.25.
-    let h = cone(
-        &ray([-2.0, 0.0, -1.5], [1.0, 0.0, 1.0]),
-        b,
-        1.0,
-        a,
-        0.0,
-        0.0,
-        INF,
-    )
-    .unwrap();
-    close(h.t, 2.25, 1e-12);
-    close3(h.normal, DVec3::new(1.0, 0.0, 1.0).normalize(), 1e-12);
+    let h = pointed([-2.0, 0.0, -1.5], [1.0, 0.0, 1.0]);
+    assert_hit(h, 2.25, DVec3::new(1.0, 0.0, 1.0).normalize(), 1e-12);
 }
 
 #[test]
@@ -549,17 +381,14 @@ fn ring(r: &Ray) -> Option<Hit> {
 
 #[test]
 fn torus_known_values() {
-    let h = ring(&ray([-5.0, 0.0, 0.0], [1.0, 0.0, 0.0])).unwrap();
-    close(h.t, 2.5, 1e-12);
-    close3(h.normal, -DVec3::X, 1e-12);
+    let h = ring(&ray([-5.0, 0.0, 0.0], [1.0, 0.0, 0.0]));
+    assert_hit(h, 2.5, -DVec3::X, 1e-12);
     // From the centre: the inner side of the tube, facing the hole.
-    let h = ring(&ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0])).unwrap();
-    close(h.t, 1.5, 1e-12);
-    close3(h.normal, -DVec3::X, 1e-12);
+    let h = ring(&ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]));
+    assert_hit(h, 1.5, -DVec3::X, 1e-12);
     // From above, down onto the tube's top.
-    let h = ring(&ray([2.0, 0.0, 5.0], [0.0, 0.0, -2.0])).unwrap();
-    close(h.t, 2.25, 1e-12);
-    close3(h.normal, DVec3::Z, 1e-12);
+    let h = ring(&ray([2.0, 0.0, 5.0], [0.0, 0.0, -2.0]));
+    assert_hit(h, 2.25, DVec3::Z, 1e-12);
     // Down the axis, through the hole.
     assert!(ring(&ray([0.0, 0.0, 5.0], [0.0, 0.0, -1.0])).is_none());
     // Across the hole at a height above the tube.
@@ -580,12 +409,10 @@ fn torus_known_values() {
 
 #[test]
 fn torus_inside_start() {
-    let h = ring(&ray([2.0, 0.0, 0.0], [1.0, 0.0, 0.0])).unwrap();
-    close(h.t, 0.5, 1e-12);
-    close3(h.normal, DVec3::X, 1e-12);
-    let h = ring(&ray([0.0, 2.0, 0.0], [0.0, 0.0, 1.0])).unwrap();
-    close(h.t, 0.5, 1e-12);
-    close3(h.normal, DVec3::Z, 1e-12);
+    let h = ring(&ray([2.0, 0.0, 0.0], [1.0, 0.0, 0.0]));
+    assert_hit(h, 0.5, DVec3::X, 1e-12);
+    let h = ring(&ray([0.0, 2.0, 0.0], [0.0, 0.0, 1.0]));
+    assert_hit(h, 0.5, DVec3::Z, 1e-12);
 }
 
 #[test]
@@ -593,9 +420,8 @@ fn torus_grazing() {
     // Along the top circle's tangent: touches at (2, 0, 0.5) only. The
     // contact is of order 4 (the quartic behaves like y⁴/16 there), so
     // rounding of about 1e-16 moves the root by about its fourth root.
-    let h = ring(&ray([2.0, -5.0, 0.5], [0.0, 1.0, 0.0])).unwrap();
-    close(h.t, 5.0, 1e-4);
-    close3(h.normal, DVec3::Z, 1e-4);
+    let h = ring(&ray([2.0, -5.0, 0.5], [0.0, 1.0, 0.0]));
+    assert_hit(h, 5.0, DVec3::Z, 1e-4);
     // Tangent to the outer equator at (2.5, 0, 0).
     let h = ring(&ray([2.5, -5.0, 0.0], [0.0, 1.0, 0.0])).unwrap();
     close(h.t, 5.0, 1e-6);

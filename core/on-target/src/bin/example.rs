@@ -20,35 +20,15 @@ fn example(
 
 #[cfg(target_os = "none")]
 mod firmware {
-    use rrt_core::geometry::BezierPatch;
-    use rrt_core::object_table::Object;
-    use rrt_core::voxel::VoxelRecord;
     use rrt_on_target::firmware::{exit, println};
-    use rrt_on_target::scene::{self, Storage};
-    use rrt_on_target::take;
-
-    // Everything the scene needs, in static memory: no heap, no stack
-    // arrays.
-    static mut PLANE: [u8; scene::PLANE_LEN] = [0; scene::PLANE_LEN];
-    static mut LINES: [u8; scene::LINES_LEN] = [0; scene::LINES_LEN];
-    static mut DIR: [u32; scene::DIR_LEN] = [0; scene::DIR_LEN];
-    static mut RECORDS: [VoxelRecord; scene::MAX_RECORDS] =
-        [scene::RECORD_INIT; scene::MAX_RECORDS];
-    static mut OBJECTS: [Object; scene::MAX_OBJECTS] = [Object::UNUSED; scene::MAX_OBJECTS];
-    static mut PATCHES: [BezierPatch; 1] = [scene::PATCH_INIT];
-    static mut IMAGE: [u8; scene::IMAGE_LEN] = [0; scene::IMAGE_LEN];
+    use rrt_on_target::{buffer, scene, scene_storage};
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
-        let mut st = Storage {
-            plane: take!(PLANE),
-            lines: take!(LINES),
-            dir: take!(DIR),
-            records: take!(RECORDS),
-            objects: take!(OBJECTS),
-            patches: take!(PATCHES),
-        };
-        let image = take!(IMAGE);
+        // Everything the scene needs, in static memory (the two macros
+        // declare static arrays): no heap, no stack arrays.
+        let mut st = scene_storage!();
+        let image = buffer!(u8 = 0; scene::IMAGE_LEN);
         match super::example(&mut st, image) {
             Ok((built, shown)) => {
                 println!("example: {built:?}");
@@ -74,20 +54,12 @@ mod firmware {
 
 #[cfg(not(target_os = "none"))]
 fn main() -> std::process::ExitCode {
-    use rrt_core::object_table::Object;
     use std::io::Write;
     let Some(path) = std::env::args_os().nth(1) else {
         eprintln!("usage: example OUTPUT.ppm");
         return std::process::ExitCode::FAILURE;
     };
-    let mut st = Storage {
-        plane: &mut vec![0; scene::PLANE_LEN],
-        lines: &mut vec![0; scene::LINES_LEN],
-        dir: &mut vec![0; scene::DIR_LEN],
-        records: &mut vec![scene::RECORD_INIT; scene::MAX_RECORDS],
-        objects: &mut vec![Object::UNUSED; scene::MAX_OBJECTS],
-        patches: &mut [scene::PATCH_INIT],
-    };
+    let mut st = rrt_on_target::scene_storage!();
     let mut image = vec![0; scene::IMAGE_LEN];
     match example(&mut st, &mut image) {
         Ok((built, shown)) => {

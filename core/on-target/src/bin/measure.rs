@@ -9,33 +9,12 @@
 #[cfg(target_os = "none")]
 mod firmware {
     use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
-    use rrt_core::geometry::BezierPatch;
-    use rrt_core::object_table::Object;
     use rrt_core::packet::{LANES, RayPacket8};
     use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
     use rrt_core::raster::{Raster, RasterMut};
-    use rrt_core::voxel::VoxelRecord;
     use rrt_on_target::firmware::{exit, println, stack_use, systick};
     use rrt_on_target::rays::{Spec, spec};
-    use rrt_on_target::{bench, scene, take, traversal};
-
-    static mut RAY_PLANE: [u8; traversal::PLANE_LEN] = [0; traversal::PLANE_LEN];
-    static mut RAY_LINES: [u8; traversal::LINES_LEN] = [0; traversal::LINES_LEN];
-    static mut COPY: [u8; traversal::PLANE_LEN] = [0; traversal::PLANE_LEN];
-    static mut PLANE: [u8; scene::PLANE_LEN] = [0; scene::PLANE_LEN];
-    static mut LINES: [u8; scene::LINES_LEN] = [0; scene::LINES_LEN];
-    static mut DIR: [u32; scene::DIR_LEN] = [0; scene::DIR_LEN];
-    static mut RECORDS: [VoxelRecord; scene::MAX_RECORDS] =
-        [scene::RECORD_INIT; scene::MAX_RECORDS];
-    static mut OBJECTS: [Object; scene::MAX_OBJECTS] = [Object::UNUSED; scene::MAX_OBJECTS];
-    static mut PATCHES: [BezierPatch; 1] = [scene::PATCH_INIT];
-    static mut IMAGE: [u8; scene::IMAGE_LEN] = [0; scene::IMAGE_LEN];
-    static mut SPECS: [Spec; traversal::RAYS as usize] = [Spec::Half {
-        origin: [0; 3],
-        dir: [0; 3],
-    }; traversal::RAYS as usize];
-    static mut CAMERA: [([i64; 3], [i32; 3]); scene::SIZE * scene::SIZE] =
-        [([0; 3], [0; 3]); scene::SIZE * scene::SIZE];
+    use rrt_on_target::{bench, buffer, scene, scene_storage, traversal};
 
     /// Free stack painted per measurement.
     const WINDOW: usize = 64 * 1024;
@@ -53,8 +32,8 @@ mod firmware {
 
     #[cortex_m_rt::entry]
     fn main() -> ! {
-        let plane = take!(RAY_PLANE);
-        let lines = take!(RAY_LINES);
+        let plane = buffer!(u8 = 0; traversal::PLANE_LEN);
+        let lines = buffer!(u8 = 0; traversal::LINES_LEN);
         if traversal::fill_raster(plane, lines).is_err() {
             exit(2);
         }
@@ -70,45 +49,43 @@ mod firmware {
         let n = 1_000_000;
         let cal = systick::calibrate(n);
         println!("calibration {} {}", 2 * u64::from(n), cal);
-        let specs = take!(SPECS);
+        const NO_SPEC: Spec = Spec::Half {
+            origin: [0; 3],
+            dir: [0; 3],
+        };
+        let specs = buffer!(Spec = NO_SPEC; traversal::RAYS as usize);
         bench::specs(&raster, specs);
         let t = systick::ticks();
         let rays = core::hint::black_box(bench::setup(&raster, specs));
         println!("insns setup {} {}", systick::ticks() - t, rays);
         for mode in Connectivity::ALL {
-            let t = systick::ticks();
-            let steps = core::hint::black_box(bench::walk(&raster, specs, mode));
-            println!(
-                "insns walk.{} {} {}",
-                mode_name(mode),
-                systick::ticks() - t,
-                steps
-            );
-            let t = systick::ticks();
-            let steps = core::hint::black_box(bench::packet(&raster, specs, mode));
-            println!(
-                "insns packet.{} {} {}",
-                mode_name(mode),
-                systick::ticks() - t,
-                steps
-            );
+            for (name, f) in [
+                (
+                    "walk",
+                    bench::walk as fn(&Raster<'_>, &[Spec], Connectivity) -> u64,
+                ),
+                ("packet", bench::packet),
+            ] {
+                let t = systick::ticks();
+                let steps = core::hint::black_box(f(&raster, specs, mode));
+                println!(
+                    "insns {}.{} {} {}",
+                    name,
+                    mode_name(mode),
+                    systick::ticks() - t,
+                    steps
+                );
+            }
         }
         // The camera rays through the integrator's scene, scalar and packets.
-        let mut st = scene::Storage {
-            plane: take!(PLANE),
-            lines: take!(LINES),
-            dir: take!(DIR),
-            records: take!(RECORDS),
-            objects: take!(OBJECTS),
-            patches: take!(PATCHES),
-        };
+        let mut st = scene_storage!();
         if scene::build(&mut st).is_err() {
             exit(3);
         }
         let Ok(shown) = scene::extent().and_then(|e| Raster::new(e, st.plane)) else {
             exit(3)
         };
-        let cam = take!(CAMERA);
+        let cam = buffer!(([i64; 3], [i32; 3]) = ([0; 3], [0; 3]); scene::SIZE * scene::SIZE);
         bench::camera(cam);
         for (name, f) in [
             (
@@ -172,7 +149,7 @@ mod firmware {
             }
             first += LANES as u64;
         }
-        let copy = take!(COPY);
+        let copy = buffer!(u8 = 0; traversal::PLANE_LEN);
         copy.copy_from_slice(raster.plane());
         if let Ok(mut r) = RasterMut::new(e, copy) {
             let (_, b) = stack_use(WINDOW, || flag_neighbourhood(&mut r));
@@ -192,7 +169,7 @@ mod firmware {
             worst.note(name, b);
         });
         let Ok(built) = built else { exit(3) };
-        let image = take!(IMAGE);
+        let image = buffer!(u8 = 0; scene::IMAGE_LEN);
         let records = st.records.get(..built.records).unwrap_or(&[]);
         let (_, b) = stack_use(WINDOW, || {
             scene::render(st.plane, st.lines, st.dir, records, image)
@@ -245,14 +222,7 @@ fn main() -> std::process::ExitCode {
     let Ok(raster) = traversal::extent().and_then(|e| Raster::new(e, &plane)) else {
         return std::process::ExitCode::FAILURE;
     };
-    let mut st = scene::Storage {
-        plane: &mut vec![0; scene::PLANE_LEN],
-        lines: &mut vec![0; scene::LINES_LEN],
-        dir: &mut vec![0; scene::DIR_LEN],
-        records: &mut vec![scene::RECORD_INIT; scene::MAX_RECORDS],
-        objects: &mut vec![rrt_core::object_table::Object::UNUSED; scene::MAX_OBJECTS],
-        patches: &mut [scene::PATCH_INIT],
-    };
+    let mut st = rrt_on_target::scene_storage!();
     if let Err(e) = scene::build(&mut st) {
         eprintln!("measure: {e:?}");
         return std::process::ExitCode::FAILURE;

@@ -20,15 +20,7 @@ include!("size/common.rs");
 
 static mut PLANE: [u8; 16384] = [0; 16384];
 static mut DIR: [u32; 65] = [0; 65];
-static mut RECORDS: [VoxelRecord; 1024] = [VoxelRecord {
-    object: 0,
-    normal: [0; 2],
-    color: [0; 3],
-    illum: [0; 3],
-    lights: 0,
-    material: 0,
-    key: 0,
-}; 1024];
+static mut RECORDS: [VoxelRecord; 1024] = [bytemuck::zeroed(); 1024];
 static mut OBJECTS: [Object; 4] = [Object::UNUSED; 4];
 static mut SAMPLES: [u16; 64] = [0; 64];
 

@@ -87,67 +87,76 @@ impl Mapping {
     /// # Errors
     /// [`TextureError::Invalid`] naming the parameter.
     pub fn validate(&self) -> Result<(), TextureError> {
-        let finite = |name: &'static str, v: DVec3| {
-            if v.is_finite() {
-                Ok(())
-            } else {
-                Err(invalid(name, format!("{v} is not finite")))
+        for (name, v) in self.named_vectors() {
+            if !v.is_finite() {
+                return Err(invalid(name, format!("{v} is not finite")));
             }
+        }
+        let usable = match *self {
+            Self::Planar { u_axis, v_axis, .. } => {
+                if u_axis.length_squared() == 0.0 || v_axis.length_squared() == 0.0 {
+                    Err("the u and v axes must be non-zero")
+                } else if u_axis.cross(v_axis).length() <= 1e-12 * u_axis.length() * v_axis.length()
+                {
+                    Err("the u and v axes are parallel")
+                } else {
+                    Ok(())
+                }
+            }
+            Self::Cylindrical {
+                axis, reference, ..
+            } => frame_of(axis, reference)
+                .map(|_| ())
+                .ok_or("the axis must be non-zero and the reference not along it"),
+            Self::Spherical {
+                pole, reference, ..
+            } => frame_of(pole, reference)
+                .map(|_| ())
+                .ok_or("the pole must be non-zero and the reference not along it"),
         };
+        usable.map_err(|why| invalid(self.name(), why.into()))
+    }
+
+    /// The mapping's kind, as its parameters are named.
+    fn name(&self) -> &'static str {
+        match self {
+            Self::Planar { .. } => "planar mapping",
+            Self::Cylindrical { .. } => "cylindrical mapping",
+            Self::Spherical { .. } => "spherical mapping",
+        }
+    }
+
+    /// The mapping's vectors, each with its parameter's name.
+    fn named_vectors(&self) -> [(&'static str, DVec3); 3] {
         match *self {
             Self::Planar {
                 origin,
                 u_axis,
                 v_axis,
-            } => {
-                finite("planar mapping origin", origin)?;
-                finite("planar mapping u axis", u_axis)?;
-                finite("planar mapping v axis", v_axis)?;
-                if u_axis.length_squared() == 0.0 || v_axis.length_squared() == 0.0 {
-                    return Err(invalid(
-                        "planar mapping",
-                        "the u and v axes must be non-zero".into(),
-                    ));
-                }
-                if u_axis.cross(v_axis).length() <= 1e-12 * u_axis.length() * v_axis.length() {
-                    return Err(invalid(
-                        "planar mapping",
-                        "the u and v axes are parallel".into(),
-                    ));
-                }
-            }
+            } => [
+                ("planar mapping origin", origin),
+                ("planar mapping u axis", u_axis),
+                ("planar mapping v axis", v_axis),
+            ],
             Self::Cylindrical {
                 origin,
                 axis,
                 reference,
-            } => {
-                finite("cylindrical mapping origin", origin)?;
-                finite("cylindrical mapping axis", axis)?;
-                finite("cylindrical mapping reference", reference)?;
-                if frame_of(axis, reference).is_none() {
-                    return Err(invalid(
-                        "cylindrical mapping",
-                        "the axis must be non-zero and the reference not along it".into(),
-                    ));
-                }
-            }
+            } => [
+                ("cylindrical mapping origin", origin),
+                ("cylindrical mapping axis", axis),
+                ("cylindrical mapping reference", reference),
+            ],
             Self::Spherical {
                 centre,
                 pole,
                 reference,
-            } => {
-                finite("spherical mapping centre", centre)?;
-                finite("spherical mapping pole", pole)?;
-                finite("spherical mapping reference", reference)?;
-                if frame_of(pole, reference).is_none() {
-                    return Err(invalid(
-                        "spherical mapping",
-                        "the pole must be non-zero and the reference not along it".into(),
-                    ));
-                }
-            }
+            } => [
+                ("spherical mapping centre", centre),
+                ("spherical mapping pole", pole),
+                ("spherical mapping reference", reference),
+            ],
         }
-        Ok(())
     }
 
     /// Texture coordinates of world point `p` (before scale, offset and

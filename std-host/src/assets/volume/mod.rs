@@ -34,7 +34,7 @@
 //! returns `None`).
 
 use std::fmt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DVec3};
 
@@ -642,6 +642,41 @@ pub enum VolumeError {
         /// What is wrong.
         msg: String,
     },
+}
+
+impl VolumeError {
+    /// [`VolumeError::Io`] on `path`, for `map_err`.
+    pub(crate) fn io(path: &Path) -> impl Fn(std::io::Error) -> Self + Copy + '_ {
+        move |source| Self::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// [`VolumeError::Header`] at line `line` of `path`.
+    pub(crate) fn header(path: &Path, line: usize, msg: String) -> Self {
+        Self::Header {
+            path: path.to_path_buf(),
+            line,
+            msg,
+        }
+    }
+
+    /// [`VolumeError::Data`] at byte `offset` of `path`.
+    pub(crate) fn data(path: &Path, offset: u64, msg: String) -> Self {
+        Self::Data {
+            path: path.to_path_buf(),
+            offset,
+            msg,
+        }
+    }
+
+    /// `path` opened, and its length.
+    pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), Self> {
+        let file = std::fs::File::open(path).map_err(Self::io(path))?;
+        let len = file.metadata().map_err(Self::io(path))?.len();
+        Ok((file, len))
+    }
 }
 
 /// Checks `dims` × `ty` against `limits` before allocating.

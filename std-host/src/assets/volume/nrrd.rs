@@ -100,21 +100,13 @@ pub struct Header {
 /// fault (module docs).
 pub fn read(path: impl AsRef<Path>, limits: &Limits) -> Result<Volume, VolumeError> {
     let path = path.as_ref();
-    let io = |source| VolumeError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = File::open(path).map_err(io)?;
-    let len = file.metadata().map_err(io)?.len();
+    let (file, len) = VolumeError::open(path)?;
     let mut reader = BufReader::new(file);
     let header = parse_header(path, &mut reader, limits, true)?;
     match &header.data_file {
         None => decode(path, &mut reader, header.header_bytes, len, &header, limits),
         Some(data) => {
-            let dio = |source| VolumeError::Io {
-                path: data.clone(),
-                source,
-            };
+            let dio = VolumeError::io(data);
             let f = File::open(data).map_err(dio)?;
             let dlen = f.metadata().map_err(dio)?.len();
             decode(data, &mut BufReader::new(f), 0, dlen, &header, limits)
@@ -141,10 +133,7 @@ pub fn parse_bytes(name: &str, bytes: &[u8], limits: &Limits) -> Result<Volume, 
 /// As [`read`], for the header.
 pub fn read_header(path: impl AsRef<Path>, limits: &Limits) -> Result<Header, VolumeError> {
     let path = path.as_ref();
-    let file = File::open(path).map_err(|source| VolumeError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let file = File::open(path).map_err(VolumeError::io(path))?;
     parse_header(path, &mut BufReader::new(file), limits, true)
 }
 
@@ -231,11 +220,7 @@ fn parse_header<R: BufRead>(
     limits: &Limits,
     may_open_files: bool,
 ) -> Result<Header, VolumeError> {
-    let herr = |line: usize, msg: String| VolumeError::Header {
-        path: path.to_path_buf(),
-        line,
-        msg,
-    };
+    let herr = |line, msg| VolumeError::header(path, line, msg);
     let mut consumed: u64 = 0;
     let mut lineno = 0usize;
     let mut buf = Vec::new();
@@ -249,10 +234,7 @@ fn parse_header<R: BufRead>(
             .by_ref()
             .take(room.saturating_add(1))
             .read_until(b'\n', &mut buf)
-            .map_err(|source| VolumeError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
+            .map_err(VolumeError::io(path))?;
         if n == 0 {
             break;
         }
@@ -373,11 +355,7 @@ fn build_header(
     may_open_files: bool,
     limits: &Limits,
 ) -> Result<Header, VolumeError> {
-    let herr = |line: usize, msg: String| VolumeError::Header {
-        path: path.to_path_buf(),
-        line,
-        msg,
-    };
+    let herr = |line, msg| VolumeError::header(path, line, msg);
     let missing = |field: &'static str, hint: &'static str| VolumeError::Missing {
         path: path.to_path_buf(),
         field,
@@ -385,12 +363,12 @@ fn build_header(
     };
 
     if !ended && fields.get("data file").is_none() {
-        return Err(VolumeError::Data {
-            path: path.to_path_buf(),
-            offset: header_bytes,
-            msg: "the header has no empty line ending it and no `data file`: truncated, or no data"
+        return Err(VolumeError::data(
+            path,
+            header_bytes,
+            "the header has no empty line ending it and no `data file`: truncated, or no data"
                 .into(),
-        });
+        ));
     }
     let ty = fields.get("type").ok_or_else(|| missing("type", ""))?;
     let sample_type = parse_type(&ty.value).map_err(|m| herr(ty.line, m))?;
@@ -434,11 +412,11 @@ fn build_header(
     };
     if data_file.is_none() && !ended {
         // `data file: LOCAL` without the empty line.
-        return Err(VolumeError::Data {
-            path: path.to_path_buf(),
-            offset: header_bytes,
-            msg: "the header has no empty line ending it: truncated, or no data".into(),
-        });
+        return Err(VolumeError::data(
+            path,
+            header_bytes,
+            "the header has no empty line ending it: truncated, or no data".into(),
+        ));
     }
     Ok(Header {
         version,
@@ -800,15 +778,8 @@ fn decode<R: BufRead>(
         header.sample_type,
         limits,
     )?;
-    let derr = |offset: u64, msg: String| VolumeError::Data {
-        path: path.to_path_buf(),
-        offset,
-        msg,
-    };
-    let io = |source| VolumeError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+    let derr = |offset, msg| VolumeError::data(path, offset, msg);
+    let io = VolumeError::io(path);
     let mut pos = start;
     for n in 0..header.line_skip {
         let skipped = reader.skip_until(b'\n').map_err(io)?;
@@ -824,6 +795,16 @@ fn decode<R: BufRead>(
         pos = pos.saturating_add(u64::try_from(skipped).unwrap_or(u64::MAX));
     }
     let need = sample_count_bytes(header);
+    // Skips `skip` bytes of the data at `pos`: the position after them.
+    let skip_data = |reader: &mut R, pos: u64, skip: u64| {
+        skip_bytes(reader, skip).map_err(|got| {
+            derr(
+                pos.saturating_add(got),
+                format!("byte skip: the data end after {got} of {skip} bytes"),
+            )
+        })?;
+        Ok::<_, VolumeError>(pos.saturating_add(skip))
+    };
     let samples = match header.encoding {
         Encoding::Raw => {
             let skip = if header.byte_skip == -1 {
@@ -842,18 +823,9 @@ fn decode<R: BufRead>(
             } else {
                 u64::try_from(header.byte_skip).unwrap_or(0)
             };
-            skip_bytes(reader, skip).map_err(|got| {
-                derr(
-                    pos.saturating_add(got),
-                    format!("byte skip: the data end after {got} of {skip} bytes"),
-                )
-            })?;
-            pos = pos.saturating_add(skip);
+            pos = skip_data(reader, pos, skip)?;
             let s = read_binary(reader, header, count).map_err(|e| match e {
-                ReadFail::Io(source) => VolumeError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                },
+                ReadFail::Io(source) => VolumeError::io(path)(source),
                 ReadFail::Short(got) => derr(
                     pos.saturating_add(got),
                     format!(
@@ -916,13 +888,7 @@ fn decode<R: BufRead>(
         }
         Encoding::Ascii => {
             let skip = u64::try_from(header.byte_skip).unwrap_or(0);
-            skip_bytes(reader, skip).map_err(|got| {
-                derr(
-                    pos.saturating_add(got),
-                    format!("byte skip: the data end after {got} of {skip} bytes"),
-                )
-            })?;
-            pos = pos.saturating_add(skip);
+            pos = skip_data(reader, pos, skip)?;
             read_ascii(path, reader, pos, header, count)?
         }
     };
@@ -931,11 +897,7 @@ fn decode<R: BufRead>(
         None => (Grid::unit(), false),
     };
     Ok(Volume::new(header.dims, grid, samples)
-        .map_err(|e| VolumeError::Header {
-            path: path.to_path_buf(),
-            line: header.sizes_line,
-            msg: e.to_string(),
-        })?
+        .map_err(|e| VolumeError::header(path, header.sizes_line, e.to_string()))?
         .with_geometry_known(known))
 }
 
@@ -1006,11 +968,7 @@ fn read_ascii<R: BufRead>(
     header: &Header,
     count: usize,
 ) -> Result<Samples, VolumeError> {
-    let derr = |offset: u64, msg: String| VolumeError::Data {
-        path: path.to_path_buf(),
-        offset,
-        msg,
-    };
+    let derr = |offset, msg| VolumeError::data(path, offset, msg);
     let ty = header.sample_type;
     let mut out = match ty {
         SampleType::U8 => Samples::U8(Vec::with_capacity(count)),
@@ -1028,10 +986,7 @@ fn read_ascii<R: BufRead>(
             None => None,
             Some(Ok(b)) => Some(b),
             Some(Err(source)) => {
-                return Err(VolumeError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                });
+                return Err(VolumeError::io(path)(source));
             }
         };
         let sep = b.is_none_or(|b| b.is_ascii_whitespace() || b == b',');
@@ -1108,10 +1063,7 @@ fn int_fit<T: TryFrom<i64>>(x: f64) -> Option<T> {
 pub fn write(path: impl AsRef<Path>, volume: &Volume, gzip: bool) -> Result<(), VolumeError> {
     let path = path.as_ref();
     let bytes = to_bytes(volume, gzip);
-    std::fs::write(path, bytes).map_err(|source| VolumeError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    std::fs::write(path, bytes).map_err(VolumeError::io(path))
 }
 
 /// The bytes of [`write()`].

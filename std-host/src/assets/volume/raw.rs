@@ -16,7 +16,6 @@
 //! # Ok::<(), rrt_host::assets::volume::VolumeError>(())
 //! ```
 
-use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::Path;
 
@@ -51,12 +50,7 @@ pub fn read(
     limits: &Limits,
 ) -> Result<Volume, VolumeError> {
     let path = path.as_ref();
-    let io = |source| VolumeError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = File::open(path).map_err(io)?;
-    let len = file.metadata().map_err(io)?.len();
+    let (file, len) = VolumeError::open(path)?;
     decode(path, BufReader::new(file), len, spec, limits)
 }
 
@@ -124,16 +118,9 @@ fn decode<R: Read>(
                 ),
             )
         };
-        return Err(VolumeError::Data {
-            path: path.to_path_buf(),
-            offset,
-            msg,
-        });
+        return Err(VolumeError::data(path, offset, msg));
     }
-    let io = |source| VolumeError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+    let io = VolumeError::io(path);
     std::io::copy(&mut reader.by_ref().take(spec.skip), &mut std::io::sink()).map_err(io)?;
     let samples = Samples::read_binary(spec.sample_type, spec.endian, count, |buf| {
         reader.read_exact(buf).map_err(io)
