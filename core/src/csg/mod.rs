@@ -36,6 +36,7 @@
 //! linear in the volume of the box, as the paper's voxblt is.
 
 use core::fmt;
+use core::ops::Range;
 
 use crate::fixed::{HALF_VOXEL, VOXEL, voxel_centre};
 use crate::geometry::{Cone, Cuboid, Point, Sphere, Torus, UnitVector};
@@ -555,6 +556,12 @@ pub trait CsgSink {
     /// Voxel `voxel` of the result's boundary layer, whose surface is
     /// formed there by leaf `leaf`.
     fn offer_leaf(&mut self, leaf: u16, voxel: [u32; 3], surfel: Surfel);
+
+    /// The layers whose voxels the sink keeps, as
+    /// [`VoxelSink::layers`]: [`voxelize`] classifies only those.
+    fn layers(&self) -> Range<u32> {
+        0..u32::MAX
+    }
 }
 
 /// Adapts any [`VoxelSink`] (a [`crate::store::Counter`], a test set) to
@@ -565,6 +572,10 @@ pub struct IgnoreLeaf<'s, S: VoxelSink>(pub &'s mut S);
 impl<S: VoxelSink> CsgSink for IgnoreLeaf<'_, S> {
     fn offer_leaf(&mut self, _leaf: u16, voxel: [u32; 3], surfel: Surfel) {
         self.0.offer(voxel, surfel);
+    }
+
+    fn layers(&self) -> Range<u32> {
+        self.0.layers()
     }
 }
 
@@ -616,6 +627,10 @@ impl CsgSink for LeafFill<'_, '_, '_, '_> {
             self.filler.offer(voxel, surfel);
         }
     }
+
+    fn layers(&self) -> Range<u32> {
+        self.filler.layers()
+    }
 }
 
 /// What [`voxelize`] did.
@@ -630,10 +645,13 @@ pub struct CsgReport {
 }
 
 /// Voxel range `[lo, hi]` covering fixed-point interval `[a, b]`, clipped
-/// to `0..n`; `None` if empty.
-fn voxel_range(a: i64, b: i64, n: u32) -> Option<(u32, u32)> {
-    let top = i64::from(n).checked_sub(1)?;
-    let lo = a.saturating_sub(HALF_VOXEL).div_euclid(VOXEL).max(0);
+/// to `start..end`; `None` if empty.
+fn voxel_range(a: i64, b: i64, (start, end): (u32, u32)) -> Option<(u32, u32)> {
+    let top = i64::from(end).checked_sub(1)?;
+    let lo = a
+        .saturating_sub(HALF_VOXEL)
+        .div_euclid(VOXEL)
+        .max(i64::from(start));
     let hi = b.saturating_add(HALF_VOXEL).div_euclid(VOXEL).min(top);
     if lo > hi {
         return None;
@@ -653,11 +671,14 @@ pub fn voxelize(tree: &CsgTree<'_>, extent: Extent, sink: &mut impl CsgSink) -> 
     let Some((lo, hi)) = tree.bounds() else {
         return report;
     };
-    let dims = extent.dims();
+    let [nx, ny, nz] = extent.dims();
+    let layers = sink.layers();
+    let z_end = layers.end.min(nz);
+    let win = [(0, nx), (0, ny), (layers.start.min(z_end), z_end)];
     let mut range = [(0u32, 0u32); 3];
     for k in 0..3 {
         let (Some(a), Some(b), Some(n), Some(slot)) =
-            (lo.get(k), hi.get(k), dims.get(k), range.get_mut(k))
+            (lo.get(k), hi.get(k), win.get(k), range.get_mut(k))
         else {
             return report;
         };

@@ -1,6 +1,8 @@
 //! The two-pass scene builder: the count pass sizes the records, the fill
 //! pass writes them (see the [module docs](super)).
 
+use core::ops::Range;
+
 use super::brick::{BRICK, BRICK_VOXELS, brick_of, directory_len};
 use super::error::BuildError;
 use super::list::{MAX_LIST_ENTRIES, list_index};
@@ -8,7 +10,7 @@ use super::proximity::{DENSE_RATIO, flag_proximity};
 use super::rank_hint::set_opaque_cells;
 use super::texture::Texture;
 use super::{RecordStore, RecordStoreMut};
-use crate::raster::{Raster, RasterMut, cell, to_usize};
+use crate::raster::{Extent, Raster, RasterMut, cell, to_usize};
 use crate::voxel::{
     KEY_POSITION_MASK, MAX_OBJECTS, OBJECT_LIST, VoxelRecord, encode_normal, make_key,
 };
@@ -199,7 +201,18 @@ fn cell_of<'r>(
     found
 }
 
+/// The layers of the larger raster that a raster of `extent` holds as a
+/// slab starting at layer `slab` (all of it for a whole raster).
+fn layers_of(extent: Extent, slab: Option<u32>) -> Range<u32> {
+    let z0 = slab.unwrap_or(0);
+    z0..z0.saturating_add(extent.dims()[2])
+}
+
 impl VoxelSink for Counter<'_, '_> {
+    fn layers(&self) -> Range<u32> {
+        layers_of(self.raster.extent(), self.slab)
+    }
+
     fn offer(&mut self, voxel: [u32; 3], _surfel: Surfel) {
         self.report.offers = self.report.offers.saturating_add(1);
         let outside = &mut self.report.outside;
@@ -848,6 +861,10 @@ impl VoxelSink for Filler<'_, '_, '_> {
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel) {
         self.put::<dyn Texture>(voxel, surfel, None);
     }
+
+    fn layers(&self) -> Range<u32> {
+        layers_of(self.raster.extent(), self.slab)
+    }
 }
 
 /// A fill-pass sink that colours voxels with a [`Texture`]
@@ -861,6 +878,10 @@ pub struct Textured<'s, 'p, 'd, 'r, T: Texture> {
 impl<T: Texture> VoxelSink for Textured<'_, '_, '_, '_, T> {
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel) {
         self.filler.put(voxel, surfel, Some(self.texture));
+    }
+
+    fn layers(&self) -> Range<u32> {
+        self.filler.layers()
     }
 }
 

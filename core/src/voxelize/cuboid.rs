@@ -34,7 +34,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, cell_floor, centre, centres_within, check_point, clip, dist_u32, length, split,
-    sub, unit,
+    sub, unit, window,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Cuboid;
@@ -79,7 +79,7 @@ fn scan<S: VoxelSink + ?Sized>(
 ) -> Result<u64, VoxelizeError> {
     let bx = BoxTies::new(b)?;
     let (lo, hi) = (bx.lo, bx.hi);
-    let dims = extent.dims();
+    let win = window(extent, sink.layers());
     let mut n = Counter::default();
     // Candidate cells along one axis: TwentySix exactly (half-open per the
     // tie rule); Six closed within the L1 budget left by the other axes,
@@ -93,7 +93,8 @@ fn scan<S: VoxelSink + ?Sized>(
         }
     };
     let (yl, yh) = range(1, H);
-    let Some((y0, y1)) = clip(yl, yh, dims[1]) else {
+    let (zl, zh) = range(2, H);
+    let (Some((y0, y1)), Some(_)) = (clip(yl, yh, win[1]), clip(zl, zh, win[2])) else {
         return Ok(0);
     };
     let (sy0, sy1) = bx.strict(1);
@@ -102,7 +103,7 @@ fn scan<S: VoxelSink + ?Sized>(
     for y in y0..=y1 {
         let dy = out_dist(lo[1], hi[1], centre(y));
         let (xl, xh) = range(0, H.saturating_sub(dy));
-        let Some((x0, x1)) = clip(xl, xh, dims[0]) else {
+        let Some((x0, x1)) = clip(xl, xh, win[0]) else {
             continue;
         };
         let yi = i128::from(y);
@@ -113,7 +114,7 @@ fn scan<S: VoxelSink + ?Sized>(
                 continue;
             }
             let (zl, zh) = range(2, budget);
-            let Some((z0, z1)) = clip(zl, zh, dims[2]) else {
+            let Some((z0, z1)) = clip(zl, zh, win[2]) else {
                 continue;
             };
             let xi = i128::from(x);

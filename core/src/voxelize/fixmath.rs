@@ -7,7 +7,10 @@
 
 use super::NORMAL_ONE;
 use super::error::{COORD_LIMIT, VoxelizeError};
+use core::ops::Range;
+
 use crate::fixed::{FRAC_BITS, HALF_VOXEL, VOXEL};
+use crate::raster::Extent;
 
 /// One voxel in fixed units, as `i128`.
 pub(crate) const V: i128 = VOXEL as i128;
@@ -72,11 +75,21 @@ pub(crate) const fn centres_within(a: i128, b: i128) -> (i128, i128) {
     )
 }
 
-/// Intersects the cell range `lo ..= hi` with the raster axis `0 .. n`.
+/// The cells a voxelizer scans along each axis, `start .. end`: the
+/// raster's, along z only the layers the sink keeps
+/// ([`VoxelSink::layers`](super::VoxelSink::layers)).
+pub(crate) fn window(extent: Extent, layers: Range<u32>) -> [(u32, u32); 3] {
+    let [nx, ny, nz] = extent.dims();
+    let end = layers.end.min(nz);
+    [(0, nx), (0, ny), (layers.start.min(end), end)]
+}
+
+/// Intersects the cell range `lo ..= hi` with the cells `start .. end` of
+/// an axis (of a [`window`]).
 #[inline]
-pub(crate) fn clip(lo: i128, hi: i128, n: u32) -> Option<(u32, u32)> {
-    let lo = lo.max(0);
-    let hi = hi.min(i128::from(n).saturating_sub(1));
+pub(crate) fn clip(lo: i128, hi: i128, (start, end): (u32, u32)) -> Option<(u32, u32)> {
+    let lo = lo.max(i128::from(start));
+    let hi = hi.min(i128::from(end).saturating_sub(1));
     if lo > hi {
         return None;
     }
@@ -324,8 +337,13 @@ mod tests {
         assert_eq!(cells_overlapping(V + 1, 2 * V - 1), (1, 1));
         assert_eq!(centres_within(0, V), (0, 0));
         assert_eq!(centres_within(H + 1, V + H - 1), (1, 0));
-        assert_eq!(clip(-5, 3, 2), Some((0, 1)));
-        assert_eq!(clip(4, 9, 2), None);
+        assert_eq!(clip(-5, 3, (0, 2)), Some((0, 1)));
+        assert_eq!(clip(4, 9, (0, 2)), None);
+        assert_eq!(clip(-5, 9, (3, 5)), Some((3, 4)));
+        let e = Extent::new(4, 5, 6).unwrap();
+        assert_eq!(window(e, 0..u32::MAX), [(0, 4), (0, 5), (0, 6)]);
+        assert_eq!(window(e, 2..4), [(0, 4), (0, 5), (2, 4)]);
+        assert_eq!(clip(0, 9, window(e, 8..16)[2]), None);
     }
 
     #[test]

@@ -41,6 +41,19 @@
 //! Every voxelizer does work linear in the number of voxels it generates
 //! (plus a term linear in the object's extent along one axis), never in the
 //! raster volume or the object's bounding-box volume.
+//!
+//! # Layers
+//! A sink may keep only some layers of the raster ([`VoxelSink::layers`]:
+//! a builder working on one z-slab of it). Every voxelizer then offers the
+//! voxels of those layers exactly as it would without the hint, in the
+//! same order, and the spheres, triangles, meshes, tessellated surfaces
+//! (cones, tori, patches), boxes, volumes and CSG trees
+//! ([`crate::csg::voxelize`]) skip the work for the other layers, so that
+//! cutting a raster into slabs costs about what the whole raster does.
+//! Other voxelizers may still offer voxels outside the layers, which the
+//! sink drops.
+
+use core::ops::Range;
 
 use crate::connectivity::Connectivity;
 
@@ -94,6 +107,15 @@ pub trait VoxelSink {
     /// voxel more than once; the sink keeps the offer with the smallest
     /// distance.
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel);
+
+    /// The layers (z coordinates) whose voxels the sink keeps; every layer
+    /// unless the sink says otherwise. A hint that lets a voxelizer skip
+    /// the work for the other layers (see *Layers* in the
+    /// [module docs](self)): the offers inside them are the same, in the
+    /// same order, as without it, and offers outside them may still come.
+    fn layers(&self) -> Range<u32> {
+        0..u32::MAX
+    }
 }
 
 pub mod cone;
@@ -107,3 +129,6 @@ mod tessellate;
 pub mod torus;
 pub mod triangle;
 pub mod volume;
+
+#[cfg(test)]
+mod tests;

@@ -63,7 +63,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, V, ceil_sqrt, cell_floor, cells_overlapping, centre, centres_within, check_point,
-    clip, dist_u32, isqrt, radial, split, sub,
+    clip, dist_u32, isqrt, radial, split, sub, window,
 };
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Sphere;
@@ -108,7 +108,7 @@ fn shell<S: VoxelSink + ?Sized>(
     sink: &mut S,
     fill: bool,
 ) -> Result<u64, VoxelizeError> {
-    let b = Ball::new(sphere, extent)?;
+    let b = Ball::new(sphere, window(extent, sink.layers()))?;
     let mut n = Counter::default();
     match separation {
         Separation::TwentySix => b.twenty_six(sink, &mut n, fill),
@@ -185,11 +185,12 @@ struct Ball {
     c: [i128; 3],
     r: i128,
     r2: i128,
-    dims: [u32; 3],
+    /// The cells scanned along each axis ([`window`]).
+    win: [(u32, u32); 3],
 }
 
 impl Ball {
-    fn new(s: &Sphere, extent: Extent) -> Result<Self, VoxelizeError> {
+    fn new(s: &Sphere, win: [(u32, u32); 3]) -> Result<Self, VoxelizeError> {
         let c = check_point(s.centre)?;
         let r = radius(s.radius)?;
         // r ≤ 2^40: r² ≤ 2^80.
@@ -197,7 +198,7 @@ impl Ball {
             c,
             r,
             r2: r.saturating_mul(r),
-            dims: extent.dims(),
+            win,
         })
     }
 
@@ -225,7 +226,7 @@ impl Ball {
     fn twenty_six<S: VoxelSink + ?Sized>(&self, sink: &mut S, n: &mut Counter, fill: bool) {
         const K: usize = 0;
         let (ca, cb, ck) = pick(K, self.c);
-        let (na, nb, nk) = pick(K, self.dims);
+        let (na, nb, nk) = pick(K, self.win);
         let (bl, bh) = cells_overlapping(cb.saturating_sub(self.r), cb.saturating_add(self.r));
         let Some((b0, b1)) = clip(bl, bh, nb) else {
             return;
@@ -295,7 +296,7 @@ impl Ball {
     #[inline(always)]
     fn centre_columns(&self, k: usize, mut f: impl FnMut(u32, u32, i128, i128, i128)) {
         let (ca, cb, _) = pick(k, self.c);
-        let (na, nb, _) = pick(k, self.dims);
+        let (na, nb, _) = pick(k, self.win);
         let (bl, bh) = centres_within(cb.saturating_sub(self.r), cb.saturating_add(self.r));
         let Some((b0, b1)) = clip(bl, bh, nb) else {
             return;
@@ -324,7 +325,7 @@ impl Ball {
     /// Six shell, the voxels found along centre lines parallel to `k`.
     fn six_axis<S: VoxelSink + ?Sized>(&self, k: usize, sink: &mut S, n: &mut Counter) {
         let (_, _, ck) = pick(k, self.c);
-        let (_, _, nk) = pick(k, self.dims);
+        let (_, _, nk) = pick(k, self.win);
         self.centre_columns(k, |ai, bi, _, _, d| {
             let s = isqrt(d);
             let exact = s.saturating_mul(s) == d;
@@ -369,7 +370,7 @@ impl Ball {
     fn six_interior<S: VoxelSink + ?Sized>(&self, sink: &mut S, n: &mut Counter) {
         const K: usize = 0;
         let (_, _, ck) = pick(K, self.c);
-        let (_, _, nk) = pick(K, self.dims);
+        let (_, _, nk) = pick(K, self.win);
         self.centre_columns(K, |ai, bi, da, db, ek| {
             let sk = isqrt(ek);
             let (kl, kh) = centres_within(ck.saturating_sub(sk), ck.saturating_add(sk));
@@ -532,7 +533,7 @@ mod tests {
             centre: [0; 3],
             radius: 3 * V as i64,
         };
-        let b = Ball::new(&s, Extent::cube(8).unwrap()).unwrap();
+        let b = Ball::new(&s, window(Extent::cube(8).unwrap(), 0..u32::MAX)).unwrap();
         let sf = b.surfel([3, 0, 0]);
         assert!(sf.normal[0] > 1 << 29);
         // centre (3.5, .5, .5): |w| = sqrt(12.75) ≈ 3.5707 voxels

@@ -10,7 +10,7 @@
 //! [`super::triangle`] makes its voxelization tunnel-free.
 
 use super::error::VoxelizeError;
-use super::fixmath::{Counter, V, bounds, cross, isqrt, least_axis, round_div, unit};
+use super::fixmath::{Counter, V, bounds, cross, isqrt, least_axis, low, round_div, unit, window};
 use super::triangle::Tri;
 use super::{Separation, Surfel, VoxelSink};
 use crate::geometry::UnitVector;
@@ -89,29 +89,30 @@ pub(crate) struct Emitter<'a, S: ?Sized> {
     pub(crate) extent: Extent,
     pub(crate) sink: &'a mut S,
     pub(crate) n: Counter,
-    /// The raster box grown by one voxel, for culling.
-    lo: i128,
+    /// The box of the cells scanned (the raster, along z the sink's
+    /// layers) grown by one voxel, for culling.
+    lo: [i128; 3],
     hi: [i128; 3],
 }
 
 impl<'a, S: VoxelSink + ?Sized> Emitter<'a, S> {
     pub(crate) fn new(sep: Separation, extent: Extent, sink: &'a mut S) -> Self {
+        let win = window(extent, sink.layers());
         Self {
             sep,
             extent,
             sink,
             n: Counter::default(),
-            lo: V.saturating_neg(),
-            hi: extent
-                .dims()
-                .map(|d| super::fixmath::low(d).saturating_add(V)),
+            lo: win.map(|(start, _)| low(start).saturating_sub(V)),
+            hi: win.map(|(_, end)| low(end).saturating_add(V)),
         }
     }
 
     /// Whether the box `[lo, hi]` (grown by `reach`) misses the raster.
     pub(crate) fn culled(&self, lo: [i128; 3], hi: [i128; 3], reach: i128) -> bool {
         (0..3).any(|k| {
-            hi.get(k).copied().unwrap_or(0).saturating_add(reach) < self.lo
+            hi.get(k).copied().unwrap_or(0).saturating_add(reach)
+                < self.lo.get(k).copied().unwrap_or(0)
                 || lo.get(k).copied().unwrap_or(0).saturating_sub(reach)
                     > self.hi.get(k).copied().unwrap_or(0)
         })

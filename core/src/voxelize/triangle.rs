@@ -71,7 +71,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, IncDiv, V, ceil_div, centre, check_point, checked_cross, clip, dist_u32, dot,
-    floor_div, isqrt, sub, unit,
+    floor_div, isqrt, low, sub, unit, window,
 };
 use super::sphere::{pick, place};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
@@ -492,16 +492,16 @@ impl Tri {
     {
         // Quick reject: the probe reaches at most half a voxel beyond the
         // triangle's bounding box.
-        let size = extent.dims().map(super::fixmath::low);
-        for (k, s) in size.iter().enumerate() {
+        let win = window(extent, sink.layers());
+        for (k, (start, end)) in win.iter().enumerate() {
             let lo = self.v.iter().map(|p| p[k]).min().unwrap_or(0);
             let hi = self.v.iter().map(|p| p[k]).max().unwrap_or(0);
-            if hi.saturating_add(H) < 0 || lo.saturating_sub(H) > *s {
+            if hi.saturating_add(H) < low(*start) || lo.saturating_sub(H) > low(*end) {
                 return Ok(());
             }
         }
         let k = dominant(self.n);
-        let (na, nb, nk) = pick(k, extent.dims());
+        let (na, nb, nk) = pick(k, win);
         // Axes in (a, b, k) coordinates, split by role.
         let mut rows = [Axis::default(); 32];
         let mut cols = [Axis::default(); 32];

@@ -45,7 +45,7 @@
 //! constant per sample.
 
 use super::error::{COORD_LIMIT, VoxelizeError};
-use super::fixmath::{Counter, V, dist_u32, dot, isqrt, unit};
+use super::fixmath::{Counter, V, dist_u32, dot, isqrt, unit, window};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::raster::Extent;
 
@@ -103,13 +103,15 @@ where
         n: block.dims.map(i64::from),
         below: thr.saturating_sub(1),
     };
-    // Block sample range that lands inside the raster, per axis.
-    let dims = extent.dims();
+    // Block sample range that lands inside the raster (along z, inside
+    // the sink's layers), per axis.
+    let win = window(extent, sink.layers());
     let mut lo = [0i64; 3];
     let mut hi = [0i64; 3];
     for k in 0..3 {
-        lo[k] = block.offset[k].saturating_neg().max(0);
-        hi[k] = (i64::from(dims[k]).saturating_sub(block.offset[k])).min(g.n[k]);
+        let (start, end) = win[k];
+        lo[k] = i64::from(start).saturating_sub(block.offset[k]).max(0);
+        hi[k] = (i64::from(end).saturating_sub(block.offset[k])).min(g.n[k]);
         if lo[k] >= hi[k] {
             return Ok(0);
         }

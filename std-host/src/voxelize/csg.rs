@@ -5,6 +5,8 @@
 //! the volume with the voxels inside (or outside) the rest of the tree
 //! transparent.
 
+use std::ops::Range;
+
 use rrt_core::csg::{self, CsgNode, CsgTree, IgnoreLeaf, LeafFill};
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::voxelize::Separation;
@@ -69,7 +71,8 @@ fn prepare(c: &Csg, frame: &RasterFrame) -> Result<Prepared, BuildError> {
 }
 
 /// The raster voxels whose centres lie inside a CSG tree, over the tree's
-/// bounding box clipped to the raster (one byte per voxel of that box).
+/// bounding box clipped to the raster and, along z, to `layers` (one byte
+/// per voxel of that box).
 struct Mask {
     lo: [u32; 3],
     n: [u32; 3],
@@ -77,7 +80,7 @@ struct Mask {
 }
 
 impl Mask {
-    fn new(tree: &CsgTree<'_>, dims: [u32; 3]) -> Self {
+    fn new(tree: &CsgTree<'_>, dims: [u32; 3], layers: Range<u32>) -> Self {
         let empty = Self {
             lo: [0; 3],
             n: [0; 3],
@@ -90,8 +93,14 @@ impl Mask {
         let mut n = [0u32; 3];
         for k in 0..3 {
             let v = VOXEL;
-            let l = (a[k].div_euclid(v) - 1).clamp(0, i64::from(dims[k]));
-            let h = (b[k].div_euclid(v) + 2).clamp(0, i64::from(dims[k]));
+            let (start, end) = if k == 2 {
+                let end = i64::from(layers.end).min(i64::from(dims[k]));
+                (i64::from(layers.start).min(end), end)
+            } else {
+                (0, i64::from(dims[k]))
+            };
+            let l = (a[k].div_euclid(v) - 1).clamp(start, end);
+            let h = (b[k].div_euclid(v) + 2).clamp(start, end);
             lo[k] = u32::try_from(l).unwrap_or(0);
             n[k] = u32::try_from(h - l).unwrap_or(0);
         }
@@ -153,7 +162,10 @@ pub(super) fn voxelize_object(
         None => None,
     };
     if let (Some(cut), Some(v)) = (p.volume_cut, volume_leaf.as_ref()) {
-        let mask = Mask::new(&tree, extent.dims());
+        // The volume reads `keep` one layer beyond the layers it voxelizes.
+        let layers = pass.layers();
+        let around = layers.start.saturating_sub(1)..layers.end.saturating_add(1);
+        let mask = Mask::new(&tree, extent.dims(), around);
         let keep = move |vx: [u32; 3]| mask.contains(vx) != cut;
         return volume::voxelize_object(v, frame, separation, Some(&keep), pass);
     }

@@ -1,7 +1,10 @@
 //! The two voxelization passes as an object sees them: where its voxels
 //! go.
 
+use std::ops::Range;
+
 use rrt_core::store::{Counter, Filler, ObjectAttrs};
+use rrt_core::voxelize::VoxelSink;
 
 use super::texture::InRaster;
 use crate::assets::texture::AnyTexture;
@@ -23,4 +26,16 @@ pub enum Pass<'a, 'p, 'd, 'r> {
         /// The material's texture.
         texture: Option<&'a InRaster<AnyTexture>>,
     },
+}
+
+impl Pass<'_, '_, '_, '_> {
+    /// The layers of the raster the pass keeps
+    /// ([`VoxelSink::layers`]: a slab's).
+    #[must_use]
+    pub fn layers(&self) -> Range<u32> {
+        match self {
+            Self::Count(c) => c.layers(),
+            Self::Fill { filler, .. } => filler.layers(),
+        }
+    }
 }

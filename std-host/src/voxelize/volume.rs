@@ -177,15 +177,18 @@ impl PlacedVolume<'_> {
         impl Iterator<Item = Result<(RasterBlock, Range<u32>), VolumeError>> + 's,
         VolumeError,
     > {
-        self.slabs(frame, classifier, max_bytes, None)
+        self.slabs(frame, classifier, max_bytes, None, 0..u32::MAX)
     }
 
+    /// [`PlacedVolume::raster_slabs`] owning only the layers `owned` of
+    /// the raster (each slab still with its halo).
     fn slabs<'s>(
         &'s self,
         frame: &'s RasterFrame,
         classifier: &'s Classifier,
         max_bytes: u64,
         keep: Option<Keep<'s>>,
+        owned: Range<u32>,
     ) -> Result<
         impl Iterator<Item = Result<(RasterBlock, Range<u32>), VolumeError>> + 's,
         VolumeError,
@@ -209,13 +212,14 @@ impl PlacedVolume<'_> {
         let own = u32::try_from(layers.saturating_sub(2))
             .unwrap_or(u32::MAX)
             .max(1);
-        let z0 = first[2];
-        let z1 = first[2] + n[2];
+        let (box0, box1) = (first[2], first[2] + n[2]);
+        let z0 = box0.max(owned.start);
+        let z1 = box1.min(owned.end);
         let starts = (z0..z1).step_by(usize::try_from(own).unwrap_or(usize::MAX));
         Ok(starts.map(move |s| {
             let e = s.saturating_add(own).min(z1);
-            let lo = s.saturating_sub(1).max(z0);
-            let hi = e.saturating_add(1).min(z1);
+            let lo = s.saturating_sub(1).max(box0);
+            let hi = e.saturating_add(1).min(box1);
             let block = self.block_for(
                 frame,
                 classifier,
@@ -273,9 +277,14 @@ impl PlacedVolume<'_> {
                 self.1 += 1;
                 self.0.offer(voxel, surfel);
             }
+
+            fn layers(&self) -> Range<u32> {
+                self.0.layers()
+            }
         }
+        let layers = sink.layers();
         let mut counted = Count(sink, 0);
-        for slab in self.slabs(frame, classifier, max_block_bytes, keep)? {
+        for slab in self.slabs(frame, classifier, max_block_bytes, keep, layers)? {
             let (block, z) = slab?;
             let core_block = Block {
                 samples: &block.samples,
@@ -388,6 +397,12 @@ impl<S: VoxelSink + ?Sized> VoxelSink for ClipZ<'_, S> {
         if self.z.contains(&voxel[2]) {
             self.sink.offer(voxel, surfel);
         }
+    }
+
+    fn layers(&self) -> Range<u32> {
+        let l = self.sink.layers();
+        let end = l.end.min(self.z.end);
+        l.start.max(self.z.start).min(end)..end
     }
 }
 

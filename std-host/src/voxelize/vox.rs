@@ -32,11 +32,17 @@ impl VoxScene {
     /// `Filler::textured`).
     pub fn voxelize<S: VoxelSink + ?Sized>(&self, placement: VoxPlacement, sink: &mut S) -> u64 {
         let s = i64::from(placement.scale.max(1));
+        let layers = sink.layers();
+        let (z0, z1) = (i64::from(layers.start), i64::from(layers.end));
         let mut n = 0u64;
         for v in self.world_voxels() {
             let base: [i64; 3] = std::array::from_fn(|a| {
                 placement.offset[a].saturating_add(v.cell[a].saturating_mul(s))
             });
+            // A cell wholly outside the sink's layers offers nothing it keeps.
+            if base[2].saturating_add(s) <= z0 || base[2] >= z1 {
+                continue;
+            }
             for dz in 0..s {
                 for dy in 0..s {
                     for dx in 0..s {

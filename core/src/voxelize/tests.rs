@@ -1,0 +1,173 @@
+//! The layers contract of every voxelizer ([`VoxelSink::layers`]): a sink
+//! that keeps some layers gets exactly the offers of those layers that a
+//! sink keeping every layer gets, in the same order.
+
+use core::ops::Range;
+use std::vec::Vec;
+
+use super::volume::Block;
+use super::*;
+use crate::csg::{self, CsgNode, CsgSink, CsgTree};
+use crate::fixed::VOXEL;
+use crate::geometry::{BezierPatch, Cone, Cuboid, Point, Sphere, Torus, Triangle};
+use crate::raster::Extent;
+use crate::testkit::Rng;
+
+/// Every offer in order; keeps the layers `layers`.
+struct Sequence {
+    layers: Range<u32>,
+    offers: Vec<(u16, [u32; 3], Surfel)>,
+}
+
+impl Sequence {
+    fn new(layers: Range<u32>) -> Self {
+        Self {
+            layers,
+            offers: Vec::new(),
+        }
+    }
+}
+
+impl VoxelSink for Sequence {
+    fn offer(&mut self, voxel: [u32; 3], surfel: Surfel) {
+        self.offers.push((0, voxel, surfel));
+    }
+
+    fn layers(&self) -> Range<u32> {
+        self.layers.clone()
+    }
+}
+
+impl CsgSink for Sequence {
+    fn offer_leaf(&mut self, leaf: u16, voxel: [u32; 3], surfel: Surfel) {
+        self.offers.push((leaf, voxel, surfel));
+    }
+
+    fn layers(&self) -> Range<u32> {
+        self.layers.clone()
+    }
+}
+
+/// `run` with every layer and with `layers`: the offers of `layers` agree.
+#[track_caller]
+fn assert_layers_kept(what: &str, layers: Range<u32>, run: impl Fn(&mut Sequence)) {
+    let mut all = Sequence::new(0..u32::MAX);
+    run(&mut all);
+    let mut some = Sequence::new(layers.clone());
+    run(&mut some);
+    let inside = |o: &&(u16, [u32; 3], Surfel)| layers.contains(&o.1[2]);
+    let want: Vec<_> = all.offers.iter().filter(inside).collect();
+    let got: Vec<_> = some.offers.iter().filter(inside).collect();
+    assert_eq!(got, want, "{what}, layers {layers:?}");
+}
+
+/// A point near the raster of `n` voxels per axis, in fixed units.
+fn point(rng: &mut Rng, n: i64) -> Point {
+    [0; 3].map(|_| rng.range(-2 * VOXEL, (n + 2) * VOXEL))
+}
+
+#[test]
+fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
+    let mut rng = Rng(0x5eed_1a7e_u64);
+    let n = 24i64;
+    let extent = Extent::new(20, 22, 24).unwrap();
+    for case in 0..40 {
+        let sep = if case % 2 == 0 {
+            Separation::Six
+        } else {
+            Separation::TwentySix
+        };
+        let z0 = rng.below_u32(26);
+        let layers = z0..z0 + 1 + rng.below_u32(12);
+        let r = |rng: &mut Rng| rng.range(VOXEL / 3, 9 * VOXEL);
+        let ball = Sphere {
+            centre: point(&mut rng, n),
+            radius: r(&mut rng),
+        };
+        assert_layers_kept("sphere", layers.clone(), |s| {
+            sphere::surface(&ball, sep, extent, s).unwrap();
+            sphere::solid(&ball, sep, extent, s).unwrap();
+        });
+        let tri = Triangle {
+            vertices: [0; 3].map(|_| point(&mut rng, n)),
+            normals: None,
+        };
+        assert_layers_kept("triangle", layers.clone(), |s| {
+            let _ = triangle::triangle(&tri, sep, extent, s);
+        });
+        let poly: Vec<Point> = (0..5).map(|_| point(&mut rng, n)).collect();
+        assert_layers_kept("polygon", layers.clone(), |s| {
+            let _ = triangle::polygon(&poly, sep, extent, s);
+        });
+        let faces = [[0, 1, 2], [0, 2, 3], [1, 3, 4]];
+        assert_layers_kept("mesh", layers.clone(), |s| {
+            let _ = triangle::mesh(&poly, None, &faces, sep, extent, s);
+        });
+        let cone = Cone {
+            base: point(&mut rng, n),
+            base_radius: r(&mut rng) / 2,
+            apex: point(&mut rng, n),
+            apex_radius: r(&mut rng) / 2,
+        };
+        assert_layers_kept("cone", layers.clone(), |s| {
+            let _ = cone::surface(&cone, sep, extent, s);
+            let _ = cone::capped(&cone, sep, extent, s);
+        });
+        let axis = [0; 3].map(|_| i32::try_from(rng.range(-1000, 1000)).unwrap());
+        let ring = Torus {
+            centre: point(&mut rng, n),
+            axis: normalize_axis(axis),
+            major: r(&mut rng),
+            minor: r(&mut rng) / 3 + 1,
+        };
+        assert_layers_kept("torus", layers.clone(), |s| {
+            let _ = torus::surface(&ring, sep, extent, s);
+        });
+        let mut control = [[[0i64; 3]; 4]; 4];
+        for row in &mut control {
+            for p in row.iter_mut() {
+                *p = point(&mut rng, n);
+            }
+        }
+        let bezier = BezierPatch { control };
+        assert_layers_kept("patch", layers.clone(), |s| {
+            let _ = patch::surface(&bezier, sep, extent, s);
+        });
+        let (a, b) = (point(&mut rng, n), point(&mut rng, n));
+        let cube = Cuboid {
+            min: [0, 1, 2].map(|k| a[k].min(b[k])),
+            max: [0, 1, 2].map(|k| a[k].max(b[k]) + 1),
+        };
+        assert_layers_kept("cuboid", layers.clone(), |s| {
+            let _ = cuboid::surface(&cube, sep, extent, s);
+            let _ = cuboid::solid(&cube, sep, extent, s);
+        });
+        let dims = [9, 10, 11];
+        let samples: Vec<u16> = (0..9 * 10 * 11)
+            .map(|_| u16::try_from(rng.below(4)).unwrap())
+            .collect();
+        let block = Block {
+            samples: &samples,
+            dims,
+            offset: [0; 3].map(|_| rng.range(-4, 16)),
+        };
+        assert_layers_kept("volume", layers.clone(), |s| {
+            volume::boundary(&block, 2, sep, extent, s).unwrap();
+        });
+        let nodes = [
+            CsgNode::Leaf(0),
+            CsgNode::Leaf(1),
+            CsgNode::Difference(0, 1),
+        ];
+        let leaves: [&dyn csg::Solid; 2] = [&ball, &cube];
+        let tree = CsgTree::new(&nodes, &leaves).unwrap();
+        assert_layers_kept("csg", layers.clone(), |s| {
+            csg::voxelize(&tree, extent, s);
+        });
+    }
+}
+
+/// `a` scaled to a unit vector of [`NORMAL_ONE`] (the z axis for zero).
+fn normalize_axis(a: [i32; 3]) -> [i32; 3] {
+    crate::voxel::normalize(a.map(i64::from)).unwrap_or([0, 0, NORMAL_ONE])
+}
