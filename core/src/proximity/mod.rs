@@ -17,6 +17,8 @@
 //! stand-in cell per 64 plane cells, which skipping walks read instead of
 //! the plane far from surfaces.
 
+pub mod field;
+
 use crate::error::RasterError;
 use crate::raster::{LINE_CELLS, Raster, RasterMut, cell, check_line_count, to_usize};
 
@@ -199,7 +201,17 @@ pub const fn dilated(c: u8) -> u8 {
 pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), RasterError> {
     let plane = raster.plane();
     check_line_count(plane.len(), lines.len())?;
-    for (out, line) in lines.iter_mut().zip(plane.chunks(LINE_CELLS)) {
+    line_stand_ins(plane, lines);
+    Ok(())
+}
+
+/// The line level of a part of a plane: `cells` are consecutive cells of
+/// a plane with its distance field, starting at a line boundary, and
+/// `lines` gets one stand-in per [`LINE_CELLS`] of them (the last line may
+/// be shorter), as [`line_distances`] computes them; stand-ins beyond the
+/// cells are left alone. A caller with threads hands out aligned parts.
+pub fn line_stand_ins(cells: &[u8], lines: &mut [u8]) {
+    for (out, line) in lines.iter_mut().zip(cells.chunks(LINE_CELLS)) {
         // Without OPAQUE or PROXIMITY in any cell, every cell is its distance
         // bits alone, and the smallest cell holds the smallest distance.
         let any = line.iter().fold(0u8, |a, &c| a | c);
@@ -210,7 +222,6 @@ pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), Raste
             least
         };
     }
-    Ok(())
 }
 
 /// Computes the proximity distance field: every cell gets the chessboard
@@ -226,11 +237,13 @@ pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), Raste
 /// once without passing a non-transparent or flagged voxel (see
 /// [`crate::discrete_ray::DiscreteRay::first_hit_skipping`]).
 ///
-/// The exact two-pass sequential chamfer transform with the 3×3×3 mask and
-/// unit weights (exact for the chessboard metric), in place on the plane:
-/// each pass reads, per row, four neighbouring rows of the previous row and
-/// slice elementwise, then runs once along the row. Linear in the number of
-/// voxels, no scratch memory beyond a small stack buffer.
+/// Computed by slices ([`field`]: the distances within each slice, then up
+/// and down the slices), in place, with no scratch memory beyond a small
+/// stack buffer. Every cell is written once; beyond that the work follows
+/// the opaque voxels: rows and slices with no opaque voxel within
+/// [`field::FIELD_REACH`] are only filled with the limit. A caller with
+/// threads runs the same steps on its own ([`field`]), with the same
+/// result.
 ///
 /// ```
 /// use rrt_core::proximity::{distance, distance_field};
@@ -248,240 +261,52 @@ pub fn distance_field(raster: &mut RasterMut<'_>) {
         return;
     };
     let plane = raster.plane_mut();
-    // Work on plain distances (opaque ⇔ 0) and rebuild the cells at the end.
-    for c in plane.iter_mut() {
-        *c = if *c & cell::OPAQUE != 0 {
-            0
-        } else {
-            DISTANCE_LIMIT
+    // Step 1 per slice, and step 2 as soon as the slice below is done, over
+    // the box the opaque voxels below reach (`seen`: those so far).
+    let mut seen = field::Area::EMPTY;
+    let mut last: Option<usize> = None;
+    for z in 0..nz {
+        let start = z.wrapping_mul(slice);
+        let Some((done, rest)) = plane.split_at_mut_checked(start) else {
+            return;
         };
-    }
-    chamfer_pass(plane, nx, ny, nz, slice, false);
-    chamfer_pass(plane, nx, ny, nz, slice, true);
-    for c in plane.iter_mut() {
-        let d = *c;
-        let opaque = if d == 0 { cell::OPAQUE } else { 0 };
-        let flag = if d <= 1 { cell::PROXIMITY } else { 0 };
-        *c = opaque | flag | (d << cell::DISTANCE_SHIFT);
-    }
-}
-
-/// Row chunk handled at once by [`chamfer_pass`] (stack buffer size).
-const CHUNK: usize = 256;
-
-/// One pass of the chamfer transform. Forward (`backward == false`): rows in
-/// increasing (z, y), x increasing; the causal neighbours of a voxel are the
-/// 3×3 block of the previous slice, the 3 voxels of the previous row and the
-/// voxel before it in its row. Backward: the mirror image.
-fn chamfer_pass(plane: &mut [u8], nx: usize, ny: usize, nz: usize, slice: usize, backward: bool) {
-    let rows = ny.saturating_mul(nz);
-    let Some(ny_nz) = core::num::NonZeroUsize::new(ny) else {
-        return;
-    };
-    for i in 0..rows {
-        let r = if backward {
-            rows.wrapping_sub(1).wrapping_sub(i)
-        } else {
-            i
+        let Some(cur) = rest.get_mut(..slice) else {
+            return;
         };
-        let (y, z) = (r % ny_nz, r / ny_nz);
-        let start = r.wrapping_mul(nx);
-        // The row, and the (read-only) part of the plane holding the
-        // already-finished neighbour rows.
-        let (done, row) = if backward {
-            let Some((upto, after)) = plane.split_at_mut_checked(start.wrapping_add(nx)) else {
-                return;
-            };
-            (after as &[u8], upto.get_mut(start..).unwrap_or(&mut []))
-        } else {
-            let Some((before, rest)) = plane.split_at_mut_checked(start) else {
-                return;
-            };
-            (before as &[u8], rest.get_mut(..nx).unwrap_or(&mut []))
-        };
-        // Neighbour rows as offsets into `done`: previous row in this slice,
-        // and the three rows around y in the previous slice.
-        let base = if backward { start.wrapping_add(nx) } else { 0 };
-        let row_at = |yy: usize, zz: usize| -> Option<&[u8]> {
-            let s = zz.checked_mul(slice)?.checked_add(yy.checked_mul(nx)?)?;
-            done.get(s.checked_sub(base)?..)?.get(..nx)
-        };
-        let (y_prev, z_prev) = if backward {
-            (
-                y.checked_add(1).filter(|&v| v < ny),
-                z.checked_add(1).filter(|&v| v < nz),
-            )
-        } else {
-            (y.checked_sub(1), z.checked_sub(1))
-        };
-        let mut neighbours: [Option<&[u8]>; 4] = [None; 4];
-        neighbours[0] = y_prev.and_then(|yy| row_at(yy, z));
-        if let Some(zz) = z_prev {
-            neighbours[1] = y.checked_sub(1).and_then(|yy| row_at(yy, zz));
-            neighbours[2] = row_at(y, zz);
-            neighbours[3] = y
-                .checked_add(1)
-                .filter(|&v| v < ny)
-                .and_then(|yy| row_at(yy, zz));
+        let opaque = field::slice_distances(cur, nx);
+        if let Some(l) = last
+            && field::reaches(z.wrapping_sub(l))
+        {
+            let below = done.get(start.wrapping_sub(slice)..).unwrap_or(&[]);
+            field::relax_rows(cur, below, nx, 0, seen.reached(nx, ny));
         }
-        relax_row(row, &neighbours, backward);
-    }
-}
-
-/// `row[x] = min(row[x], 1 + min over the neighbour rows of their entries
-/// at x−1, x, x+1)`, then one sequential sweep along the row.
-fn relax_row(row: &mut [u8], neighbours: &[Option<&[u8]>; 4], backward: bool) {
-    let n = row.len();
-    let mut start = 0usize;
-    while start < n {
-        let end = start.saturating_add(CHUNK).min(n);
-        // t[j] = min of the neighbour rows at x = start − 1 + j.
-        let mut t = [DISTANCE_LIMIT; CHUNK + 2];
-        let lo = start.saturating_sub(1);
-        let hi = end.saturating_add(1).min(n);
-        let off = lo.wrapping_add(1).wrapping_sub(start); // 0 when start > 0, 1 at the row's start
-        for nb in neighbours.iter().flatten() {
-            if let (Some(src), Some(dst)) = (
-                nb.get(lo..hi),
-                t.get_mut(off..off.wrapping_add(hi.wrapping_sub(lo))),
-            ) {
-                for (d, &s) in dst.iter_mut().zip(src) {
-                    *d = (*d).min(s);
-                }
-            }
+        if !opaque.is_empty() {
+            seen = seen.union(opaque);
+            last = Some(z);
         }
-        if let Some(seg) = row.get_mut(start..end) {
-            for (j, c) in seg.iter_mut().enumerate() {
-                let a = t.get(j).copied().unwrap_or(DISTANCE_LIMIT);
-                let b = t.get(j.wrapping_add(1)).copied().unwrap_or(DISTANCE_LIMIT);
-                let c2 = t.get(j.wrapping_add(2)).copied().unwrap_or(DISTANCE_LIMIT);
-                let m = a.min(b).min(c2).saturating_add(1);
-                *c = (*c).min(m);
-            }
-        }
-        start = end;
     }
-    // Along the row: the neighbour before (after, going backward).
-    let mut prev = DISTANCE_LIMIT;
-    let mut sweep = |c: &mut u8| {
-        let v = (*c).min(prev.saturating_add(1)).min(DISTANCE_LIMIT);
-        *c = v;
-        prev = v;
-    };
-    if backward {
-        row.iter_mut().rev().for_each(&mut sweep);
-    } else {
-        row.iter_mut().for_each(&mut sweep);
+    // Step 3, down the slices.
+    let area = seen.reached(nx, ny);
+    let mut next: Option<usize> = None;
+    for z in (0..nz).rev() {
+        let start = z.wrapping_mul(slice);
+        let end = start.wrapping_add(slice);
+        let Some((head, above)) = plane.split_at_mut_checked(end) else {
+            return;
+        };
+        let Some(cur) = head.get_mut(start..) else {
+            return;
+        };
+        if let Some(n) = next
+            && field::reaches(n.wrapping_sub(z))
+        {
+            field::relax_rows(cur, above.get(..slice).unwrap_or(&[]), nx, 0, area);
+        }
+        if cur.contains(&field::OPAQUE_CELL) {
+            next = Some(z);
+        }
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use std::vec;
-    use std::vec::Vec;
-
-    use super::*;
-    use crate::raster::Extent;
-    use crate::raster::line_count;
-    use crate::testkit::Rng;
-
-    /// Chessboard distance to the nearest opaque voxel, by brute force.
-    fn brute(e: Extent, opaque: &[[u32; 3]]) -> Vec<u8> {
-        let [nx, ny, nz] = e.dims();
-        let mut out = vec![DISTANCE_LIMIT; e.len()];
-        for z in 0..nz {
-            for y in 0..ny {
-                for x in 0..nx {
-                    let d = opaque
-                        .iter()
-                        .map(|o| o[0].abs_diff(x).max(o[1].abs_diff(y)).max(o[2].abs_diff(z)))
-                        .min()
-                        .unwrap_or(u32::MAX);
-                    out[e.index([x, y, z]).unwrap()] =
-                        u8::try_from(d.min(u32::from(DISTANCE_LIMIT))).unwrap();
-                }
-            }
-        }
-        out
-    }
-
-    #[test]
-    fn distance_field_is_the_exact_chessboard_distance() {
-        let mut rng = Rng(0x1234_5678_9abc_def0u64);
-        let mut next = |m: u32| rng.below_u32(m);
-        for case in 0..60 {
-            let dims = [1 + next(20), 1 + next(20), 1 + next(20)];
-            let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
-            let count = next(6);
-            let opaque: Vec<[u32; 3]> = (0..count)
-                .map(|_| [next(dims[0]), next(dims[1]), next(dims[2])])
-                .collect();
-            let mut plane = vec![cell::EMPTY; e.len()];
-            for o in &opaque {
-                plane[e.index(*o).unwrap()] = cell::OPAQUE;
-            }
-            let mut flags = plane.clone();
-            flag_neighbourhood(&mut RasterMut::new(e, &mut flags).unwrap());
-            distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
-            let want = brute(e, &opaque);
-            for (i, (&c, &w)) in plane.iter().zip(&want).enumerate() {
-                assert_eq!(
-                    distance(c),
-                    w,
-                    "case {case} dims {dims:?} voxel {:?}",
-                    e.coord(i)
-                );
-                assert_eq!(c & cell::OPAQUE != 0, w == 0, "case {case}");
-                // The flag is exactly what flag_neighbourhood sets.
-                assert_eq!(
-                    c & cell::PROXIMITY,
-                    flags[i] & cell::PROXIMITY,
-                    "case {case}"
-                );
-            }
-            // The line level: each line's smallest distance when that is at
-            // least 2, else EMPTY.
-            let mut lines = vec![0xffu8; line_count(e.len())];
-            line_distances(
-                &RasterMut::new(e, &mut plane).unwrap().as_raster(),
-                &mut lines,
-            )
-            .unwrap();
-            for (l, &got) in lines.iter().enumerate() {
-                let m = want
-                    .iter()
-                    .skip(l * LINE_CELLS)
-                    .take(LINE_CELLS)
-                    .min()
-                    .copied()
-                    .unwrap();
-                let expect = if m >= 2 {
-                    m << cell::DISTANCE_SHIFT
-                } else {
-                    cell::EMPTY
-                };
-                assert_eq!(got, expect, "case {case} line {l}");
-            }
-        }
-    }
-
-    #[test]
-    fn distances_saturate_at_the_limit() {
-        let e = Extent::new(150, 3, 2).unwrap();
-        let mut plane = vec![cell::EMPTY; e.len()];
-        plane[e.index([0, 1, 1]).unwrap()] = cell::OPAQUE;
-        distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
-        let at = |x| distance(plane[e.index([x, 0, 0]).unwrap()]);
-        assert_eq!(
-            (at(1), at(62), at(63), at(64), at(149)),
-            (1, 62, 63, 63, 63)
-        );
-        let mut empty = vec![cell::EMPTY; e.len()];
-        distance_field(&mut RasterMut::new(e, &mut empty).unwrap());
-        assert!(
-            empty
-                .iter()
-                .all(|&c| distance(c) == DISTANCE_LIMIT && c & cell::PROXIMITY == 0)
-        );
-    }
-}
+mod tests;

@@ -1,0 +1,378 @@
+//! The proximity distance field by slices: exact, in place, in work that a
+//! caller can share among threads, and next to nothing far from surfaces.
+//!
+//! The field of a cell is `min(DISTANCE_LIMIT, min over opaque voxels q of
+//! max(|dx|, |dy|, |dz|))`. It is computed in three steps, each exact:
+//! 1. [`slice_distances`], per z-slice on its own: the distance to the
+//!    nearest opaque voxel *of the same slice*, `d2`. Per row, the distance
+//!    along the row (a ramp written only within the limit of each opaque
+//!    run; a row without one is filled with the limit), then the rows
+//!    relaxed from their neighbours, up the slice and down again.
+//! 2. Up the slices: `F(z) = min(d2(z), 1 + min over the 3×3 cells around
+//!    (x, y) of F(z − 1))` ([`relax_rows`] with the slice below) is the
+//!    exact distance to the opaque voxels at or below `z`: the chessboard
+//!    distance from a voxel to one in a lower slice is one more than the
+//!    least of its nine neighbours' in the slice below (a step that brings
+//!    every coordinate one nearer).
+//! 3. Down the slices: `min(F(z), 1 + min over 3×3 of the finished slice
+//!    z + 1)` ([`relax_rows`] with the slice above) is the exact distance
+//!    (the second term is never below it, and holds every opaque voxel
+//!    above).
+//!
+//! The same holds for the rows within a slice (step 1) with 1×3
+//! neighbourhoods. Since distances saturate at [`DISTANCE_LIMIT`], a
+//! relaxation from a neighbour changes nothing unless an opaque voxel lies
+//! within [`FIELD_REACH`] slices (rows) on that side: such slices and rows
+//! are skipped, so far from surfaces the work is the first step's fill.
+//!
+//! Cells hold their finished form from the first step on: the distance in
+//! the distance bits, [`cell::PROXIMITY`] at distance 0 and 1, and
+//! [`cell::OPAQUE`] at 0 (the map is increasing, so minima commute with
+//! it). Steps 2 and 3 read one whole neighbouring slice and write rows of
+//! another, so a caller may hand out the rows of a slice to threads; step
+//! 1 is independent per slice.
+
+use super::DISTANCE_LIMIT;
+use crate::raster::cell;
+
+/// How far an opaque voxel's influence reaches through the relaxations:
+/// relaxing a slice (row) from its neighbour on one side changes it only
+/// if an opaque voxel lies within this many slices (rows) on that side.
+/// A distance of `DISTANCE_LIMIT − 1` or less in the neighbour is needed
+/// for `1 + distance` to lower anything, and the neighbour itself counts.
+pub const FIELD_REACH: u32 = DISTANCE_LIMIT as u32 - 1;
+
+/// One distance step in the distance bits.
+const STEP: u8 = 1 << cell::DISTANCE_SHIFT;
+/// The saturated distance in the distance bits: the cell far from
+/// everything.
+pub(super) const FAR: u8 = DISTANCE_LIMIT << cell::DISTANCE_SHIFT;
+/// The finished form of an opaque cell (rank hints are written later).
+pub(super) const OPAQUE_CELL: u8 = cell::OPAQUE | cell::PROXIMITY;
+/// Distance bits of a finished cell.
+const DISTANCE_BITS: u8 = cell::DISTANCE_MASK << cell::DISTANCE_SHIFT;
+/// Columns handled at once by [`relax_row`]'s stack buffer.
+const CHUNK: usize = 256;
+
+/// The finished cell of a transparent voxel at distance `d ≥ 1`.
+#[inline]
+const fn at_distance(d: u8) -> u8 {
+    let d = if d > DISTANCE_LIMIT {
+        DISTANCE_LIMIT
+    } else {
+        d
+    };
+    let bits = d << cell::DISTANCE_SHIFT;
+    if d <= 1 { bits | cell::PROXIMITY } else { bits }
+}
+
+/// The finished cell one step beyond a neighbour whose finished cell is
+/// `n`: distance `distance(n) + 1`, saturated (with PROXIMITY at 1).
+#[inline]
+const fn one_beyond(n: u8) -> u8 {
+    let bits = (n & DISTANCE_BITS).saturating_add(STEP);
+    let bits = if bits > FAR { FAR } else { bits };
+    if bits == STEP {
+        bits | cell::PROXIMITY
+    } else {
+        bits
+    }
+}
+
+/// A box of cells of a slice: the columns `x[0]..x[1]` of the rows
+/// `y[0]..y[1]`; empty when either range is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Area {
+    /// Columns, half-open.
+    pub x: [usize; 2],
+    /// Rows, half-open.
+    pub y: [usize; 2],
+}
+
+impl Area {
+    /// No cell.
+    pub const EMPTY: Self = Self {
+        x: [0, 0],
+        y: [0, 0],
+    };
+
+    /// Whether the box holds no cell.
+    #[must_use]
+    pub const fn is_empty(&self) -> bool {
+        self.x[0] >= self.x[1] || self.y[0] >= self.y[1]
+    }
+
+    /// The smallest box holding both.
+    #[must_use]
+    pub fn union(self, other: Self) -> Self {
+        if self.is_empty() {
+            return other;
+        }
+        if other.is_empty() {
+            return self;
+        }
+        Self {
+            x: [self.x[0].min(other.x[0]), self.x[1].max(other.x[1])],
+            y: [self.y[0].min(other.y[0]), self.y[1].max(other.y[1])],
+        }
+    }
+
+    /// The box grown by `by` cells on every side, clipped to a slice of
+    /// `nx × ny` cells.
+    #[must_use]
+    pub fn grown(self, by: usize, nx: usize, ny: usize) -> Self {
+        if self.is_empty() {
+            return self;
+        }
+        Self {
+            x: [
+                self.x[0].saturating_sub(by),
+                self.x[1].saturating_add(by).min(nx),
+            ],
+            y: [
+                self.y[0].saturating_sub(by),
+                self.y[1].saturating_add(by).min(ny),
+            ],
+        }
+    }
+
+    /// Where a relaxation from neighbours whose opaque voxels lie in
+    /// `self` can change anything: the box grown by [`FIELD_REACH`].
+    #[must_use]
+    pub fn reached(self, nx: usize, ny: usize) -> Self {
+        self.grown(reach(), nx, ny)
+    }
+}
+
+/// Step 1 on one z-slice `slice` of rows of `nx` cells (every cell read
+/// only for its [`cell::OPAQUE`] bit): each cell gets its finished form
+/// for the distance to the nearest opaque voxel of the slice (see the
+/// [module docs](self)). Returns the box of the slice's opaque voxels
+/// (empty without one). A slice whose length is not a multiple of `nx`
+/// (or `nx` = 0) is left as it is.
+pub fn slice_distances(slice: &mut [u8], nx: usize) -> Area {
+    if nx == 0 || !slice.len().is_multiple_of(nx) {
+        return Area::EMPTY;
+    }
+    let rows = slice.len().checked_div(nx).unwrap_or(0);
+    // Along each row, then up the slice: from the row below when an opaque
+    // row is near below (`last`: the latest one), over the columns the
+    // opaque voxels so far reach (`seen`).
+    let mut seen = Area::EMPTY;
+    let mut last: Option<usize> = None;
+    for y in 0..rows {
+        let start = y.wrapping_mul(nx);
+        let Some((done, rest)) = slice.split_at_mut_checked(start) else {
+            break;
+        };
+        let row = rest.get_mut(..nx).unwrap_or(&mut []);
+        let opaque = row_distances(row);
+        if let Some(l) = last
+            && reaches(y.wrapping_sub(l))
+        {
+            let below = done.get(start.wrapping_sub(nx)..).unwrap_or(&[]);
+            relax_row(row, &[below], seen.reached(nx, rows).x);
+        }
+        if let Some(x) = opaque {
+            seen = seen.union(Area {
+                x,
+                y: [y, y.wrapping_add(1)],
+            });
+            last = Some(y);
+        }
+    }
+    if seen.is_empty() {
+        return seen;
+    }
+    // Down the slice: from the row above when an opaque row is near above.
+    let columns = seen.reached(nx, rows).x;
+    let mut next: Option<usize> = None;
+    for y in (0..rows).rev() {
+        let start = y.wrapping_mul(nx);
+        if let Some(n) = next
+            && reaches(n.wrapping_sub(y))
+        {
+            let (head, above) = slice.split_at_mut(start.wrapping_add(nx));
+            let above = above.get(..nx).unwrap_or(&[]);
+            relax_row(head.get_mut(start..).unwrap_or(&mut []), &[above], columns);
+        }
+        let row = slice.get(start..start.wrapping_add(nx)).unwrap_or(&[]);
+        if row.contains(&OPAQUE_CELL) {
+            next = Some(y);
+        }
+    }
+    seen
+}
+
+/// [`FIELD_REACH`] as an index distance.
+#[inline]
+const fn reach() -> usize {
+    FIELD_REACH as usize
+}
+
+/// Steps 2 and 3: relaxes the cells `area` of a slice of rows of `nx`
+/// cells from the finished neighbouring slice `neighbour` (the whole
+/// slice below for step 2, above for step 3): each cell becomes the least
+/// of itself and one beyond the nine cells around it in `neighbour`.
+/// `rows` holds the slice's rows from row `y0` on (all of them, or a
+/// caller's share: only the rows of `area` among them are relaxed). The
+/// relaxation changes nothing outside the box of the opaque voxels in the
+/// slices on that side within [`FIELD_REACH`], [grown](Area::reached) by
+/// it: that box is the `area` to give (or any larger one).
+pub fn relax_rows(rows: &mut [u8], neighbour: &[u8], nx: usize, y0: usize, area: Area) {
+    if nx == 0 || area.is_empty() {
+        return;
+    }
+    let ny = neighbour.len().checked_div(nx).unwrap_or(0);
+    for (i, row) in rows.chunks_exact_mut(nx).enumerate() {
+        let y = y0.saturating_add(i);
+        if y >= ny.min(area.y[1]) {
+            return;
+        }
+        if y < area.y[0] {
+            continue;
+        }
+        let at = |yy: usize| neighbour.get(yy.checked_mul(nx)?..)?.get(..nx);
+        let near = [
+            y.checked_sub(1).and_then(at),
+            at(y),
+            at(y.saturating_add(1)),
+        ];
+        let mut given: [&[u8]; 3] = [&[]; 3];
+        let mut k = 0usize;
+        for r in near.into_iter().flatten() {
+            if let Some(slot) = given.get_mut(k) {
+                *slot = r;
+                k = k.saturating_add(1);
+            }
+        }
+        relax_row(row, given.get(..k).unwrap_or(&[]), area.x);
+    }
+}
+
+/// Whether relaxing slice (row) `i` from its neighbour on one side can
+/// change it, given the nearest slice (row) with an opaque voxel on that
+/// side (counting the neighbour itself) at distance `gap`: only within
+/// [`FIELD_REACH`].
+#[must_use]
+pub const fn reaches(gap: usize) -> bool {
+    gap >= 1 && gap <= reach()
+}
+
+/// `row[x] = min(row[x], one_beyond(min of the neighbour rows at x − 1, x,
+/// x + 1))` for the columns `x0..x1` of `row`, with neighbour rows of
+/// its length.
+fn relax_row(row: &mut [u8], neighbours: &[&[u8]], [x0, x1]: [usize; 2]) {
+    let n = row.len();
+    let stop = x1.min(n);
+    let mut start = x0;
+    while start < stop {
+        let end = start.saturating_add(CHUNK).min(stop);
+        // t[j] = the least neighbour cell at x = start − 1 + j.
+        let mut t = [FAR; CHUNK + 2];
+        let lo = start.saturating_sub(1);
+        let hi = end.saturating_add(1).min(n);
+        // 0 when start > 0, 1 at the row's start.
+        let off = lo.wrapping_add(1).wrapping_sub(start);
+        let width = hi.wrapping_sub(lo);
+        for nb in neighbours {
+            if let (Some(src), Some(dst)) =
+                (nb.get(lo..hi), t.get_mut(off..off.wrapping_add(width)))
+            {
+                for (d, &s) in dst.iter_mut().zip(src) {
+                    *d = (*d).min(s);
+                }
+            }
+        }
+        if let Some(seg) = row.get_mut(start..end) {
+            let len = seg.len();
+            let (a, b, c) = (
+                t.get(..len).unwrap_or(&[]),
+                t.get(1..len.wrapping_add(1)).unwrap_or(&[]),
+                t.get(2..len.wrapping_add(2)).unwrap_or(&[]),
+            );
+            for (((cell, &a), &b), &c) in seg.iter_mut().zip(a).zip(b).zip(c) {
+                *cell = (*cell).min(one_beyond(a.min(b).min(c)));
+            }
+        }
+        start = end;
+    }
+}
+
+/// Step 1 along one row: opaque cells become [`OPAQUE_CELL`], the others
+/// the finished form of their distance along the row. Returns the columns
+/// from the first opaque voxel to the last (half-open), if any.
+fn row_distances(row: &mut [u8]) -> Option<[usize; 2]> {
+    let n = row.len();
+    let mut first: Option<usize> = None;
+    let mut prev: Option<usize> = None;
+    let mut from = 0usize;
+    loop {
+        let next = next_opaque(row, from);
+        let end = next.unwrap_or(n);
+        if let Some(gap) = row.get_mut(from..end) {
+            fill_gap(gap, prev.is_some(), next.is_some());
+        }
+        let Some(j) = next else {
+            return Some([first?, prev?.wrapping_add(1)]);
+        };
+        first = first.or(Some(j));
+        if let Some(c) = row.get_mut(j) {
+            *c = OPAQUE_CELL;
+        }
+        prev = Some(j);
+        from = j.wrapping_add(1);
+    }
+}
+
+/// The first cell at or after `from` with [`cell::OPAQUE`].
+fn next_opaque(row: &[u8], from: usize) -> Option<usize> {
+    let rest = row.get(from..)?;
+    // Sixteen cells at a time, then the one that has it.
+    const WORD: usize = 16;
+    const ONES: u128 = u128::from_le_bytes([cell::OPAQUE; WORD]);
+    let mut base = 0usize;
+    for w in rest.chunks_exact(WORD) {
+        let bytes: [u8; WORD] = w.try_into().unwrap_or([0; WORD]);
+        if u128::from_le_bytes(bytes) & ONES != 0 {
+            break;
+        }
+        base = base.wrapping_add(WORD);
+    }
+    let at = rest
+        .get(base..)?
+        .iter()
+        .position(|&c| c & cell::OPAQUE != 0)?;
+    Some(from.wrapping_add(base).wrapping_add(at))
+}
+
+/// The cells between two opaque ones (`left`, `right`: whether there is
+/// one just before, just after the gap): the finished form of the distance
+/// to the nearer. Only the cells within [`DISTANCE_LIMIT`] of an end are
+/// computed; the rest are set far.
+fn fill_gap(gap: &mut [u8], left: bool, right: bool) {
+    let n = gap.len();
+    let reach = usize::from(DISTANCE_LIMIT);
+    let head = if left { reach.min(n) } else { 0 };
+    let tail = if right {
+        reach.min(n.wrapping_sub(head))
+    } else {
+        0
+    };
+    let (a, rest) = gap.split_at_mut(head);
+    let mid = rest.len().wrapping_sub(tail);
+    let (m, b) = rest.split_at_mut(mid);
+    // Distances 1, 2, … from the left; the right end may be nearer.
+    for (i, c) in a.iter_mut().enumerate() {
+        let from_left = i.wrapping_add(1);
+        let from_right = if right { n.wrapping_sub(i) } else { usize::MAX };
+        *c = at_distance(u8::try_from(from_left.min(from_right)).unwrap_or(DISTANCE_LIMIT));
+    }
+    m.fill(FAR);
+    // Distances …, 2, 1 to the right end (the left one is farther here).
+    let t = b.len();
+    for (i, c) in b.iter_mut().enumerate() {
+        let d = t.wrapping_sub(i);
+        *c = at_distance(u8::try_from(d).unwrap_or(DISTANCE_LIMIT));
+    }
+}

@@ -1,0 +1,403 @@
+//! Unit tests of proximity flags, the distance field and the line level.
+
+use std::vec;
+use std::vec::Vec;
+
+use super::*;
+use crate::raster::Extent;
+use crate::raster::line_count;
+use crate::testkit::Rng;
+
+/// Chessboard distance to the nearest opaque voxel, by brute force.
+fn brute(e: Extent, opaque: &[[u32; 3]]) -> Vec<u8> {
+    let [nx, ny, nz] = e.dims();
+    let mut out = vec![DISTANCE_LIMIT; e.len()];
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let d = opaque
+                    .iter()
+                    .map(|o| o[0].abs_diff(x).max(o[1].abs_diff(y)).max(o[2].abs_diff(z)))
+                    .min()
+                    .unwrap_or(u32::MAX);
+                out[e.index([x, y, z]).unwrap()] =
+                    u8::try_from(d.min(u32::from(DISTANCE_LIMIT))).unwrap();
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn distance_field_is_the_exact_chessboard_distance() {
+    let mut rng = Rng(0x1234_5678_9abc_def0u64);
+    let mut next = |m: u32| rng.below_u32(m);
+    for case in 0..60 {
+        let dims = [1 + next(20), 1 + next(20), 1 + next(20)];
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let count = next(6);
+        let opaque: Vec<[u32; 3]> = (0..count)
+            .map(|_| [next(dims[0]), next(dims[1]), next(dims[2])])
+            .collect();
+        let mut plane = vec![cell::EMPTY; e.len()];
+        for o in &opaque {
+            plane[e.index(*o).unwrap()] = cell::OPAQUE;
+        }
+        let mut flags = plane.clone();
+        flag_neighbourhood(&mut RasterMut::new(e, &mut flags).unwrap());
+        distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+        let want = brute(e, &opaque);
+        for (i, (&c, &w)) in plane.iter().zip(&want).enumerate() {
+            assert_eq!(
+                distance(c),
+                w,
+                "case {case} dims {dims:?} voxel {:?}",
+                e.coord(i)
+            );
+            assert_eq!(c & cell::OPAQUE != 0, w == 0, "case {case}");
+            // The flag is exactly what flag_neighbourhood sets.
+            assert_eq!(
+                c & cell::PROXIMITY,
+                flags[i] & cell::PROXIMITY,
+                "case {case}"
+            );
+        }
+        // The line level: each line's smallest distance when that is at
+        // least 2, else EMPTY.
+        let mut lines = vec![0xffu8; line_count(e.len())];
+        line_distances(
+            &RasterMut::new(e, &mut plane).unwrap().as_raster(),
+            &mut lines,
+        )
+        .unwrap();
+        for (l, &got) in lines.iter().enumerate() {
+            let m = want
+                .iter()
+                .skip(l * LINE_CELLS)
+                .take(LINE_CELLS)
+                .min()
+                .copied()
+                .unwrap();
+            let expect = if m >= 2 {
+                m << cell::DISTANCE_SHIFT
+            } else {
+                cell::EMPTY
+            };
+            assert_eq!(got, expect, "case {case} line {l}");
+        }
+    }
+}
+
+#[test]
+fn distances_saturate_at_the_limit() {
+    let e = Extent::new(150, 3, 2).unwrap();
+    let mut plane = vec![cell::EMPTY; e.len()];
+    plane[e.index([0, 1, 1]).unwrap()] = cell::OPAQUE;
+    distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+    let at = |x| distance(plane[e.index([x, 0, 0]).unwrap()]);
+    assert_eq!(
+        (at(1), at(62), at(63), at(64), at(149)),
+        (1, 62, 63, 63, 63)
+    );
+    let mut empty = vec![cell::EMPTY; e.len()];
+    distance_field(&mut RasterMut::new(e, &mut empty).unwrap());
+    assert!(
+        empty
+            .iter()
+            .all(|&c| distance(c) == DISTANCE_LIMIT && c & cell::PROXIMITY == 0)
+    );
+}
+
+/// The reference: the whole-plane two-pass sequential chamfer transform
+/// (3×3×3 mask, unit weights) that the slices replaced, kept to check that
+/// they give the same bytes.
+fn chamfer_field(raster: &mut RasterMut<'_>) {
+    let Some(([nx, ny, nz], slice)) = layout(raster) else {
+        return;
+    };
+    let plane = raster.plane_mut();
+    // Work on plain distances (opaque ⇔ 0) and rebuild the cells at the end.
+    for c in plane.iter_mut() {
+        *c = if *c & cell::OPAQUE != 0 {
+            0
+        } else {
+            DISTANCE_LIMIT
+        };
+    }
+    chamfer_pass(plane, nx, ny, nz, slice, false);
+    chamfer_pass(plane, nx, ny, nz, slice, true);
+    for c in plane.iter_mut() {
+        let d = *c;
+        let opaque = if d == 0 { cell::OPAQUE } else { 0 };
+        let flag = if d <= 1 { cell::PROXIMITY } else { 0 };
+        *c = opaque | flag | (d << cell::DISTANCE_SHIFT);
+    }
+}
+
+/// Row chunk handled at once by [`chamfer_pass`] (stack buffer size).
+const CHUNK: usize = 256;
+
+/// One pass of the chamfer transform. Forward (`backward == false`): rows in
+/// increasing (z, y), x increasing; the causal neighbours of a voxel are the
+/// 3×3 block of the previous slice, the 3 voxels of the previous row and the
+/// voxel before it in its row. Backward: the mirror image.
+fn chamfer_pass(plane: &mut [u8], nx: usize, ny: usize, nz: usize, slice: usize, backward: bool) {
+    let rows = ny.saturating_mul(nz);
+    let Some(ny_nz) = core::num::NonZeroUsize::new(ny) else {
+        return;
+    };
+    for i in 0..rows {
+        let r = if backward {
+            rows.wrapping_sub(1).wrapping_sub(i)
+        } else {
+            i
+        };
+        let (y, z) = (r % ny_nz, r / ny_nz);
+        let start = r.wrapping_mul(nx);
+        // The row, and the (read-only) part of the plane holding the
+        // already-finished neighbour rows.
+        let (done, row) = if backward {
+            let Some((upto, after)) = plane.split_at_mut_checked(start.wrapping_add(nx)) else {
+                return;
+            };
+            (after as &[u8], upto.get_mut(start..).unwrap_or(&mut []))
+        } else {
+            let Some((before, rest)) = plane.split_at_mut_checked(start) else {
+                return;
+            };
+            (before as &[u8], rest.get_mut(..nx).unwrap_or(&mut []))
+        };
+        // Neighbour rows as offsets into `done`: previous row in this slice,
+        // and the three rows around y in the previous slice.
+        let base = if backward { start.wrapping_add(nx) } else { 0 };
+        let row_at = |yy: usize, zz: usize| -> Option<&[u8]> {
+            let s = zz.checked_mul(slice)?.checked_add(yy.checked_mul(nx)?)?;
+            done.get(s.checked_sub(base)?..)?.get(..nx)
+        };
+        let (y_prev, z_prev) = if backward {
+            (
+                y.checked_add(1).filter(|&v| v < ny),
+                z.checked_add(1).filter(|&v| v < nz),
+            )
+        } else {
+            (y.checked_sub(1), z.checked_sub(1))
+        };
+        let mut neighbours: [Option<&[u8]>; 4] = [None; 4];
+        neighbours[0] = y_prev.and_then(|yy| row_at(yy, z));
+        if let Some(zz) = z_prev {
+            neighbours[1] = y.checked_sub(1).and_then(|yy| row_at(yy, zz));
+            neighbours[2] = row_at(y, zz);
+            neighbours[3] = y
+                .checked_add(1)
+                .filter(|&v| v < ny)
+                .and_then(|yy| row_at(yy, zz));
+        }
+        relax_row(row, &neighbours, backward);
+    }
+}
+
+/// `row[x] = min(row[x], 1 + min over the neighbour rows of their entries
+/// at x−1, x, x+1)`, then one sequential sweep along the row.
+fn relax_row(row: &mut [u8], neighbours: &[Option<&[u8]>; 4], backward: bool) {
+    let n = row.len();
+    let mut start = 0usize;
+    while start < n {
+        let end = start.saturating_add(CHUNK).min(n);
+        // t[j] = min of the neighbour rows at x = start − 1 + j.
+        let mut t = [DISTANCE_LIMIT; CHUNK + 2];
+        let lo = start.saturating_sub(1);
+        let hi = end.saturating_add(1).min(n);
+        let off = lo.wrapping_add(1).wrapping_sub(start); // 0 when start > 0, 1 at the row's start
+        for nb in neighbours.iter().flatten() {
+            if let (Some(src), Some(dst)) = (
+                nb.get(lo..hi),
+                t.get_mut(off..off.wrapping_add(hi.wrapping_sub(lo))),
+            ) {
+                for (d, &s) in dst.iter_mut().zip(src) {
+                    *d = (*d).min(s);
+                }
+            }
+        }
+        if let Some(seg) = row.get_mut(start..end) {
+            for (j, c) in seg.iter_mut().enumerate() {
+                let a = t.get(j).copied().unwrap_or(DISTANCE_LIMIT);
+                let b = t.get(j.wrapping_add(1)).copied().unwrap_or(DISTANCE_LIMIT);
+                let c2 = t.get(j.wrapping_add(2)).copied().unwrap_or(DISTANCE_LIMIT);
+                let m = a.min(b).min(c2).saturating_add(1);
+                *c = (*c).min(m);
+            }
+        }
+        start = end;
+    }
+    // Along the row: the neighbour before (after, going backward).
+    let mut prev = DISTANCE_LIMIT;
+    let mut sweep = |c: &mut u8| {
+        let v = (*c).min(prev.saturating_add(1)).min(DISTANCE_LIMIT);
+        *c = v;
+        prev = v;
+    };
+    if backward {
+        row.iter_mut().rev().for_each(&mut sweep);
+    } else {
+        row.iter_mut().for_each(&mut sweep);
+    }
+}
+
+/// A plane of `e` with opaque voxels (and junk in the other cells' bits,
+/// which the field must ignore): a few scattered ones, runs along each
+/// axis, or dense noise, by `kind`.
+fn random_plane(rng: &mut Rng, e: Extent, kind: u32) -> Vec<u8> {
+    let [nx, ny, nz] = e.dims();
+    let mut plane: Vec<u8> = (0..e.len())
+        .map(|_| {
+            if kind.is_multiple_of(2) {
+                0
+            } else {
+                u8::try_from(rng.below(256)).unwrap() & !cell::OPAQUE
+            }
+        })
+        .collect();
+    let set = |v: [u32; 3], plane: &mut Vec<u8>| {
+        if let Some(i) = e.index(v) {
+            plane[i] |= cell::OPAQUE;
+        }
+    };
+    match kind / 2 % 3 {
+        0 => {
+            for _ in 0..rng.below(6) {
+                let v = [rng.below_u32(nx), rng.below_u32(ny), rng.below_u32(nz)];
+                set(v, &mut plane);
+            }
+        }
+        1 => {
+            for _ in 0..rng.below(4) {
+                let mut v = [rng.below_u32(nx), rng.below_u32(ny), rng.below_u32(nz)];
+                let axis = usize::try_from(rng.below(3)).unwrap();
+                for _ in 0..rng.below(40) {
+                    set(v, &mut plane);
+                    v[axis] += 1;
+                }
+            }
+        }
+        _ => {
+            let density = 1 + rng.below(40);
+            for i in 0..e.len() {
+                if rng.below(1000) < density {
+                    let v = e.coord(i).unwrap();
+                    set(v, &mut plane);
+                }
+            }
+        }
+    }
+    plane
+}
+
+#[test]
+fn distance_field_gives_the_bytes_of_the_whole_plane_chamfer() {
+    let mut rng = Rng(0x0d15_7a9c_e5eb_u64);
+    for case in 0..300u32 {
+        // Small rasters, and some longer than the limit along one axis (the
+        // skipped slices and rows) or wider than the stack buffer.
+        let long = |rng: &mut Rng| 1 + rng.below_u32(if case % 5 == 0 { 300 } else { 24 });
+        let dims = [long(&mut rng), long(&mut rng), long(&mut rng)];
+        let Ok(e) = Extent::new(dims[0], dims[1], dims[2]) else {
+            continue;
+        };
+        if e.len() > 400_000 {
+            continue;
+        }
+        let plane = random_plane(&mut rng, e, case);
+        let mut want = plane.clone();
+        chamfer_field(&mut RasterMut::new(e, &mut want).unwrap());
+        let mut got = plane.clone();
+        distance_field(&mut RasterMut::new(e, &mut got).unwrap());
+        if let Some(i) = (0..e.len()).find(|&i| got[i] != want[i]) {
+            panic!(
+                "case {case} dims {dims:?}: voxel {:?}: {:#04x}, the chamfer's {:#04x}",
+                e.coord(i),
+                got[i],
+                want[i]
+            );
+        }
+        // Again over the finished plane: the same.
+        distance_field(&mut RasterMut::new(e, &mut got).unwrap());
+        assert_eq!(got, want, "case {case}: a second run");
+    }
+}
+
+#[test]
+fn distance_field_is_exact_where_the_relaxations_are_skipped() {
+    // Long thin rasters with one or two opaque voxels: the only paths to
+    // the cells 62 and 63 voxels away run along the long axis, through the
+    // last slices (rows) a relaxation may not skip.
+    for (dims, at) in [
+        ([1, 1, 150], [[0, 0, 3], [0, 0, 140]]),
+        ([2, 3, 150], [[1, 2, 10], [1, 2, 10]]),
+        ([1, 150, 1], [[0, 5, 0], [0, 80, 0]]),
+        ([3, 150, 2], [[2, 140, 1], [2, 140, 1]]),
+        ([150, 1, 1], [[7, 0, 0], [7, 0, 0]]),
+        ([70, 70, 1], [[0, 0, 0], [69, 69, 0]]),
+        ([2, 70, 70], [[0, 0, 0], [1, 69, 69]]),
+    ] {
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let mut plane = vec![cell::EMPTY; e.len()];
+        for v in at {
+            plane[e.index(v).unwrap()] = cell::OPAQUE;
+        }
+        let mut want = plane.clone();
+        chamfer_field(&mut RasterMut::new(e, &mut want).unwrap());
+        distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+        assert_eq!(plane, want, "{dims:?} {at:?}");
+        assert_eq!(
+            brute(e, &at),
+            plane.iter().map(|&c| distance(c)).collect::<Vec<_>>()
+        );
+    }
+}
+
+#[test]
+fn field_steps_shared_out_by_rows_give_the_whole_field() {
+    // The steps a threaded caller runs (slices apart, then rows of each
+    // slice apart) against the one call.
+    let mut rng = Rng(0x0005_1ab5_u64);
+    for case in 0..40u32 {
+        let dims = [
+            1 + rng.below_u32(40),
+            1 + rng.below_u32(40),
+            1 + rng.below_u32(90),
+        ];
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let plane = random_plane(&mut rng, e, case);
+        let mut want = plane.clone();
+        distance_field(&mut RasterMut::new(e, &mut want).unwrap());
+        let [nx, ny, nz] = dims.map(|d| d as usize);
+        let slice = nx * ny;
+        let mut got = plane;
+        let opaque: Vec<field::Area> = got
+            .chunks_exact_mut(slice)
+            .map(|s| field::slice_distances(s, nx))
+            .collect();
+        let band = 1 + rng.below(5) as usize;
+        // The opaque voxels' box over the slices `zs`, reached.
+        let reached = |zs: core::ops::Range<usize>| {
+            zs.fold(field::Area::EMPTY, |a, z| a.union(opaque[z]))
+                .reached(nx, ny)
+        };
+        let relax = |got: &mut Vec<u8>, z: usize, from: usize, area: field::Area| {
+            let src = got[from * slice..][..slice].to_vec();
+            for (i, rows) in got[z * slice..][..slice].chunks_mut(band * nx).enumerate() {
+                field::relax_rows(rows, &src, nx, i * band, area);
+            }
+        };
+        let reach = field::FIELD_REACH as usize;
+        for z in 1..nz {
+            let area = reached(z.saturating_sub(reach)..z);
+            relax(&mut got, z, z - 1, area);
+        }
+        for z in (0..nz.saturating_sub(1)).rev() {
+            let area = reached(z + 1..(z + 1 + reach).min(nz));
+            relax(&mut got, z, z + 1, area);
+        }
+        assert_eq!(got, want, "case {case} dims {dims:?} band {band}");
+    }
+}
