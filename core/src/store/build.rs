@@ -213,6 +213,10 @@ impl VoxelSink for Counter<'_, '_> {
         layers_of(self.raster.extent(), self.slab)
     }
 
+    fn reads_surfels(&self) -> bool {
+        false
+    }
+
     fn offer(&mut self, voxel: [u32; 3], _surfel: Surfel) {
         self.report.offers = self.report.offers.saturating_add(1);
         let outside = &mut self.report.outside;

@@ -36,7 +36,7 @@ use super::fixmath::{
     Counter, H, cell_floor, centre, centres_within, check_point, clip, dist_u32, length, split,
     sub, unit, window,
 };
-use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
+use super::{NORMAL_ONE, Separation, Surfel, UNREAD, VoxelSink};
 use crate::geometry::Cuboid;
 use crate::raster::Extent;
 
@@ -80,6 +80,7 @@ fn scan<S: VoxelSink + ?Sized>(
     let bx = BoxTies::new(b)?;
     let (lo, hi) = (bx.lo, bx.hi);
     let win = window(extent, sink.layers());
+    let reads = sink.reads_surfels();
     let mut n = Counter::default();
     // Candidate cells along one axis: TwentySix exactly (half-open per the
     // tie rule); Six closed within the L1 budget left by the other axes,
@@ -129,15 +130,23 @@ fn scan<S: VoxelSink + ?Sized>(
                     if sep == Separation::Six && !bx.meets_six(v) {
                         continue;
                     }
-                    sink.offer(v, surfel(lo, hi, v));
+                    let s = if reads { surfel(lo, hi, v) } else { UNREAD };
+                    sink.offer(v, s);
                     n.bump();
                 }
             }
             if let (true, Some((a, b))) = (fill, inside) {
                 for z in a..=b {
                     let v = [x, y, z];
-                    let s = surfel(lo, hi, v);
-                    sink.offer(v, Surfel { distance: 0, ..s });
+                    let s = if reads {
+                        Surfel {
+                            distance: 0,
+                            ..surfel(lo, hi, v)
+                        }
+                    } else {
+                        UNREAD
+                    };
+                    sink.offer(v, s);
                     n.bump();
                 }
             }

@@ -116,7 +116,22 @@ pub trait VoxelSink {
     fn layers(&self) -> Range<u32> {
         0..u32::MAX
     }
+
+    /// Whether the sink reads the surfels offered (yes unless it says
+    /// otherwise). To a sink that only counts voxels (the builder's count
+    /// pass) a voxelizer may offer [`UNREAD`] instead of computing them;
+    /// the voxels and their order are the same.
+    fn reads_surfels(&self) -> bool {
+        true
+    }
 }
+
+/// The surfel offered to a sink that does not read surfels
+/// ([`VoxelSink::reads_surfels`]).
+pub const UNREAD: Surfel = Surfel {
+    normal: [0, 0, NORMAL_ONE],
+    distance: 0,
+};
 
 pub mod cone;
 pub mod cuboid;

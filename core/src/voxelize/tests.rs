@@ -1,6 +1,8 @@
-//! The layers contract of every voxelizer ([`VoxelSink::layers`]): a sink
-//! that keeps some layers gets exactly the offers of those layers that a
-//! sink keeping every layer gets, in the same order.
+//! The hints of every voxelizer's sink: a sink that keeps some layers
+//! ([`VoxelSink::layers`]) gets exactly the offers of those layers that a
+//! sink keeping every layer gets, in the same order, and one that reads no
+//! surfels ([`VoxelSink::reads_surfels`]) the same voxels in the same
+//! order.
 
 use core::ops::Range;
 use std::vec::Vec;
@@ -13,9 +15,11 @@ use crate::geometry::{BezierPatch, Cone, Cuboid, Point, Sphere, Torus, Triangle}
 use crate::raster::Extent;
 use crate::testkit::Rng;
 
-/// Every offer in order; keeps the layers `layers`.
+/// Every offer in order; keeps the layers `layers`, reads the surfels if
+/// `reads`.
 struct Sequence {
     layers: Range<u32>,
+    reads: bool,
     offers: Vec<(u16, [u32; 3], Surfel)>,
 }
 
@@ -23,6 +27,7 @@ impl Sequence {
     fn new(layers: Range<u32>) -> Self {
         Self {
             layers,
+            reads: true,
             offers: Vec::new(),
         }
     }
@@ -35,6 +40,10 @@ impl VoxelSink for Sequence {
 
     fn layers(&self) -> Range<u32> {
         self.layers.clone()
+    }
+
+    fn reads_surfels(&self) -> bool {
+        self.reads
     }
 }
 
@@ -59,6 +68,15 @@ fn assert_layers_kept(what: &str, layers: Range<u32>, run: impl Fn(&mut Sequence
     let want: Vec<_> = all.offers.iter().filter(inside).collect();
     let got: Vec<_> = some.offers.iter().filter(inside).collect();
     assert_eq!(got, want, "{what}, layers {layers:?}");
+    let mut counting = Sequence {
+        reads: false,
+        ..Sequence::new(layers.clone())
+    };
+    run(&mut counting);
+    let voxels = |o: &(u16, [u32; 3], Surfel)| (o.0, o.1);
+    let want: Vec<_> = all.offers.iter().filter(inside).map(voxels).collect();
+    let got: Vec<_> = counting.offers.iter().filter(inside).map(voxels).collect();
+    assert_eq!(got, want, "{what}, layers {layers:?}, surfels unread");
 }
 
 /// A point near the raster of `n` voxels per axis, in fixed units.

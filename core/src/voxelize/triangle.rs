@@ -74,7 +74,7 @@ use super::fixmath::{
     floor_div, isqrt, low, sub, unit, window,
 };
 use super::sphere::{pick, place};
-use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
+use super::{NORMAL_ONE, Separation, Surfel, UNREAD, VoxelSink};
 use crate::geometry::{Point, Triangle, UnitVector};
 use crate::raster::Extent;
 
@@ -502,6 +502,7 @@ impl Tri {
         }
         let k = dominant(self.n);
         let (na, nb, nk) = pick(k, win);
+        let reads = sink.reads_surfels();
         // Axes in (a, b, k) coordinates, split by role.
         let mut rows = [Axis::default(); 32];
         let mut cols = [Axis::default(); 32];
@@ -596,7 +597,8 @@ impl Tri {
                 };
                 for ki in k0..=k1 {
                     let v = place(k, ai, bi, ki);
-                    sink.offer(v, surfel(self, v));
+                    let s = if reads { surfel(self, v) } else { UNREAD };
+                    sink.offer(v, s);
                     n.bump();
                 }
             }

@@ -46,7 +46,7 @@
 
 use super::error::{COORD_LIMIT, VoxelizeError};
 use super::fixmath::{Counter, V, dist_u32, dot, isqrt, unit, window};
-use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
+use super::{NORMAL_ONE, Separation, Surfel, UNREAD, VoxelSink};
 use crate::raster::Extent;
 
 /// A block of samples, x fastest (`samples[i + nx·(j + ny·k)]`), placed at
@@ -167,7 +167,12 @@ where
                 if !extent.contains(c) {
                     continue;
                 }
-                sink.offer(c, g.surfel(i, j, k, f, thr));
+                let s = if sink.reads_surfels() {
+                    g.surfel(i, j, k, f, thr)
+                } else {
+                    UNREAD
+                };
+                sink.offer(c, s);
                 n.bump();
             }
         }

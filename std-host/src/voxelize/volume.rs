@@ -281,6 +281,10 @@ impl PlacedVolume<'_> {
             fn layers(&self) -> Range<u32> {
                 self.0.layers()
             }
+
+            fn reads_surfels(&self) -> bool {
+                self.0.reads_surfels()
+            }
         }
         let layers = sink.layers();
         let mut counted = Count(sink, 0);
@@ -397,6 +401,10 @@ impl<S: VoxelSink + ?Sized> VoxelSink for ClipZ<'_, S> {
         if self.z.contains(&voxel[2]) {
             self.sink.offer(voxel, surfel);
         }
+    }
+
+    fn reads_surfels(&self) -> bool {
+        self.sink.reads_surfels()
     }
 
     fn layers(&self) -> Range<u32> {
