@@ -91,7 +91,7 @@ impl<'p, 'd> Counter<'p, 'd> {
     /// [`BuildError::DirectoryLength`] unless `dir.len()` is
     /// [`directory_len`] of the raster.
     pub fn new(raster: RasterMut<'p>, dir: &'d mut [u32]) -> Result<Self, BuildError> {
-        Self::start(raster, dir, None)
+        Self::start(raster, dir, None, true)
     }
 
     /// Starts one *slab* of a scene: the layers `z0 .. z0 + nz` of a larger
@@ -117,13 +117,33 @@ impl<'p, 'd> Counter<'p, 'd> {
         if !z0.is_multiple_of(BRICK) {
             return Err(BuildError::SlabOrigin { z0 });
         }
-        Self::start(raster, dir, Some(z0))
+        Self::start(raster, dir, Some(z0), true)
+    }
+
+    /// [`Counter::slab`] over a plane part and a directory that are all
+    /// zero already (fresh zeroed memory): they are not read to check, so
+    /// the pages of a fresh anonymous map that no voxel falls in are never
+    /// touched. A nonzero cell or entry makes the build wrong or refused,
+    /// never unsafe.
+    ///
+    /// # Errors
+    /// As [`Counter::slab`].
+    pub fn slab_zeroed(
+        raster: RasterMut<'p>,
+        dir: &'d mut [u32],
+        z0: u32,
+    ) -> Result<Self, BuildError> {
+        if !z0.is_multiple_of(BRICK) {
+            return Err(BuildError::SlabOrigin { z0 });
+        }
+        Self::start(raster, dir, Some(z0), false)
     }
 
     fn start(
         mut raster: RasterMut<'p>,
         dir: &'d mut [u32],
         slab: Option<u32>,
+        clearing: bool,
     ) -> Result<Self, BuildError> {
         let expected = directory_len(raster.extent()).unwrap_or(usize::MAX);
         if dir.len() != expected {
@@ -132,8 +152,10 @@ impl<'p, 'd> Counter<'p, 'd> {
                 found: dir.len(),
             });
         }
-        clear(raster.plane_mut());
-        clear(dir);
+        if clearing {
+            clear(raster.plane_mut());
+            clear(dir);
+        }
         Ok(Self {
             raster,
             dir,

@@ -73,7 +73,10 @@
 //! plane, directory, records and lists are contiguous ranges of the whole
 //! scene's, and slabs built independently (on any number of threads) are
 //! concatenated into exactly the bytes one whole build of the same slabs
-//! gives.
+//! gives. The slab's sinks name its layers
+//! ([`VoxelSink::layers`](crate::voxelize::VoxelSink::layers)), so the
+//! voxelizers skip the rest of the raster; [`Counter::slab_zeroed`] starts
+//! on fresh zeroed memory without reading it.
 //!
 //! # Overlap
 //! When two offers claim one voxel, the one whose surface is nearer the

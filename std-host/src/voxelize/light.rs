@@ -66,18 +66,17 @@ impl LightScene {
         }
     }
 
-    /// The lit copy of `store`'s records, computed on `threads` threads (0:
-    /// one per core), and the pass's counts; `progress` counts records as
-    /// their runs finish.
+    /// The lit copy of `store`'s records, computed on `pool`'s threads, and
+    /// the pass's counts; `progress` counts records as their runs finish.
     ///
     /// # Errors
-    /// The core's [`LightError`]; threads that cannot be started.
+    /// The core's [`LightError`].
     pub fn illuminate(
         &self,
         raster: &Raster<'_>,
         store: &RecordStore<'_>,
         params: &LightParams,
-        threads: usize,
+        pool: &rayon::ThreadPool,
         progress: &ProgressBar,
     ) -> Result<(Vec<VoxelRecord>, LightReport), BuildError> {
         let mut storage = vec![Object::UNUSED; self.entries.len()];
@@ -87,10 +86,6 @@ impl LightScene {
             let _ = table.push(*o);
         }
         let mut out = store.records().to_vec();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| BuildError::Raster(format!("cannot start threads: {e}")))?;
         let reports: Vec<Result<LightReport, LightError>> = pool.install(|| {
             out.par_chunks_mut(LIGHT_RUN)
                 .enumerate()

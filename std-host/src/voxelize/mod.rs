@@ -1,30 +1,32 @@
 //! From a scene to a voxelized raster: the paper's preprocessing phase
 //! (voxelization and light visibility).
 //!
-//! [`build`] runs the whole pipeline:
+//! [`build`] runs the whole pipeline, each pass on rayon's threads (the
+//! `threads` of [`BuildOptions`]), with a result that does not depend on
+//! their number:
 //! 1. **fit** ([`crate::fit`]): the raster's frame, the memory estimate
 //!    against the limit, every primitive and light in fixed point;
-//! 2. **allocate** the plane ([`Plane`]: an anonymous map with huge pages)
-//!    and the brick directory;
-//! 3. **count pass**: every object of the object table
-//!    ([`objects::in_id_order`]) through its voxelizer into the
-//!    [`Counter`], with the separation the chosen rays need
-//!    ([`Separation::for_rays`]); the exact record count is then checked
-//!    against the memory limit before the records are allocated;
+//! 2. **allocate** the plane ([`Plane`]: an anonymous map with huge pages);
+//! 3. **count pass** ([`slabs`]: the raster cut into z-slabs, each built on
+//!    its own by the core's builder and joined): every object of the
+//!    object table ([`objects::in_id_order`]) through its voxelizer into
+//!    the [`Counter`](rrt_core::store::Counter) of each slab, with the
+//!    separation the chosen rays need ([`Separation::for_rays`]); the exact
+//!    record count is then checked against the memory limit before the
+//!    records are allocated;
 //! 4. **fill pass**: every object again, named with its object id,
 //!    material and colour ([`materials`]; textured materials colour each
 //!    voxel once, [`texture`]);
 //!    [`Filler::finish`](rrt_core::store::Filler::finish) sorts the bricks
-//!    and sets the proximity flags;
+//!    and lays out the object lists; the slabs are joined;
 //! 5. **finish** ([`finish_plane`]): the proximity distance field, which
-//!    lets 26-runs skip empty space, the records' rank hints and the line
-//!    level;
+//!    lets 26-runs skip empty space (and sets the proximity flags), the
+//!    records' rank hints and the line level;
 //! 6. **light visibility** ([`light`]): per record and light, one discrete
 //!    shadow ray (the paper's two bits), or for a record of exact objects
 //!    on an exact raster the shadow classification or nothing
 //!    ([`LightParams::exact_records`]); then the precomputed ambient +
-//!    diffuse illumination; on rayon's threads; the result does not
-//!    depend on the thread count.
+//!    diffuse illumination.
 //!
 //! The primitives are voxelized by their core voxelizers
 //! ([`crate::shape`]); volumes ([`volume`]), `.vox` models ([`vox`]) and
@@ -40,6 +42,7 @@ pub mod materials;
 pub mod objects;
 pub mod pass;
 pub mod plane;
+pub mod slabs;
 pub mod texture;
 pub mod volume;
 pub mod vox;
@@ -51,8 +54,7 @@ use indicatif::ProgressBar;
 use rrt_core::connectivity::Connectivity;
 use rrt_core::light::{ExactRecords, LightError, LightParams, LightReport};
 use rrt_core::object_table::MAX_LIGHTS;
-use rrt_core::raster::RasterMut;
-use rrt_core::store::{self, Built, Counter, Limits, Sizing, directory_len};
+use rrt_core::store;
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 use rrt_core::voxelize::error::VoxelizeError;
@@ -62,12 +64,10 @@ pub use self::voxel_scene::{VoxelScene, WorldLight, WorldObject, finish_plane, l
 
 use self::light::LightScene;
 use self::materials::MaterialTable;
-use self::objects::TableObject;
-use self::pass::Pass;
 use self::plane::Plane;
+use self::slabs::{Counted, Passes, Voxelized};
 use self::texture::MaterialTextures;
 use crate::fit::{self, Bytes, FitError, FitOptions};
-use crate::frame::RasterFrame;
 use crate::progress::Unit;
 use crate::scene::{Scene, SourceLoc};
 
@@ -82,7 +82,8 @@ pub struct BuildOptions {
     /// exact objects ([`LightParams::exact_records`]; only on an
     /// [`exact`](Self::exact) raster, the paper's bits otherwise).
     pub light: LightParams,
-    /// Threads of the light pass; 0 for one per core.
+    /// Threads of the voxelization, the plane's last pass and the light
+    /// pass; 0 for one per core. The result does not depend on it.
     pub threads: usize,
     /// Voxelize for exact intersection verification: every object
     /// conservatively ([`Separation::TwentySix`]: each voxel whose closed
@@ -134,7 +135,7 @@ pub struct BuildReport {
     /// Objects dropped by the fit (degenerate in fixed point, or outside
     /// explicit bounds).
     pub dropped: usize,
-    /// Voxel offers in the count pass.
+    /// Voxel offers inside the raster in the count pass.
     pub offers: u64,
     /// Records (non-transparent voxels).
     pub records: usize,
@@ -280,68 +281,64 @@ pub fn build(
     };
     let objects = objects::in_id_order(scene, &fitted);
     let n = objects.len();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .map_err(|e| BuildError::Raster(format!("cannot start threads: {e}")))?;
 
     let mut plane = Plane::zeroed(extent.len()).map_err(alloc_err("raster plane", extent.len()))?;
-    let dir_len =
-        directory_len(extent).ok_or_else(|| BuildError::Raster("too many bricks".into()))?;
-    let mut directory = vec![0u32; dir_len];
-
-    let (sizing, offers) = count_pass(
-        &objects,
-        &frame,
-        separation,
-        &mut plane,
-        &mut directory,
-        progress,
-    )?;
-    let records_n = sizing.records();
-    if let Some(bounds) = opts.fit.bounds
-        && records_n == 0
-    {
-        return Err(BuildError::EmptyBounds {
-            file: scene.file.to_string(),
-            bounds,
-        });
-    }
-    // The lists' working storage: the count pass's bound (see
-    // `Sizing::list_entries`), only for an exact raster.
-    let list_n = if opts.exact { sizing.list_entries() } else { 0 };
-    let needed = u64::try_from(
-        extent
-            .len()
-            .saturating_add(dir_len.saturating_mul(size_of::<u32>()))
-            .saturating_add(sizing.record_bytes())
-            .saturating_add(list_n.saturating_mul(size_of::<u32>())),
-    )
-    .unwrap_or(u64::MAX);
-    if needed > opts.fit.max_memory {
-        return Err(BuildError::TooMuchMemory {
-            dims: fit::Dims(extent.dims()),
-            records: records_n,
-            needed,
-            limit: opts.fit.max_memory,
-        });
-    }
-    let mut records = vec![VoxelRecord::default(); records_n];
-    let mut lists = vec![0u32; list_n];
     let textures = MaterialTextures::new(scene, frame);
-    let built = fill_pass(
-        &objects,
-        &frame,
+    let passes = Passes {
+        objects: &objects,
+        frame: &frame,
         separation,
-        sizing,
-        (&mut records, opts.exact.then_some(&mut lists[..])),
-        &materials,
-        &textures,
-        progress,
-    )?;
-    let lists_used = built.lists().len();
-    lists.truncate(lists_used);
-    lists.shrink_to_fit();
+        materials: &materials,
+        textures: &textures,
+        exact: opts.exact,
+    };
+    let layers = slabs::slab_layers(extent.dims()[2], pool.current_num_threads());
+    // Refused after the count pass, before the records are allocated: an
+    // empty box, or more memory than the limit for the exact record count
+    // (and the lists' working storage, the count pass's bound, see
+    // `Sizing::list_entries`).
+    let check = |c: Counted| {
+        if let Some(bounds) = opts.fit.bounds
+            && c.records == 0
+        {
+            return Err(BuildError::EmptyBounds {
+                file: scene.file.to_string(),
+                bounds,
+            });
+        }
+        let needed = u64::try_from(
+            extent
+                .len()
+                .saturating_add(c.directory.saturating_mul(size_of::<u32>()))
+                .saturating_add(c.records.saturating_mul(size_of::<VoxelRecord>()))
+                .saturating_add(c.list_entries.saturating_mul(size_of::<u32>())),
+        )
+        .unwrap_or(u64::MAX);
+        if needed > opts.fit.max_memory {
+            return Err(BuildError::TooMuchMemory {
+                dims: fit::Dims(extent.dims()),
+                records: c.records,
+                needed,
+                limit: opts.fit.max_memory,
+            });
+        }
+        Ok(())
+    };
+    let Voxelized {
+        directory,
+        mut records,
+        lists,
+        offers,
+    } = passes.run(&mut plane, &layers, &pool, check, progress)?;
+    let records_n = records.len();
     // The light pass changes no cell and no record's place: the plane can
     // be finished first, so that its walks read the distance field and
     // the rank hints.
-    let lines = finish_plane(extent, &mut plane, &directory, &records, &lists);
+    let lines = pool.install(|| finish_plane(extent, &mut plane, &directory, &records, &lists));
     let voxelize = t0.elapsed();
 
     let t1 = Instant::now();
@@ -359,13 +356,8 @@ pub fn build(
         .map_err(|e| BuildError::Raster(e.to_string()))?;
     let store = rrt_core::store::RecordStore::with_lists(extent, &directory, &records, &lists)
         .map_err(|e| BuildError::Raster(e.to_string()))?;
-    let (lit, light_report) = LightScene::new(&objects, &materials, &fitted.lights).illuminate(
-        &raster,
-        &store,
-        &light,
-        opts.threads,
-        progress,
-    )?;
+    let (lit, light_report) = LightScene::new(&objects, &materials, &fitted.lights)
+        .illuminate(&raster, &store, &light, &pool, progress)?;
     records = lit;
     let lights_time = t1.elapsed();
 
@@ -412,75 +404,4 @@ pub fn build(
         },
         report,
     ))
-}
-
-/// The count pass: every object's voxels counted into the plane and the
-/// brick directory. Returns the sizing of the records and the voxels
-/// offered.
-fn count_pass<'p, 'd>(
-    objects: &[TableObject<'_>],
-    frame: &RasterFrame,
-    separation: Separation,
-    plane: &'p mut [u8],
-    directory: &'d mut [u32],
-    progress: &ProgressBar,
-) -> Result<(Sizing<'p, 'd>, u64), BuildError> {
-    crate::progress::phase(
-        progress,
-        "voxelizing (count pass)",
-        Unit::Objects,
-        objects.len() as u64,
-    );
-    let raster =
-        RasterMut::new(frame.extent, plane).map_err(|e| BuildError::Raster(e.to_string()))?;
-    let mut counter = Counter::new(raster, directory)?;
-    for o in objects {
-        o.voxelize(frame, separation, Pass::Count(&mut counter))?;
-        progress.inc(1);
-    }
-    let offers = counter.report().offers;
-    Ok((counter.finish()?, offers))
-}
-
-/// The fill pass: every object again, into `records` (and, given list
-/// storage, the object lists), named with its object id, material and
-/// colour (a textured material's colour computed per voxel). Returns the
-/// store, its bricks sorted and proximity flags set.
-#[allow(clippy::too_many_arguments)]
-fn fill_pass<'p, 'd, 'r>(
-    objects: &[TableObject<'_>],
-    frame: &RasterFrame,
-    separation: Separation,
-    sizing: Sizing<'p, 'd>,
-    (records, lists): (&'r mut [VoxelRecord], Option<&'r mut [u32]>),
-    materials: &MaterialTable,
-    textures: &MaterialTextures,
-    progress: &ProgressBar,
-) -> Result<Built<'p, 'd, 'r>, BuildError> {
-    crate::progress::phase(
-        progress,
-        "voxelizing (fill pass)",
-        Unit::Objects,
-        objects.len() as u64,
-    );
-    let limits = Limits {
-        objects: u32::try_from(objects.len()).unwrap_or(u32::MAX),
-        materials: u32::try_from(materials.list.len()).unwrap_or(u32::MAX),
-    };
-    let mut filler = match lists {
-        Some(lists) => sizing.fill_with_lists(records, lists, limits)?,
-        None => sizing.fill(records, limits)?,
-    };
-    for (id, o) in objects.iter().enumerate() {
-        let m = o.material();
-        let pass = Pass::Fill {
-            filler: &mut filler,
-            attrs: materials.attrs(id, m),
-            leaves: o.leaf_materials().map(|l| materials.attrs(id, l)).collect(),
-            texture: textures.of(m),
-        };
-        o.voxelize(frame, separation, pass)?;
-        progress.inc(1);
-    }
-    Ok(filler.finish()?)
 }

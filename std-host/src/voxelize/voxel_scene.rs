@@ -6,9 +6,11 @@
 //! the lights in `f64` for shading.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use rrt_core::light::ExactRecords;
-use rrt_core::proximity::{distance_field, line_distances};
-use rrt_core::raster::{Extent, Raster, RasterMut, line_count};
+use rrt_core::proximity::field::{self, Area};
+use rrt_core::proximity::line_stand_ins;
+use rrt_core::raster::{Extent, LINE_CELLS, Raster, RasterMut, line_count};
 use rrt_core::store::{RecordStore, StoreError, write_rank_hints};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
@@ -128,8 +130,11 @@ impl VoxelScene {
 /// proximity distance field (empty-space skipping for 26-runs; it sets the
 /// same PROXIMITY flags the builder set), the records' rank hints in their
 /// opaque cells (which the field clears), and the line level, returned.
-/// A plane, directory, record or list array that does not match `extent`
-/// is left as it is, with no line level.
+/// On the current rayon pool; the bytes are those of
+/// [`distance_field`](rrt_core::proximity::distance_field) and
+/// [`write_rank_hints`] whatever the number of threads. A plane,
+/// directory, record or list array that does not match `extent` is left
+/// as it is, with no line level.
 pub fn finish_plane(
     extent: Extent,
     plane: &mut [u8],
@@ -137,25 +142,95 @@ pub fn finish_plane(
     records: &[VoxelRecord],
     lists: &[u32],
 ) -> Vec<u8> {
-    if let Ok(mut raster) = RasterMut::new(extent, plane) {
-        distance_field(&mut raster);
-        if let Ok(store) = RecordStore::with_lists(extent, directory, records, lists) {
-            write_rank_hints(&mut raster, &store);
-        }
+    if plane.len() != extent.len() {
+        return Vec::new();
+    }
+    distance_field(extent, plane);
+    if let Ok(mut raster) = RasterMut::new(extent, plane)
+        && let Ok(store) = RecordStore::with_lists(extent, directory, records, lists)
+    {
+        write_rank_hints(&mut raster, &store);
     }
     line_level(extent, plane)
 }
 
-/// The line level of a plane over `extent` ([`line_distances`]): one
+/// Boxes of fewer cells than this are relaxed on one thread.
+const PARALLEL_CELLS: usize = 1 << 15;
+
+/// The distance field of `plane` (as long as `extent`) on the current
+/// rayon pool: the core's steps ([`field`]) with the slices of step 1
+/// shared out, then the rows of each slice in steps 2 and 3, each slice
+/// relaxed only over the box its neighbours' opaque voxels reach.
+fn distance_field(extent: Extent, plane: &mut [u8]) {
+    let [nx, ny, nz] = extent.dims().map(|d| d as usize);
+    let slice = nx * ny;
+    let opaque: Vec<Area> = plane
+        .par_chunks_mut(slice)
+        .map(|s| field::slice_distances(s, nx))
+        .collect();
+    let reach = field::FIELD_REACH as usize;
+    let reached = |zs: std::ops::Range<usize>| {
+        opaque[zs]
+            .iter()
+            .fold(Area::EMPTY, |a, &b| a.union(b))
+            .reached(nx, ny)
+    };
+    for z in 1..nz {
+        let area = reached(z.saturating_sub(reach)..z);
+        relax_slice(plane, [nx, ny], z, z - 1, area);
+    }
+    for z in (0..nz.saturating_sub(1)).rev() {
+        let area = reached(z + 1..(z + 1 + reach).min(nz));
+        relax_slice(plane, [nx, ny], z, z + 1, area);
+    }
+}
+
+/// Relaxes the box `area` of slice `z` of `plane` from its neighbour
+/// `from` ([`field::relax_rows`]), its rows shared out among the pool's
+/// threads.
+fn relax_slice(plane: &mut [u8], [nx, ny]: [usize; 2], z: usize, from: usize, area: Area) {
+    if area.is_empty() {
+        return;
+    }
+    let slice = nx * ny;
+    let (cur, src): (&mut [u8], &[u8]) = if from < z {
+        let (lo, hi) = plane.split_at_mut(z * slice);
+        (&mut hi[..slice], &lo[from * slice..][..slice])
+    } else {
+        let (lo, hi) = plane.split_at_mut(from * slice);
+        (&mut lo[z * slice..][..slice], &hi[..slice])
+    };
+    let [y0, y1] = area.y;
+    let rows = &mut cur[y0 * nx..y1 * nx];
+    if (y1 - y0) * (area.x[1] - area.x[0]) < PARALLEL_CELLS {
+        field::relax_rows(rows, src, nx, y0, area);
+        return;
+    }
+    // A few bands of rows per thread.
+    let band = (y1 - y0).div_ceil(4 * rayon::current_num_threads()).max(1);
+    rows.par_chunks_mut(band * nx)
+        .enumerate()
+        .for_each(|(i, rows)| field::relax_rows(rows, src, nx, y0 + i * band, area));
+}
+
+/// The line level of a plane over `extent`
+/// ([`line_distances`](rrt_core::proximity::line_distances)): one
 /// stand-in cell per 64 cells, which lets skipping walks stay off the plane
-/// far from surfaces. Empty if the plane does not match the extent.
+/// far from surfaces; on the current rayon pool. Empty if the plane does
+/// not match the extent.
 #[must_use]
 pub fn line_level(extent: Extent, plane: &[u8]) -> Vec<u8> {
-    let mut lines = vec![0u8; line_count(plane.len())];
-    match Raster::new(extent, plane).map(|r| line_distances(&r, &mut lines)) {
-        Ok(Ok(())) => lines,
-        _ => Vec::new(),
+    if plane.len() != extent.len() {
+        return Vec::new();
     }
+    let mut lines = vec![0u8; line_count(plane.len())];
+    // Parts of whole lines.
+    const LINES_PER_PART: usize = 1 << 12;
+    lines
+        .par_chunks_mut(LINES_PER_PART)
+        .zip(plane.par_chunks(LINES_PER_PART * LINE_CELLS))
+        .for_each(|(l, cells)| line_stand_ins(cells, l));
+    lines
 }
 
 /// One entry of the world object table.
