@@ -200,6 +200,10 @@ fn cell_of<'r>(
 }
 
 impl VoxelSink for Counter<'_, '_> {
+    fn reads_surfels(&self) -> bool {
+        false
+    }
+
     fn offer(&mut self, voxel: [u32; 3], _surfel: Surfel) {
         self.report.offers = self.report.offers.saturating_add(1);
         let outside = &mut self.report.outside;

@@ -87,6 +87,15 @@ pub struct Surfel {
     pub distance: u32,
 }
 
+impl Surfel {
+    /// The surfel offered to a sink that does not read surfels
+    /// ([`VoxelSink::reads_surfels`]).
+    pub const NONE: Self = Self {
+        normal: [0, 0, NORMAL_ONE],
+        distance: 0,
+    };
+}
+
 /// Receives the voxels a voxelizer generates.
 pub trait VoxelSink {
     /// Voxel `voxel` (inside the raster) belongs to the object being
@@ -94,6 +103,14 @@ pub trait VoxelSink {
     /// voxel more than once; the sink keeps the offer with the smallest
     /// distance.
     fn offer(&mut self, voxel: [u32; 3], surfel: Surfel);
+
+    /// Whether the sink reads the surfels it is offered. Voxelizers offer
+    /// [`Surfel::NONE`] instead of computing surfels for a sink that does
+    /// not (the builder's count pass counts voxels only); the voxels
+    /// offered are the same.
+    fn reads_surfels(&self) -> bool {
+        true
+    }
 }
 
 pub mod cone;

@@ -215,8 +215,19 @@ impl Ball {
 
     #[inline]
     fn offer<S: VoxelSink + ?Sized>(&self, v: [u32; 3], sink: &mut S, n: &mut Counter) {
-        sink.offer(v, self.surfel(v));
+        sink.offer(v, self.surfel_for(v, sink));
         n.bump();
+    }
+
+    /// [`Ball::surfel`], or [`Surfel::NONE`] for a sink that does not read
+    /// surfels.
+    #[inline]
+    fn surfel_for<S: VoxelSink + ?Sized>(&self, v: [u32; 3], sink: &S) -> Surfel {
+        if sink.reads_surfels() {
+            self.surfel(v)
+        } else {
+            Surfel::NONE
+        }
     }
 
     /// TwentySix shell (and, with `fill`, the cells wholly inside). Columns
@@ -278,7 +289,7 @@ impl Ball {
                 if let (true, Some((k0, k1))) = (fill, inside) {
                     for ki in k0..=k1 {
                         let v = place(K, ai, bi, ki);
-                        let s = self.surfel(v);
+                        let s = self.surfel_for(v, sink);
                         sink.offer(v, Surfel { distance: 0, ..s });
                         n.bump();
                     }
@@ -388,7 +399,7 @@ impl Ball {
                     .saturating_add(H.saturating_mul(H));
                 if reach < self.r2 {
                     let v = place(K, ai, bi, ki);
-                    let s = self.surfel(v);
+                    let s = self.surfel_for(v, sink);
                     sink.offer(v, Surfel { distance: 0, ..s });
                     n.bump();
                 }

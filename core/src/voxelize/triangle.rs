@@ -490,6 +490,7 @@ impl Tri {
         S: VoxelSink + ?Sized,
         F: Fn(&Self, [u32; 3]) -> Surfel,
     {
+        let reads = sink.reads_surfels();
         // Quick reject: the probe reaches at most half a voxel beyond the
         // triangle's bounding box.
         let size = extent.dims().map(super::fixmath::low);
@@ -596,7 +597,7 @@ impl Tri {
                 };
                 for ki in k0..=k1 {
                     let v = place(k, ai, bi, ki);
-                    sink.offer(v, surfel(self, v));
+                    sink.offer(v, if reads { surfel(self, v) } else { Surfel::NONE });
                     n.bump();
                 }
             }

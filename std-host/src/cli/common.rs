@@ -11,7 +11,7 @@ use rrt_core::light::ExactRecords;
 
 use super::CliError;
 use super::ray::ConnectivityArg;
-use crate::fit::{FitOptions, default_max_memory};
+use crate::fit::{FitOptions, RasterNeed, default_max_memory, default_raster};
 use crate::output::rasterfile;
 use crate::scene::{Scene, View};
 use crate::trace::Mode;
@@ -26,14 +26,15 @@ pub const DEFAULT_SCENE_NAME: &str = "balls2.nff (built-in)";
 pub const MIN_RASTER: i64 = 2 * crate::fit::size::DEFAULT_MARGIN as i64 + 1;
 /// The largest `--raster`: the core's longest raster axis.
 pub const MAX_RASTER: i64 = rrt_core::raster::MAX_AXIS as i64;
-/// Voxels along the longest axis unless `--raster` says otherwise.
-pub const DEFAULT_RASTER: u32 = 1024;
 
 /// How to voxelize a scene.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RasterArgs {
     /// Voxels along the scene's longest axis, 5 to 65536 (two voxels of
-    /// margin on each side) [default: 1024].
+    /// margin on each side) [default: fitted to the scene and the image,
+    /// 64 to 1024: as many as the image has rays for, fewer where voxels
+    /// would only cost time; at least a pixel's footprint where voxels are
+    /// the picture (the paper's mode, volumes, .vox models, CSG)].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(MIN_RASTER..=MAX_RASTER))]
     pub raster: Option<u32>,
     /// Connectivity of the discrete rays (the surfaces are voxelized thick
@@ -94,10 +95,18 @@ pub enum Purpose {
 }
 
 impl RasterArgs {
-    /// The build options these arguments ask for, for `purpose`.
+    /// Whether hits are the voxels themselves.
     #[must_use]
-    pub fn build_options(&self, purpose: Purpose) -> BuildOptions {
-        let raster = self.raster.unwrap_or(DEFAULT_RASTER);
+    pub fn discrete(&self) -> bool {
+        self.mode == ModeArg::Paper
+    }
+
+    /// The build options these arguments ask for, for `purpose`, with
+    /// `default_raster` voxels along the longest axis unless `--raster`
+    /// says otherwise.
+    #[must_use]
+    pub fn build_options(&self, purpose: Purpose, default_raster: u32) -> BuildOptions {
+        let raster = self.raster.unwrap_or(default_raster);
         let mut o = match self.mode {
             ModeArg::Paper => BuildOptions::paper(raster),
             _ => BuildOptions::new(raster),
@@ -250,6 +259,21 @@ pub fn read_scene(path: Option<&Path>, bar: &ProgressBar) -> Result<(Scene, Dura
     Ok((scene?, t.elapsed()))
 }
 
+/// The image a build is for, which the default raster is fitted to:
+/// the view with its overrides, and the size (the scene's resolution
+/// where `None`).
+#[derive(Debug, Clone, Copy)]
+pub struct ImageNeed<'a> {
+    /// View overrides.
+    pub view: &'a ViewArgs,
+    /// Width in pixels.
+    pub width: Option<u32>,
+    /// Height in pixels.
+    pub height: Option<u32>,
+    /// Rays per pixel.
+    pub samples: u32,
+}
+
 /// Where a render's scene comes from.
 #[derive(Debug)]
 pub enum Loaded {
@@ -282,6 +306,7 @@ pub fn load_or_build(
     path: Option<&PathBuf>,
     raster: &RasterArgs,
     purpose: Purpose,
+    image: &ImageNeed<'_>,
     threads: usize,
     show_progress: bool,
 ) -> Result<Loaded, CliError> {
@@ -321,7 +346,17 @@ pub fn load_or_build(
             return Err(e);
         }
     };
-    let mut opts = raster.build_options(purpose);
+    let view = image.view.apply(&scene.view);
+    let need = RasterNeed {
+        view: &view,
+        image: [
+            image.width.unwrap_or(view.resolution[0]),
+            image.height.unwrap_or(view.resolution[1]),
+        ],
+        samples: image.samples,
+        discrete: raster.discrete(),
+    };
+    let mut opts = raster.build_options(purpose, default_raster(&scene, &need));
     opts.threads = threads;
     let built = build(&scene, &opts, &bar);
     bar.finish_and_clear();

@@ -4,7 +4,9 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, progress, secs};
+use super::common::{
+    ImageNeed, Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, progress, secs,
+};
 use crate::output::image::{Encoding, ImageOutput};
 use crate::render::camera::Camera;
 use crate::render::{RenderOptions, check_sizes, render};
@@ -83,6 +85,12 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         args.scene.as_ref(),
         &args.raster,
         Purpose::Render,
+        &ImageNeed {
+            view: &args.view,
+            width: args.width,
+            height: args.height,
+            samples: args.supersample,
+        },
         args.threads,
         !args.quiet,
     )?;

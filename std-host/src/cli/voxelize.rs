@@ -4,7 +4,9 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, Purpose, RasterArgs, load_or_build, progress, secs};
+use super::common::{
+    ImageNeed, Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, progress, secs,
+};
 use crate::fit::Bytes;
 use crate::output::atomic::AtomicFile;
 use crate::output::rasterfile;
@@ -53,10 +55,25 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         path: args.output.clone(),
         source,
     })?;
+    // A saved raster is rendered from any view: its default size is fitted
+    // to the scene's own view and resolution.
+    let view = ViewArgs {
+        from: None,
+        at: None,
+        up: None,
+        angle: None,
+    };
+    let image = ImageNeed {
+        view: &view,
+        width: None,
+        height: None,
+        samples: 1,
+    };
     let loaded = load_or_build(
         args.scene.as_ref(),
         &args.raster,
         Purpose::Save,
+        &image,
         args.threads,
         !args.quiet,
     );

@@ -233,6 +233,22 @@ impl Shape {
         !matches!(self, Self::Voxels)
     }
 
+    /// Whether a ray leaving a point of this shape's surface, towards the
+    /// side its normal there faces, can meet the shape again: `front` says
+    /// that side is the one the shape's own normal points to (the outside
+    /// of a closed shape). A flat triangle (whose normal is its plane's)
+    /// never meets its plane again, a sphere left from outside never meets
+    /// itself again (it is convex); everything else may, a triangle with
+    /// interpolated normals too (its shading normal is not its plane's).
+    #[must_use]
+    pub const fn meets_itself_leaving(&self, front: bool) -> bool {
+        match self {
+            Self::Triangle(t) => t.normals.is_some(),
+            Self::Sphere(_) => !front,
+            Self::Cone(_) | Self::Torus(_) | Self::Voxels => true,
+        }
+    }
+
     /// Checks the world-space invariants of its primitive.
     ///
     /// # Errors
