@@ -13,7 +13,7 @@
 //! at 51.3 dB with 4 pixels different: the two differ only where `f32` and
 //! `f64` arithmetic disagree on which side of an edge a ray falls.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use glam::DVec3;
 use rrt_host::fit::{self, FitOptions};
