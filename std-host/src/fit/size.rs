@@ -80,7 +80,7 @@ pub const MAX_DEFAULT_RASTER: u32 = 1024;
 /// [`default_raster`] accepts, in units of the 8 voxels a tiny primitive's
 /// conservative voxelization takes: with fewer, voxels hold so many
 /// objects that verifying them costs more than a finer raster saves.
-const CROWDING: f64 = 8.0;
+pub const CROWDING: f64 = 8.0;
 
 /// What a raster is for, to [`default_raster`].
 #[derive(Clone, Copy, Debug, PartialEq)]
