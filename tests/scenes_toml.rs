@@ -600,3 +600,83 @@ fn an_opacity_ramp_alone_classifies_a_volume() {
         "{msg}"
     );
 }
+
+/// A volume has no exact normal: its hits are shaded with the stored
+/// normals interpolated at the hit point, so that a sampled sphere is not
+/// faceted. Against the true sphere's normal, over a row of rays a
+/// fiftieth of a voxel apart, the interpolated normals are closer than
+/// each hit voxel's own, and jump between neighbouring rays less often:
+/// no longer at every voxel edge, only where the hit point itself jumps
+/// (the ray's first voxel changing layer).
+#[test]
+fn volume_hits_have_interpolated_normals() {
+    use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+    use rrt_host::world::Ray;
+    let d = temp_dir("smooth-volume");
+    let p = d.join("s.toml");
+    std::fs::write(
+        &p,
+        r#"
+[camera]
+from = [0, 0, 10]
+at = [0, 0, 0]
+up = [0, 1, 0]
+angle = 30
+resolution = [16, 16]
+
+[[light]]
+position = [10, 0, 20]
+
+[material.grey]
+colour = [0.8, 0.8, 0.8]
+
+[volume.blob]
+metaballs = { dims = [40, 40, 40], min = [-1.5, -1.5, -1.5], max = [1.5, 1.5, 1.5], balls = [[0, 0, 0, 1.0, 1.0]] }
+iso = 0.3
+
+[[object]]
+material = "grey"
+volume = "blob"
+"#,
+    )
+    .unwrap();
+    let scene = Scene::load(&p).unwrap();
+    let vs = built(&scene, 48);
+    let tracer = Tracer::new(&vs, TraceOptions::default()).unwrap();
+    let store = vs.store().unwrap();
+    let mut stats = RayStats::default();
+    let mut err = [Vec::new(), Vec::new()];
+    let mut turns = [Vec::new(), Vec::new()];
+    let mut prev: Option<[DVec3; 2]> = None;
+    for i in 0..400 {
+        let x = -0.6 + 1.2 * f64::from(i) / 400.0;
+        let ray = Ray::new(DVec3::new(x, 0.13, 10.0), DVec3::NEG_Z);
+        let Some(h) = tracer.hit(&ray, &mut stats) else {
+            prev = None;
+            continue;
+        };
+        let truth = h.point.normalize();
+        let rec = store.get_voxel(h.voxel).unwrap();
+        let voxel = DVec3::from(rrt_core::voxel::unfold(rec.normal).map(|c| c as f64)).normalize();
+        let normals = [h.normal, voxel];
+        for k in 0..2 {
+            err[k].push(normals[k].angle_between(truth).to_degrees());
+            if let Some(q) = prev {
+                turns[k].push(q[k].angle_between(normals[k]).to_degrees());
+            }
+        }
+        prev = Some(normals);
+    }
+    assert!(err[0].len() > 300, "{} hits", err[0].len());
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    // Facet edges: neighbouring rays whose normals differ by over 2°.
+    let jumps = |v: &[f64]| v.iter().filter(|&&t| t > 2.0).count();
+    let (e_smooth, e_voxel) = (mean(&err[0]), mean(&err[1]));
+    let (j_smooth, j_voxel) = (jumps(&turns[0]), jumps(&turns[1]));
+    eprintln!(
+        "mean error: interpolated {e_smooth:.2}°, voxel {e_voxel:.2}°; \
+         jumps over 2° between neighbouring rays: {j_smooth}, {j_voxel}"
+    );
+    assert!(e_smooth < 0.6 * e_voxel, "{e_smooth} vs {e_voxel}");
+    assert!(j_smooth < j_voxel, "{j_smooth} vs {j_voxel}");
+}

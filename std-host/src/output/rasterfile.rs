@@ -30,7 +30,7 @@
 //! | 2 | plane | one cell per voxel, x fastest ([`rrt_core::raster`]) |
 //! | 3 | directory | brick directory, `bricks + 1` × u32 ([`rrt_core::store`]) |
 //! | 4 | records | the 20-byte [`VoxelRecord`]s, field by field as in [`rrt_core::voxel`] |
-//! | 5 | objects | per object 168 bytes: kind u32 (1 sphere, 2 cone, 3 triangle, 4 triangle with vertex normals, 5 voxels only: volume, `.vox` or CSG, all slots 0, 6 torus), material u32, 20 × f64, the shape's saved form ([`crate::shape`]): sphere centre, radius; cone base, base radius, apex, apex radius; triangle v0 v1 v2, then n0 n1 n2; torus centre, axis, major, minor; unused slots 0 |
+//! | 5 | objects | per object 168 bytes: kind u32 (1 sphere, 2 cone, 3 triangle, 4 triangle with vertex normals, 5 voxels only: volume, `.vox` or CSG, slot 0 is 1 where the stored normals are interpolated (volumes, CSG) and 0 otherwise, the other slots 0, 6 torus), material u32, 20 × f64, the shape's saved form ([`crate::shape`]): sphere centre, radius; cone base, base radius, apex, apex radius; triangle v0 v1 v2, then n0 n1 n2; torus centre, axis, major, minor; unused slots 0 |
 //! | 6 | materials | per material 8 × f64: colour r g b, Kd, Ks, Shine, T, index of refraction |
 //! | 7 | lights | per light 6 × f64: position, colour |
 //! | 8 | lists | version 2 only: the store's object-list array, u32 each ([`rrt_core::store`], *Object lists*) |

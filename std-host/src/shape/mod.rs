@@ -176,9 +176,15 @@ pub enum Shape {
     Torus(Torus),
     /// No continuous definition: the voxels are the object (volumes,
     /// `.vox` models, CSG results). It has no exact intersection, so
-    /// intersection verification keeps the discrete hit with the stored
-    /// normal.
-    Voxels,
+    /// intersection verification keeps the discrete hit, shaded with the
+    /// stored normals: interpolated between the neighbouring voxels of the
+    /// object where `smooth` (volumes and CSG results, whose voxels sample
+    /// a smooth surface), the hit voxel's own otherwise (`.vox` models,
+    /// blocky by design).
+    Voxels {
+        /// Whether the stored normals are interpolated at the hit point.
+        smooth: bool,
+    },
 }
 
 /// Each surface primitive is a [`Shape`].
@@ -203,7 +209,7 @@ macro_rules! each_surface {
             Shape::Cone($s) => $body,
             Shape::Triangle($s) => $body,
             Shape::Torus($s) => $body,
-            Shape::Voxels => $voxels,
+            Shape::Voxels { .. } => $voxels,
         }
     };
 }
@@ -230,7 +236,7 @@ impl Shape {
     /// but [`Shape::Voxels`]).
     #[must_use]
     pub const fn is_exact(&self) -> bool {
-        !matches!(self, Self::Voxels)
+        !matches!(self, Self::Voxels { .. })
     }
 
     /// Whether a ray leaving a point of this shape's surface, towards the
@@ -245,7 +251,7 @@ impl Shape {
         match self {
             Self::Triangle(t) => t.normals.is_some(),
             Self::Sphere(_) => !front,
-            Self::Cone(_) | Self::Torus(_) | Self::Voxels => true,
+            Self::Cone(_) | Self::Torus(_) | Self::Voxels { .. } => true,
         }
     }
 
@@ -262,6 +268,9 @@ impl Shape {
     pub fn save(&self) -> (u32, Slots) {
         let mut slots = [0.0; SLOTS];
         let kind = each_surface!(self, s => s.save(&mut slots), voxels => VOXELS_KIND);
+        if let Self::Voxels { smooth: true } = self {
+            slots[0] = 1.0;
+        }
         (kind, slots)
     }
 
@@ -269,7 +278,9 @@ impl Shape {
     #[must_use]
     pub fn load(kind: u32, slots: &Slots) -> Option<Self> {
         if kind == VOXELS_KIND {
-            return Some(Self::Voxels);
+            return Some(Self::Voxels {
+                smooth: slots[0] != 0.0,
+            });
         }
         Sphere::load(kind, slots)
             .map(Self::Sphere)

@@ -296,6 +296,10 @@ struct SurfaceHit {
     /// Unit normal (stored, or true under verification), not turned.
     normal: DVec3,
     verified: bool,
+    /// The normal is interpolated between voxels (an object without exact
+    /// geometry): the precomputed illumination, which is the hit voxel's,
+    /// is not used.
+    smoothed: bool,
 }
 
 /// What a ray hits ([`Tracer::hit`]).

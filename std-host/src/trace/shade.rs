@@ -63,7 +63,7 @@ impl Tracer<'_> {
         let i = self.intensity;
         // The precomputed illumination is the stored normal's side, at the
         // voxel centre: used as it is for the basic algorithm on that side.
-        let use_illum = front && !h.verified;
+        let use_illum = front && !h.verified && !h.smoothed;
         let mut local = if use_illum {
             rgb(h.rec.illum)
         } else {
