@@ -84,6 +84,34 @@ pub fn verify(
     }
 }
 
+/// The 26 neighbours of a voxel, nearest first (6 faces, 12 edges, 8
+/// corners), each group in z, y, x order.
+const NEIGHBOURS_BY_DISTANCE: [[i32; 3]; 26] = {
+    let mut out = [[0i32; 3]; 26];
+    let mut n = 0;
+    let mut far = 1;
+    while far <= 3 {
+        let mut dz: i32 = -1;
+        while dz <= 1 {
+            let mut dy: i32 = -1;
+            while dy <= 1 {
+                let mut dx: i32 = -1;
+                while dx <= 1 {
+                    if dx.abs() + dy.abs() + dz.abs() == far {
+                        out[n] = [dx, dy, dz];
+                        n += 1;
+                    }
+                    dx += 1;
+                }
+                dy += 1;
+            }
+            dz += 1;
+        }
+        far += 1;
+    }
+    out
+};
+
 /// Objects one ray has already been tested against: its *mailbox*. A ray
 /// meets an object in many voxels; each exact object is intersected once
 /// per ray. It holds the last [`MAILBOX`] objects tested: a ray meeting
@@ -335,41 +363,32 @@ impl Tracer<'_> {
     }
 
     /// A record with object `id`'s attributes near voxel `v` (record
-    /// `rec`): see [`Tracer::candidate_hit`].
+    /// `rec`): see [`Tracer::candidate_hit`]; of the neighbours it owns,
+    /// the nearest ([`NEIGHBOURS_BY_DISTANCE`]).
     fn attributes_of(&self, id: u32, v: [u32; 3], rec: &VoxelRecord) -> VoxelRecord {
         if self.store.owner(rec) == id {
             return *rec;
         }
-        let mut nearest: Option<(i32, VoxelRecord)> = None;
-        for dz in -1i32..=1 {
-            for dy in -1i32..=1 {
-                for dx in -1i32..=1 {
-                    let (Some(x), Some(y), Some(z)) = (
-                        v[0].checked_add_signed(dx),
-                        v[1].checked_add_signed(dy),
-                        v[2].checked_add_signed(dz),
-                    ) else {
-                        continue;
-                    };
-                    let Some(index) = self.extent.index([x, y, z]) else {
-                        continue;
-                    };
-                    let c = self.raster.plane().get(index).copied().unwrap_or(0);
-                    if c & cell::OPAQUE == 0 {
-                        continue;
-                    }
-                    let far = dx.abs() + dy.abs() + dz.abs();
-                    if let Some(n) = self.store.get_hinted([x, y, z], c)
-                        && self.store.owner(n) == id
-                        && nearest.as_ref().is_none_or(|(d, _)| far < *d)
-                    {
-                        nearest = Some((far, *n));
-                    }
-                }
+        for d in NEIGHBOURS_BY_DISTANCE {
+            let (Some(x), Some(y), Some(z)) = (
+                v[0].checked_add_signed(d[0]),
+                v[1].checked_add_signed(d[1]),
+                v[2].checked_add_signed(d[2]),
+            ) else {
+                continue;
+            };
+            let Some(index) = self.extent.index([x, y, z]) else {
+                continue;
+            };
+            let c = self.raster.plane().get(index).copied().unwrap_or(0);
+            if c & cell::OPAQUE == 0 {
+                continue;
             }
-        }
-        if let Some((_, n)) = nearest {
-            return n;
+            if let Some(n) = self.store.get_hinted([x, y, z], c)
+                && self.store.owner(n) == id
+            {
+                return *n;
+            }
         }
         let mut r = *rec;
         if let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) {
