@@ -15,7 +15,9 @@
 //! 16+24n     4  crc32 of the bytes before it
 //! 20+24n     4  zero, then zeros up to H
 //!      H        sections, in table order, each starting at a multiple of 64
-//!               (H = 192 for version 1, 256 for version 2)
+//!               (H = 192 for version 1, 256 for version 2), zeros between
+//!               them; the file ends with the last section padded with
+//!               zeros to a multiple of 64
 //! ```
 //!
 //! The paper's raster (one object per voxel) is written as version 1,
@@ -40,8 +42,9 @@
 //! # Loading
 //! [`load`] refuses, with the file's name and what is wrong: a file that is
 //! not a raster, another version, a header or section whose checksum does
-//! not match (corrupt), a section that ends past the end of the file
-//! (truncated) or whose length disagrees with the counts, and contents
+//! not match (corrupt), a section that ends past the end of the file or a
+//! file shorter than its last section's padding (truncated), bytes after
+//! that padding, a section whose length disagrees with the counts, and contents
 //! that break an invariant (dimensions, the record store's directory and
 //! sort order, object and material indices, non-finite numbers). Sizes are
 //! checked against the file's length before anything is allocated.
@@ -84,6 +87,8 @@ const HEADER_LEN: u64 = 192;
 /// The header of a version 2 file.
 const HEADER2_LEN: u64 = 256;
 const META_LEN: u64 = 192;
+/// Every section starts at a multiple of this, and the file ends at one.
+const SECTION_ALIGN: u64 = 64;
 /// Kind, material and the shape's saved numbers.
 const OBJECT_LEN: u64 = 8 + 8 * SLOTS as u64;
 const MATERIAL_LEN: u64 = 64;
@@ -445,7 +450,7 @@ pub fn save_to(
         let (len, crc) = (c.len, c.crc.finalize());
         table.push((kind, crc, offset, len));
         offset += len;
-        let pad = offset.next_multiple_of(64) - offset;
+        let pad = offset.next_multiple_of(SECTION_ALIGN) - offset;
         w.write_all(&vec![0u8; pad as usize])
             .map_err(io("cannot write"))?;
         offset += pad;
@@ -606,6 +611,28 @@ fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> 
         }
         end = stop;
         *s = (crc, off, len);
+    }
+    // The writer pads the last section to a multiple of 64 like every
+    // other: a shorter file lost bytes (of padding only, perhaps, but it
+    // is not the file that was written), a longer one has something after
+    // the raster.
+    let written = end.next_multiple_of(SECTION_ALIGN);
+    if file_len < written {
+        return Err(RasterFileError::Truncated {
+            path: p(),
+            what: format!(
+                "the file has {file_len} bytes, its sections and padding end at byte {written}"
+            ),
+        });
+    }
+    if file_len > written {
+        return Err(RasterFileError::Invalid {
+            path: p(),
+            what: format!(
+                "{} bytes after the end of the raster (byte {written})",
+                file_len - written
+            ),
+        });
     }
     Ok(Header {
         version,
