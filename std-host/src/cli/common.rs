@@ -232,17 +232,25 @@ pub fn progress(show: bool) -> ProgressBar {
     ProgressBar::new(0)
 }
 
-/// Reads an NFF or TOML scene (the built-in one for `None`), with a
-/// spinner on `bar` while it parses.
+/// Reads an NFF or TOML scene (the built-in one for `None`): the bytes
+/// of an NFF file parsed on `bar`, a spinner while a TOML scene and the
+/// files it names are read.
 ///
 /// # Errors
 /// The parser's located error.
 pub fn read_scene(path: Option<&Path>, bar: &ProgressBar) -> Result<(Scene, Duration), CliError> {
     let t = Instant::now();
     let scene = match path {
-        Some(p) => {
+        Some(p)
+            if p.extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
+        {
             crate::progress::spinner(bar, format!("reading {}", p.display()));
             Scene::load(p)
+        }
+        Some(p) => {
+            crate::progress::phase(bar, "reading", crate::progress::Unit::Bytes, 0);
+            Scene::load_with(p, bar)
         }
         None => Scene::parse(DEFAULT_SCENE_NAME, DEFAULT_SCENE.as_bytes()),
     };

@@ -396,10 +396,15 @@ pub fn save_to(
     let (sections, header_len) = layout(version);
     w.write_all(&vec![0u8; header_len as usize])
         .map_err(io("cannot write"))?;
+    // Every section's bytes, as the writer below counts them.
     progress.set_length(
-        scene.plane.len() as u64
+        META_LEN
+            + scene.plane.len() as u64
             + scene.directory.len() as u64 * DIRECTORY_ENTRY_LEN
             + scene.records.len() as u64 * RECORD_LEN
+            + scene.objects.len() as u64 * OBJECT_LEN
+            + scene.materials.len() as u64 * MATERIAL_LEN
+            + scene.lights.len() as u64 * LIGHT_LEN
             + scene.lists.len() as u64 * 4,
     );
     progress.set_position(0);
@@ -655,13 +660,14 @@ fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
 }
 
 /// Reads section `k` into `buf` (whose length is the section's) and checks
-/// its checksum.
+/// its checksum; `progress` counts the bytes read.
 fn read_section(
     file: &mut File,
     path: &Path,
     h: &Header,
     k: usize,
     buf: &mut [u8],
+    progress: &ProgressBar,
 ) -> Result<(), RasterFileError> {
     let (crc, off, _) = h.sections[k];
     let io = |source| RasterFileError::Io {
@@ -670,8 +676,14 @@ fn read_section(
         source,
     };
     file.seek(SeekFrom::Start(off)).map_err(io)?;
-    file.read_exact(buf).map_err(io)?;
-    if crc32fast::hash(buf) != crc {
+    // In pieces, so that the bar moves while a large plane is read.
+    let mut hasher = crc32fast::Hasher::new();
+    for piece in buf.chunks_mut(1 << 22) {
+        file.read_exact(piece).map_err(io)?;
+        hasher.update(piece);
+        progress.inc(piece.len() as u64);
+    }
+    if hasher.finalize() != crc {
         return Err(RasterFileError::Checksum {
             path: path.to_path_buf(),
             section: NAMES[k],
@@ -706,7 +718,7 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
         )));
     }
     let mut b = vec![0u8; META_LEN as usize];
-    read_section(file, path, h, 0, &mut b)?;
+    read_section(file, path, h, 0, &mut b, &ProgressBar::hidden())?;
     let mut c = Cursor::new(&b);
     let dims = [c.u32(), c.u32(), c.u32()];
     let separation = match c.u8() {
@@ -888,6 +900,15 @@ pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError
 /// # Errors
 /// [`RasterFileError`] naming the file and what is wrong.
 pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
+    load_with(path, &ProgressBar::hidden())
+}
+
+/// [`load`], counting the bytes read on `progress` (its length is set to
+/// the file's).
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, RasterFileError> {
     let invalid = |what: String| RasterFileError::Invalid {
         path: path.to_path_buf(),
         what,
@@ -895,6 +916,8 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     let mut file = open(path)?;
     let h = read_header(&mut file, path)?;
     let m = read_meta(&mut file, path, &h)?;
+    progress.set_length(h.file_len);
+    progress.set_position(0);
     let extent =
         Extent::new(m.dims[0], m.dims[1], m.dims[2]).map_err(|e| invalid(e.to_string()))?;
     let expect = |k: usize, len: u64| -> Result<usize, RasterFileError> {
@@ -924,7 +947,7 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     let lists_len = expect(7, lists_bytes)?;
     let section = |file: &mut File, k: usize, len: usize| -> Result<Vec<u8>, RasterFileError> {
         let mut b = vec![0u8; len];
-        read_section(file, path, &h, k, &mut b)?;
+        read_section(file, path, &h, k, &mut b, progress)?;
         Ok(b)
     };
 
@@ -933,9 +956,9 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         what: "cannot allocate the raster plane",
         source,
     })?;
-    read_section(&mut file, path, &h, 1, &mut plane)?;
+    read_section(&mut file, path, &h, 1, &mut plane, progress)?;
     let directory = directory_from(&section(&mut file, 2, dir_len)?);
-    let records = read_records(&mut file, path, &h, rec_len)?;
+    let records = read_records(&mut file, path, &h, rec_len, progress)?;
     let materials = materials_from(&section(&mut file, 5, mat_len)?).map_err(invalid)?;
     let objects =
         objects_from(&section(&mut file, 4, obj_len)?, materials.len()).map_err(invalid)?;
@@ -1059,6 +1082,7 @@ fn read_records(
     path: &Path,
     h: &Header,
     len: usize,
+    progress: &ProgressBar,
 ) -> Result<Vec<VoxelRecord>, RasterFileError> {
     let (crc, off, _) = h.sections[3];
     let io = |source| RasterFileError::Io {
@@ -1082,6 +1106,7 @@ fn read_records(
                 .map(record_from),
         );
         left -= take;
+        progress.inc(take as u64);
     }
     if hasher.finalize() != crc {
         return Err(RasterFileError::Checksum {
