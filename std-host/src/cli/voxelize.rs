@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, Purpose, RasterArgs, load_or_build, progress, secs};
+use super::common::{Loaded, Purpose, RasterArgs, load_or_build, parse_threads, progress, secs};
 use crate::fit::Bytes;
 use crate::output::atomic::AtomicFile;
 use crate::output::rasterfile;
@@ -15,14 +15,14 @@ use crate::progress::Unit;
 pub struct VoxelizeArgs {
     /// An NFF or TOML scene [default: the built-in 91-sphereflake].
     pub scene: Option<PathBuf>,
-    /// The raster file to write.
+    /// The raster file to write; its name ends in .rrt.
     #[arg(short, long, value_name = "FILE.rrt")]
     pub output: PathBuf,
     /// Voxelization.
     #[command(flatten)]
     pub raster: RasterArgs,
-    /// Threads for the light pass (0: one per core).
-    #[arg(long, value_name = "T", default_value_t = 0)]
+    /// Threads for the light pass, 0 (one per core) to 1024.
+    #[arg(long, value_name = "T", default_value_t = 0, value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: usize,
     /// No progress bar and no summary line.
     #[arg(long, short)]
@@ -46,6 +46,26 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
             ),
         });
     }
+    // A raster goes to a file named as one: not to standard output (`-`,
+    // which render reads as an image), nor over a scene or an image.
+    let is_rrt = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("rrt"));
+    if !is_rrt {
+        return Err(CliError::Arg {
+            arg: "--output",
+            message: format!(
+                "{}: a saved raster is written to a file whose name ends in .rrt{}",
+                args.output.display(),
+                if args.output.as_os_str() == "-" {
+                    " (not to standard output)"
+                } else {
+                    ""
+                }
+            ),
+        });
+    }
     // Fail on an unwritable output before voxelizing: the temporary file
     // beside it is created now, renamed over it when the raster is
     // complete, and removed on an error or an interruption.
@@ -59,6 +79,7 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         Purpose::Save,
         args.threads,
         !args.quiet,
+        &|_| Ok(()),
     );
     let Loaded::Built {
         scene,
