@@ -41,7 +41,7 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         return Err(CliError::Arg {
             arg: "SCENE",
             message: format!(
-                "{} is already a saved raster; give an NFF scene",
+                "{} is already a saved raster; give an NFF or TOML scene",
                 p.display()
             ),
         });
@@ -89,7 +89,7 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
     else {
         return Err(CliError::Arg {
             arg: "SCENE",
-            message: "expected an NFF scene".into(),
+            message: "expected an NFF or TOML scene".into(),
         });
     };
     let t = std::time::Instant::now();
