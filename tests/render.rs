@@ -288,6 +288,13 @@ fn damaged_raster_files_are_refused() {
     assert!(e.contains("truncated"), "{e}");
     let e = load("header-only.rrt", &bytes[..100]);
     assert!(e.contains("truncated"), "{e}");
+    // The last byte (padding after the last section) gone, or bytes added
+    // after the end: not the file that was written.
+    assert_eq!(bytes.len() % 64, 0);
+    let e = load("short.rrt", &bytes[..bytes.len() - 1]);
+    assert!(e.contains("truncated: the file has"), "{e}");
+    let e = load("long.rrt", &[&bytes[..], &[0u8; 64]].concat());
+    assert!(e.contains("64 bytes after the end of the raster"), "{e}");
 
     let mut v3 = bytes.clone();
     v3[8] = 3;
