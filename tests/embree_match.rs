@@ -13,7 +13,7 @@
 //! at 51.3 dB with 4 pixels different: the two differ only where `f32` and
 //! `f64` arithmetic disagree on which side of an edge a ray falls.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use glam::DVec3;
 use rrt_host::fit::{self, FitOptions};
@@ -130,28 +130,6 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// A binary PPM (P6, maxval 255) as written by `embree_nff`.
-fn read_ppm(path: &Path) -> (u32, u32, Vec<u8>) {
-    let bytes = std::fs::read(path).unwrap();
-    let mut fields = Vec::new();
-    let mut at = 0;
-    while fields.len() < 4 {
-        while bytes[at].is_ascii_whitespace() {
-            at += 1;
-        }
-        let start = at;
-        while !bytes[at].is_ascii_whitespace() {
-            at += 1;
-        }
-        fields.push(std::str::from_utf8(&bytes[start..at]).unwrap().to_owned());
-    }
-    assert_eq!((fields[0].as_str(), fields[3].as_str()), ("P6", "255"));
-    let (w, h) = (fields[1].parse().unwrap(), fields[2].parse().unwrap());
-    let pixels = bytes[at + 1..].to_vec();
-    assert_eq!(pixels.len(), 3 * (w * h) as usize);
-    (w, h, pixels)
-}
-
 /// PSNR in dB and the share of pixels with a channel off by more than 8.
 fn compare(a: &[u8], b: &[u8]) -> (f64, f64) {
     let off = a
@@ -166,7 +144,7 @@ fn compare(a: &[u8], b: &[u8]) -> (f64, f64) {
 /// are `embree_nff`'s (primary, shadow, reflection, hits).
 #[track_caller]
 fn check(scene: &Scene, reference: &str, counts: [u64; 4], min_psnr: f64) {
-    let (w, h, expect) = read_ppm(&data("embree").join(reference));
+    let (w, h, expect) = rrt_tests::read_ppm(&data("embree").join(reference));
     let mut tracer = Tracer::new(scene);
     let got = tracer.render(w, h);
     let (psnr, off) = compare(&got, &expect);

@@ -600,3 +600,338 @@ fn an_opacity_ramp_alone_classifies_a_volume() {
         "{msg}"
     );
 }
+
+/// A volume has no exact normal: its hits are shaded with the stored
+/// normals interpolated at the hit point, so that a sampled sphere is not
+/// faceted. Against the true sphere's normal, over a row of rays a
+/// fiftieth of a voxel apart, the interpolated normals are closer than
+/// each hit voxel's own, and jump between neighbouring rays less often:
+/// no longer at every voxel edge, only where the hit point itself jumps
+/// (the ray's first voxel changing layer).
+#[test]
+fn volume_hits_have_interpolated_normals() {
+    use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+    use rrt_host::world::Ray;
+    let d = temp_dir("smooth-volume");
+    let p = d.join("s.toml");
+    std::fs::write(
+        &p,
+        r#"
+[camera]
+from = [0, 0, 10]
+at = [0, 0, 0]
+up = [0, 1, 0]
+angle = 30
+resolution = [16, 16]
+
+[[light]]
+position = [10, 0, 20]
+
+[material.grey]
+colour = [0.8, 0.8, 0.8]
+
+[volume.blob]
+metaballs = { dims = [40, 40, 40], min = [-1.5, -1.5, -1.5], max = [1.5, 1.5, 1.5], balls = [[0, 0, 0, 1.0, 1.0]] }
+iso = 0.3
+
+[[object]]
+material = "grey"
+volume = "blob"
+"#,
+    )
+    .unwrap();
+    let scene = Scene::load(&p).unwrap();
+    let vs = built(&scene, 48);
+    let tracer = Tracer::new(&vs, TraceOptions::default()).unwrap();
+    let store = vs.store().unwrap();
+    let mut stats = RayStats::default();
+    let mut err = [Vec::new(), Vec::new()];
+    let mut turns = [Vec::new(), Vec::new()];
+    let mut prev: Option<[DVec3; 2]> = None;
+    for i in 0..400 {
+        let x = -0.6 + 1.2 * f64::from(i) / 400.0;
+        let ray = Ray::new(DVec3::new(x, 0.13, 10.0), DVec3::NEG_Z);
+        let Some(h) = tracer.hit(&ray, &mut stats) else {
+            prev = None;
+            continue;
+        };
+        let truth = h.point.normalize();
+        let rec = store.get_voxel(h.voxel).unwrap();
+        let voxel = DVec3::from(rrt_core::voxel::unfold(rec.normal).map(|c| c as f64)).normalize();
+        let normals = [h.normal, voxel];
+        for k in 0..2 {
+            err[k].push(normals[k].angle_between(truth).to_degrees());
+            if let Some(q) = prev {
+                turns[k].push(q[k].angle_between(normals[k]).to_degrees());
+            }
+        }
+        prev = Some(normals);
+    }
+    assert!(err[0].len() > 300, "{} hits", err[0].len());
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    // Facet edges: neighbouring rays whose normals differ by over 2°.
+    let jumps = |v: &[f64]| v.iter().filter(|&&t| t > 2.0).count();
+    let (e_smooth, e_voxel) = (mean(&err[0]), mean(&err[1]));
+    let (j_smooth, j_voxel) = (jumps(&turns[0]), jumps(&turns[1]));
+    eprintln!(
+        "mean error: interpolated {e_smooth:.2}°, voxel {e_voxel:.2}°; \
+         jumps over 2° between neighbouring rays: {j_smooth}, {j_voxel}"
+    );
+    assert!(e_smooth < 0.6 * e_voxel, "{e_smooth} vs {e_voxel}");
+    assert!(j_smooth < j_voxel, "{j_smooth} vs {j_voxel}");
+}
+
+/// A scene whose second object's shape is `shape`, with `extra` after it
+/// (more tables: lights, materials, solids, volumes).
+fn second_object(shape: &str, extra: &str) -> String {
+    format!(
+        "{CAMERA}[[light]]\nposition = [1, 1, 1]\n[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n[[object]]\nmaterial = \"m\"\n{shape}\n{extra}"
+    )
+}
+
+/// Every kind of bad value is reported at the value itself (the line and
+/// column of `needle`, its first occurrence in the scene) with its full key
+/// path, inside inline tables and arrays too.
+#[test]
+fn every_bad_value_is_located_at_itself() {
+    let metaballs = "[volume.v]\nmetaballs = { dims = [8, 8, 8], min = [-1, -1, -1], max = [1, 1, 1], balls = [[0, 0, 0, 1, 1]] }\n";
+    let volume = |class: &str| second_object("volume = \"v\"", &format!("{metaballs}{class}\n"));
+    let solids = "[solid.a]\nsphere = { centre = [0,0,0], radius = 1 }\n[solid.b]\nbox = { min = [0,0,0], max = [1,1,1] }\n";
+    let texture = |t: &str| {
+        second_object(
+            "sphere = { centre = [3,0,0], radius = 1 }",
+            &format!("[material.t]\ntexture = {{ {t} }}\n"),
+        )
+    };
+    let raw = |r: &str| {
+        volume("").replace(metaballs, &format!("[volume.v]\nraw = {{ {r} }}\n")) + "iso = 1\n"
+    };
+    let cases: Vec<(&str, String, &str, &str, &str)> = vec![
+        // (name, scene, needle, key path, message)
+        (
+            "light colour",
+            second_object(
+                "sphere = { centre = [3,0,0], radius = 1 }",
+                "[[light]]\nposition = [2, 2, 2]\ncolour = [1, -1, 1]\n",
+            ),
+            "[1, -1, 1]",
+            "light[1].colour",
+            "expected channels ≥ 0",
+        ),
+        (
+            "polygon vertex",
+            second_object("polygon = [[0,0,0], [1,0,0], [0,nan,0]]", ""),
+            "[0,nan,0]",
+            "object[1].polygon[2]",
+            "expected finite numbers",
+        ),
+        (
+            "box",
+            second_object("box = { min = [0,0,0], max = [1,-1,1] }", ""),
+            "[1,-1,1]",
+            "object[1].box.max",
+            "expected min < max",
+        ),
+        (
+            "cone apex",
+            second_object(
+                "cone = { base = [2,2,2], base_radius = 1, apex = [2, 2, 2], apex_radius = 0.5 }",
+                "",
+            ),
+            "[2, 2, 2]",
+            "object[1].cone.apex",
+            "equals the base",
+        ),
+        (
+            "cone radius",
+            second_object(
+                "cone = { base = [0,0,0], base_radius = -1, apex = [0,0,1], apex_radius = 0.5 }",
+                "",
+            ),
+            "-1",
+            "object[1].cone.base_radius",
+            "expected a number ≥ 0",
+        ),
+        (
+            "torus",
+            second_object("torus = { centre = [0,0,0], major = 1, minor = -2 }", ""),
+            "-2",
+            "object[1].torus.minor",
+            "expected a number > 0",
+        ),
+        (
+            "transform scale",
+            second_object(
+                "polygon = [[0,0,0], [1,0,0], [0,1,0]]\ntransform = { scale = 0 }",
+                "",
+            ),
+            "0 }",
+            "object[1].transform.scale",
+            "expected a number > 0",
+        ),
+        (
+            "transform angle",
+            second_object(
+                "polygon = [[0,0,0], [1,0,0], [0,1,0]]\ntransform = { rotate_y = inf }",
+                "",
+            ),
+            "inf",
+            "object[1].transform.rotate_y",
+            "expected a finite angle",
+        ),
+        (
+            "csg leaf",
+            second_object(
+                "csg = { difference = [\"a\", { union = [\"b\", \"zz\"] }] }",
+                solids,
+            ),
+            "\"zz\"",
+            "object[1].csg.difference[1].union[1]",
+            "no [solid.zz] in this scene",
+        ),
+        (
+            "csg operands",
+            second_object("csg = { union = [\"a\"] }", solids),
+            "[\"a\"]",
+            "object[1].csg.union",
+            "2 or more operands",
+        ),
+        (
+            "solid",
+            second_object(
+                "csg = { union = [\"a\", \"b\"] }",
+                &solids.replace("max = [1,1,1]", "max = [1,1,-1]"),
+            ),
+            "[1,1,-1]",
+            "solid.b.box.max",
+            "expected min < max",
+        ),
+        (
+            "checker",
+            texture("checker = { size = -1, colours = [[1,2,3],[4,5,6]] }"),
+            "-1",
+            "material.t.texture.checker.size",
+            "expected a number > 0",
+        ),
+        (
+            "marble",
+            texture(
+                "marble = { period = 1, direction = [0.0, 0, 0], colours = [[1,2,3],[4,5,6]] }",
+            ),
+            "[0.0, 0, 0]",
+            "material.t.texture.marble.direction",
+            "expected a non-zero vector",
+        ),
+        (
+            "wood",
+            texture("wood = { period = 1, octaves = 17, colours = [[1,2,3],[4,5,6]] }"),
+            "17",
+            "material.t.texture.wood.octaves",
+            "expected 1 to 16",
+        ),
+        (
+            "image wrap",
+            texture(
+                "image = { file = \"x.png\", wrap = \"tile\", planar = { origin = [0,0,0], u = [1,0,0], v = [0,1,0] } }",
+            ),
+            "\"tile\"",
+            "material.t.texture.image.wrap",
+            "expected repeat, mirror or clamp",
+        ),
+        (
+            "metaball",
+            volume("iso = 0.5").replace("[[0, 0, 0, 1, 1]]", "[[0, 0, 0, 1, 1], [0, 0, 0, -1, 1]]"),
+            "[0, 0, 0, -1, 1]",
+            "volume.v.metaballs.balls[1]",
+            "radius > 0",
+        ),
+        (
+            "opacity",
+            volume("opacity = [[0, 0], [1, 2]]"),
+            "[1, 2]",
+            "volume.v.opacity[1]",
+            "alpha in [0, 1]",
+        ),
+        (
+            "colours",
+            volume("iso = 0.5\ncolours = [[1, 0, 0, 0], [0.5, 1, 1, 1]]"),
+            "0.5, 1",
+            "volume.v.colours[1][0]",
+            "increase along the ramp",
+        ),
+        (
+            "fit",
+            volume("iso = 0.5\nfit = { min = [0, 0, 0], max = [1, 1, 0] }"),
+            "[1, 1, 0]",
+            "volume.v.fit.max",
+            "expected min < max",
+        ),
+        (
+            "scale",
+            volume("iso = 0.5\nscale = -1"),
+            "-1\n",
+            "volume.v.scale",
+            "expected a number > 0",
+        ),
+        (
+            "raw dims",
+            raw("file = \"x.raw\", dims = [0, 2, 2], type = \"u8\""),
+            "[0, 2, 2]",
+            "volume.v.raw.dims",
+            "expected 1 to 65536",
+        ),
+        (
+            "raw type",
+            raw("file = \"x.raw\", dims = [2, 2, 2], type = \"double\""),
+            "\"double\"",
+            "volume.v.raw.type",
+            "float (float32, f32)",
+        ),
+    ];
+    for (name, text, needle, key, msg) in cases {
+        let at = text
+            .find(needle)
+            .unwrap_or_else(|| panic!("{name}: no {needle:?}"));
+        let line = text[..at].matches('\n').count() + 1;
+        let column = at - text[..at].rfind('\n').map_or(0, |i| i + 1) + 1;
+        let err = error_of(&format!("at-{}", name.replace(' ', "-")), &text);
+        assert!(
+            err.contains(&format!("bad.toml:{line}:{column}: {key}: ")),
+            "{name}: want {line}:{column} {key}: {err}"
+        );
+        assert!(err.contains(msg), "{name}: want {msg:?}: {err}");
+    }
+}
+
+/// toml's own errors name the table a key is missing from, and nothing
+/// for a document without its `[camera]`.
+#[test]
+fn missing_keys_name_their_table() {
+    let msg = error_of(
+        "no-angle",
+        &format!(
+            "{}[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n",
+            CAMERA.replace("angle = 40\n", "")
+        ),
+    );
+    assert!(
+        msg.contains("bad.toml:1:1: camera: missing field `angle`"),
+        "{msg}"
+    );
+    let msg = error_of(
+        "no-camera",
+        "[[light]]\nposition = [1, 1, 1]\n[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = { centre = [0,0,0], radius = 1 }\n",
+    );
+    assert!(
+        msg.contains("bad.toml:1:1: missing field `camera`: every scene needs a [camera] table"),
+        "{msg}"
+    );
+    let msg = error_of(
+        "no-radius",
+        &second_object("sphere = { centre = [0,0,0] }", ""),
+    );
+    assert!(
+        msg.contains(": object[1].sphere: missing field `radius`"),
+        "{msg}"
+    );
+}

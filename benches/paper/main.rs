@@ -25,6 +25,7 @@ mod skipping;
 mod table1;
 mod table2;
 mod verification;
+mod whole;
 
 use clap::Parser;
 
@@ -112,13 +113,14 @@ fn run() -> Res<()> {
     let mut body = Md::default();
     std::mem::swap(&mut body, &mut ctx.md);
 
-    let sections: [(&str, Section); 6] = [
+    let sections: [(&str, Section); 7] = [
         ("Table 1", table1::table1),
         ("Table 2", table2::table2),
         ("connectivity", connectivity::connectivity),
         ("verification", verification::verification),
         ("skipping", skipping::skipping),
         ("Embree", embree::embree),
+        ("whole job", whole::whole),
     ];
     for (name, section) in sections {
         ctx.log(&format!("{name} …"));

@@ -50,8 +50,9 @@ pub(crate) fn verification(ctx: &mut Ctx) -> Res<()> {
     md.para(&format!(
         "Adaptive rays, depth 3, {0}×{0}, one thread. **False-hit rays**: rays (eye, reflected, \
          refracted; not shadow rays) that met at least one discrete hit whose object the \
-         continuous ray does not meet, which `--verify` skipped (`RayStats::false_hit_rays` over \
-         those rays). **Verify cost**: render time with `--verify` over without, − 1; the paper \
+         continuous ray does not meet, which `--mode verified` skipped (`RayStats::false_hit_rays` \
+         over those rays). **Verify cost**: render time with `--mode verified` over `--mode paper`, \
+         − 1, both on the raster `rrt voxelize` saves; the paper \
          measured 72 → 75 s (4 %) for the 91-sphereflake at 320³. **Supersample 2**: 2×2 rays per \
          pixel, time over 1×1 (4 would be proportional).",
         cfg.image
@@ -61,7 +62,7 @@ pub(crate) fn verification(ctx: &mut Ctx) -> Res<()> {
             "scene, raster",
             "render s",
             "steps/ray",
-            "--verify s",
+            "verified s",
             "verify steps/ray",
             "false-hit rays %",
             "paper false-hit %",

@@ -39,19 +39,38 @@ impl Unit {
     }
 }
 
-/// Starts a phase on `bar`: its message, unit and length; position,
-/// elapsed time and ETA from zero.
+/// How often a visible bar redraws on its own, so that its elapsed time
+/// and ETA move while one long step (a large object, a slow tile) runs.
+const TICK: Duration = Duration::from_millis(200);
+
+/// Starts a phase on `bar`: its message, unit and length (0: set later,
+/// when known); position,
+/// elapsed time and ETA from zero. The bar is redrawn at once in its new
+/// style (never the previous phase's unit or length, nor indicatif's
+/// default style) and then every [`TICK`].
 pub fn phase(bar: &ProgressBar, message: &'static str, unit: Unit, len: u64) {
     if bar.is_hidden() {
         return;
     }
+    // Each change below may draw the bar: an empty line until all are
+    // made, then the phase in its own style.
+    if let Ok(blank) = ProgressStyle::with_template("") {
+        bar.set_style(blank);
+    }
     // Position, elapsed time and ETA from zero for this phase.
     bar.reset();
-    bar.set_length(len);
+    if len == 0 {
+        // Not known yet (a file's size): an empty bar, not a full one.
+        bar.unset_length();
+    } else {
+        bar.set_length(len);
+    }
     bar.set_message(message);
     if let Ok(style) = ProgressStyle::with_template(unit.template()) {
         bar.set_style(style.progress_chars("=> "));
     }
+    bar.force_draw();
+    bar.enable_steady_tick(TICK);
 }
 
 /// A phase whose length is unknown (reading a scene or a raster): a

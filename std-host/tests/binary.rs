@@ -113,9 +113,22 @@ fn help_says_what_is_accepted() {
         "5 to 65536",
         "Vertical field of view",
         "top and bottom pixel rows",
+        // Each range as the parser accepts it.
+        "Image width in pixels, 1 to 32768",
+        "Image height in pixels, 1 to 32768",
+        "K from 1 to 16",
+        "Depth of the ray tree, 1 to 64",
+        "0 (one per core) to 1024",
+        "between 0 and 180 (both excluded)",
     ] {
         assert!(words.contains(want), "render --help lacks {want:?}");
     }
+    // The top-level help describes the tool, not the crate.
+    let top = text(&["--help"]);
+    assert!(
+        top.starts_with("rrt: 3D raster (discrete) ray tracing"),
+        "{top}"
+    );
     // One default per option.
     let threads = render
         .split("--threads")
@@ -125,7 +138,11 @@ fn help_says_what_is_accepted() {
         .next()
         .unwrap();
     assert_eq!(threads.matches("default").count(), 1, "{threads}");
-    assert!(text(&["voxelize", "--help"]).contains("An NFF or TOML scene"));
+    let voxelize = text(&["voxelize", "--help"]);
+    assert!(voxelize.contains("An NFF or TOML scene"));
+    let words = voxelize.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(words.contains("its name ends in .rrt"), "{voxelize}");
+    assert!(words.contains("0 (one per core) to 1024"), "{voxelize}");
     let ray = text(&["ray", "--help"]);
     assert!(ray.contains("--dims") && ray.contains("--raster"));
 }
@@ -135,6 +152,67 @@ fn arguments_out_of_range_are_refused_as_the_help_says() {
     for (args, expect) in [
         (&["render", "--raster", "4"][..], "5..=65536"),
         (&["render", "--supersample", "0"][..], "must be positive"),
+        // Negative numbers get the range, not clap's "use -- -1" tip.
+        (
+            &["render", "--supersample", "-2"][..],
+            "must be positive, found -2",
+        ),
+        (
+            &["render", "--height", "-5"][..],
+            "must be positive, found -5",
+        ),
+        (
+            &["render", "--depth", "-1"][..],
+            "expected 1 to 64, found -1",
+        ),
+        (
+            &["render", "--depth", "65"][..],
+            "expected 1 to 64, found 65",
+        ),
+        (
+            &["render", "--threads", "-1"][..],
+            "expected 0 (one per core) to 1024, found -1",
+        ),
+        // 100000 threads used to be accepted (and took minutes to start).
+        (
+            &["voxelize", "-o", "x.rrt", "--threads", "100000"][..],
+            "expected 0 (one per core) to 1024, found 100000",
+        ),
+        (&["render", "--angle", "0"][..], "between 0 and 180"),
+        (&["render", "--angle", "-30"][..], "between 0 and 180"),
+        (&["render", "--angle", "180"][..], "between 0 and 180"),
+        // A view that makes no camera is refused before voxelizing.
+        (
+            &[
+                "render",
+                "-o",
+                "/tmp/rrt-never-written.png",
+                "--from",
+                "0,0,0",
+                "--at",
+                "0,0,0",
+            ][..],
+            "`from` and `at` must be distinct",
+        ),
+        // Bounds away from all geometry, at the default raster: the
+        // bounds are named (not the memory a raster of them would need).
+        (
+            &[
+                "render",
+                "-o",
+                "/tmp/rrt-never-written.png",
+                "--bounds",
+                "100,100,100,101,101,101",
+            ][..],
+            "contain no geometry",
+        ),
+        // A raster goes to a .rrt file, never to standard output or over
+        // an image or a scene.
+        (&["voxelize", "-o", "-"][..], "not to standard output"),
+        (
+            &["voxelize", "-o", "/tmp/rrt-never-written.png"][..],
+            "whose name ends in .rrt",
+        ),
         (
             &["ray", "--origin", "0,0,0", "--dir", "1,0,0"][..],
             "give --dims NX,NY,NZ for a ray through an empty raster, or --raster",

@@ -1,7 +1,8 @@
 //! What `rrt` writes: images in the format their extension names (magic
 //! bytes of each, refusals, PNG on standard output) and outputs that
 //! survive an interruption (SIGINT or SIGTERM while a raster or an image
-//! is being made leaves the old file byte for byte and no temporary).
+//! is being made, or while it is being written, leaves the old file byte
+//! for byte and no temporary).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -86,6 +87,45 @@ fn each_format_by_its_magic_bytes() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// The float formats hold the same linear values: the OpenEXR file read
+/// back by the `exr` crate equals the PFM file's floats (rows bottom to
+/// top there).
+#[test]
+fn exr_and_pfm_hold_the_same_floats() {
+    let d = folder("floats");
+    assert!(render(&d, "f.exr", &[]).status.success());
+    assert!(render(&d, "f.pfm", &[]).status.success());
+    let pfm = std::fs::read(d.join("f.pfm")).unwrap();
+    let header = b"PF\n16 16\n-1.0\n";
+    assert!(pfm.starts_with(header));
+    let floats: Vec<f32> = pfm[header.len()..]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let pfm_at = |x: usize, y: usize| {
+        let i = 3 * ((15 - y) * 16 + x);
+        [floats[i], floats[i + 1], floats[i + 2]]
+    };
+    let exr = exr::prelude::read_first_rgba_layer_from_file(
+        d.join("f.exr"),
+        |size, _| vec![[0f32; 3]; size.width() * size.height()],
+        |px: &mut Vec<[f32; 3]>, p, (r, g, b, _): (f32, f32, f32, f32)| {
+            px[p.y() * 16 + p.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let size = exr.layer_data.size;
+    assert_eq!((size.width(), size.height()), (16, 16));
+    let px = &exr.layer_data.channel_data.pixels;
+    assert!(px.iter().flatten().any(|&v| v > 0.0), "an empty image");
+    for y in 0..16 {
+        for x in 0..16 {
+            assert_eq!(px[y * 16 + x], pfm_at(x, y), "pixel {x}, {y}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 #[test]
 fn unknown_formats_and_options_are_refused_before_work() {
     let d = folder("refuse");
@@ -130,11 +170,24 @@ fn dash_writes_png_to_stdout_and_the_summary_to_stderr() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// When to send the signal: a while after the temporary file appears
+/// (the work under way), or as soon as it holds bytes (the output being
+/// written).
+#[derive(Clone, Copy)]
+enum When {
+    Working,
+    Writing,
+}
+
 /// Starts `args` in `d`, waits until a temporary file beside `target`
 /// exists (the output has been started and the work is under way), sends
 /// `signal`, and checks that the run fails, `target` is byte for byte what
 /// it was and nothing else is left in `d`.
 fn interrupt(d: &Path, args: &[&str], target: &str, signal: &str) {
+    interrupt_when(d, args, target, signal, When::Working);
+}
+
+fn interrupt_when(d: &Path, args: &[&str], target: &str, signal: &str, when: When) {
     let old = std::fs::read(d.join(target)).unwrap();
     let before = names(d);
     let mut child = rrt()
@@ -149,7 +202,11 @@ fn interrupt(d: &Path, args: &[&str], target: &str, signal: &str) {
         let tmp = names(d)
             .into_iter()
             .find(|n| n.starts_with(target) && n.ends_with(".tmp"));
-        if let Some(tmp) = tmp {
+        let ready = tmp.as_ref().is_some_and(|tmp| match when {
+            When::Working => true,
+            When::Writing => std::fs::metadata(d.join(tmp)).is_ok_and(|m| m.len() > 0),
+        });
+        if let (true, Some(tmp)) = (ready, tmp) {
             break tmp;
         }
         assert!(
@@ -157,10 +214,12 @@ fn interrupt(d: &Path, args: &[&str], target: &str, signal: &str) {
             "no temporary file appeared"
         );
         assert!(child.try_wait().unwrap().is_none(), "finished too soon");
-        std::thread::sleep(Duration::from_millis(5));
+        std::thread::sleep(Duration::from_millis(1));
     };
     // Into the work (voxelizing or rendering), then the signal.
-    std::thread::sleep(Duration::from_millis(300));
+    if let When::Working = when {
+        std::thread::sleep(Duration::from_millis(300));
+    }
     assert!(child.try_wait().unwrap().is_none(), "finished too soon");
     assert!(d.join(&tmp).exists());
     let kill = Command::new("kill")
@@ -201,6 +260,31 @@ fn an_interrupted_voxelize_keeps_the_old_raster() {
         "x.rrt",
         "-TERM",
     );
+    // While the new raster is being written (where rrt used to write in
+    // place and leave a truncated file): a sparse scene whose raster is
+    // large (a 500³ plane, 120 MiB) and quick to make.
+    std::fs::write(
+        d.join("sparse.nff"),
+        "s 0 0 0 0.05\ns 10 10 10 0.05\nl 5 5 20\nf 1 0.5 0.2 0.8 0.2 10 0 1\nv\nfrom 5 -20 5\nat 5 5 5\nup 0 0 1\nangle 45\nhither 0.1\nresolution 16 16\n",
+    )
+    .unwrap();
+    for signal in ["-INT", "-TERM"] {
+        interrupt_when(
+            &d,
+            &[
+                "voxelize",
+                "-q",
+                "sparse.nff",
+                "--raster",
+                "500",
+                "-o",
+                "x.rrt",
+            ],
+            "x.rrt",
+            signal,
+            When::Writing,
+        );
+    }
     // Still a valid raster.
     let info = rrt()
         .current_dir(&d)

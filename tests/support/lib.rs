@@ -87,6 +87,32 @@ pub fn shared_data() -> Option<PathBuf> {
     p.is_dir().then_some(p)
 }
 
+/// A binary PPM (P6, maxval 255) as written by `embree_nff`.
+///
+/// # Panics
+/// On a file that is not such a PPM (a test's fixture is broken).
+#[must_use]
+pub fn read_ppm(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    let mut fields = Vec::new();
+    let mut at = 0;
+    while fields.len() < 4 {
+        while bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        let start = at;
+        while !bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        fields.push(std::str::from_utf8(&bytes[start..at]).unwrap().to_owned());
+    }
+    assert_eq!((fields[0].as_str(), fields[3].as_str()), ("P6", "255"));
+    let (w, h) = (fields[1].parse().unwrap(), fields[2].parse().unwrap());
+    let pixels = bytes[at + 1..].to_vec();
+    assert_eq!(pixels.len(), 3 * (w * h) as usize);
+    (w, h, pixels)
+}
+
 /// `../shared/data/spd` (the SPD scenes), or `None` with a skip message
 /// when the shared data is absent.
 #[must_use]

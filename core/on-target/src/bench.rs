@@ -1,14 +1,15 @@
 //! The workloads whose instructions per step are measured: the same code
 //! on the target (counted by QEMU) and on the host (counted by callgrind).
-//! Each returns the number of voxels its walks visited.
+//! Each returns the number of voxels its walks visited ([`dilated`]: of
+//! the 6-connected paths whose tubes it walks).
 
-use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
+use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use rrt_core::packet::{LANES, RayPacket8};
 use rrt_core::raster::Raster;
 
 use crate::rays::{Spec, spec};
 use crate::scene;
-use crate::traversal::{RAYS, SEED};
+use crate::traversal::{RAYS, SEED, dilated_test};
 
 /// Draws every ray's inputs from the seed into `out` (outside the
 /// measured workloads).
@@ -66,6 +67,23 @@ pub fn packet(raster: &Raster<'_>, specs: &[Spec], mode: Connectivity) -> u64 {
         }
     }
     steps
+}
+
+/// Sets up every ray and walks its tube ([`DiscreteRay::walk_dilated`],
+/// the shadow classification's walk) to each of its hits
+/// ([`dilated_test`]) and on to its exit; returns the voxels of the rays'
+/// 6-connected paths (`1 +` the crossings: the walk's own step count
+/// counts a jump as one step).
+#[inline(never)]
+pub fn dilated(raster: &Raster<'_>, specs: &[Spec]) -> u64 {
+    let e = raster.extent();
+    let mut voxels = 0;
+    for s in specs {
+        let Ok(Some(mut r)) = s.ray(e) else { continue };
+        while let Ok(WalkEnd::Hit) = r.walk_dilated(raster, u32::MAX, dilated_test) {}
+        voxels += 1 + r.crossings().iter().map(|&c| u64::from(c)).sum::<u64>();
+    }
+    voxels
 }
 
 fn lane_steps(p: &RayPacket8) -> u64 {

@@ -1,6 +1,7 @@
 //! A selection of rrt-core's own invariant checkers (its `check` feature),
 //! run over the traversal raster, the seeded rays and voxelized closed
-//! shapes.
+//! shapes, and one of this crate's: the tube walk
+//! ([`DiscreteRay::walk_dilated`]) against the tube found by brute force.
 
 use core::fmt;
 
@@ -9,7 +10,7 @@ use rrt_core::check::{
 };
 use rrt_core::check_packet::check_packet;
 use rrt_core::check_voxelize::{PlaneSink, check_closed, probe_targets};
-use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
+use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::geometry::{Cone, Cuboid, Sphere};
 use rrt_core::packet::{LANES, RayPacket8};
@@ -18,7 +19,7 @@ use rrt_core::raster::{Extent, Raster, RasterMut, cell};
 use rrt_core::voxelize::{Separation, cone, cuboid, sphere};
 
 use crate::rng::Rng;
-use crate::traversal::{RAYS, SEED, ray};
+use crate::traversal::{RAYS, SEED, dilated_test, ray, walk_limit};
 
 /// Passed and failed runs of one checker.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -77,9 +78,9 @@ pub const SCRATCH_LEN: usize = (CLOSED_SIDE * CLOSED_SIDE * CLOSED_SIDE) as usiz
 /// Runs the checkers: `check_ray` on every [`RAY_STRIDE`]-th ray in every mode,
 /// `check_adaptive_matches_six` on every ray, `check_skipping` and
 /// `check_packet` on every [`STRIDE`]-th ray or packet,
-/// `check_lattice_counts` on seeded voxel-centre pairs, and `check_closed`
+/// `check_lattice_counts` on seeded voxel-centre pairs, `check_closed`
 /// (no ray from inside escapes) on a sphere, a box and a capped cone in
-/// both separations. `raster` is the traversal raster, `lined` the same
+/// both separations, and [`check_tube`] on every ray over both rasters. `raster` is the traversal raster, `lined` the same
 /// with its distance field and line level; `scratch` holds
 /// `CLOSED_SIDE³` cells. Each failure goes to `fail` with the checker's
 /// name and the violation.
@@ -88,7 +89,7 @@ pub fn run(
     lined: &Raster<'_>,
     scratch: &mut [u8],
     fail: &mut impl FnMut(&'static str, &dyn fmt::Debug),
-) -> [Tally; 6] {
+) -> [Tally; 7] {
     let e = raster.extent();
     let mut t = [
         Tally::new("check_ray"),
@@ -97,6 +98,7 @@ pub fn run(
         Tally::new("check_packet"),
         Tally::new("check_lattice_counts"),
         Tally::new("check_closed"),
+        Tally::new("check_tube"),
     ];
     for i in 0..RAYS {
         let Some(r) = ray(e, i) else { continue };
@@ -109,6 +111,9 @@ pub fn run(
             }
         }
         t[1].add(check_adaptive_matches_six(raster, &r), fail);
+        for rs in [raster, lined] {
+            t[6].add(check_tube(rs, r).map_err(|v| (i, v)), fail);
+        }
     }
     let mut first = 0;
     while first < RAYS {
@@ -132,6 +137,99 @@ pub fn run(
     }
     closed(&mut t[5], scratch, fail);
     t
+}
+
+/// Where a tube walk left the brute-force tube.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TubeViolation {
+    /// The walk failed.
+    Walk(rrt_core::error::RayError),
+    /// The `call`-th test call (counted over the resumed walks) was on
+    /// `got` (index, cell), where the tube has `expected` next (`None`:
+    /// past its end, or the walk ended before it).
+    Call {
+        /// The call's number.
+        call: u64,
+        /// The walk's voxel and cell.
+        got: Option<(usize, u8)>,
+        /// The tube's.
+        expected: Option<(usize, u8)>,
+    },
+    /// The walk did not exit within the resumption limit.
+    Endless,
+}
+
+/// The tube walk checked against brute force: ray `r` walked through
+/// `raster` by [`DiscreteRay::walk_dilated`] with [`dilated_test`], resumed
+/// after each hit until it exits, must call its test exactly on the
+/// voxels of the ray's 6-connected path that have an opaque voxel of the
+/// plane within chessboard distance 1 (looked up cell by cell), in path
+/// order, each with the plane's own cell. This is what the shadow
+/// classification's proof rests on (`rrt_core::light`, *Shadow
+/// classification*). Returns the number of calls.
+///
+/// # Errors
+/// The first difference.
+pub fn check_tube(raster: &Raster<'_>, r: DiscreteRay) -> Result<u64, TubeViolation> {
+    let e = raster.extent();
+    let plane = raster.plane();
+    let [nx, ny, nz] = e.dims();
+    let near = |[x, y, z]: [u32; 3]| {
+        let span = |c: u32, n: u32| c.saturating_sub(1)..=(c + 1).min(n - 1);
+        span(z, nz).any(|w| {
+            span(y, ny).any(|v| {
+                span(x, nx).any(|u| {
+                    e.index([u, v, w])
+                        .and_then(|i| plane.get(i))
+                        .is_some_and(|&c| c & cell::OPAQUE != 0)
+                })
+            })
+        })
+    };
+    let mut expected = r.path(Connectivity::Six).filter_map(|v| {
+        let c = plane.get(v.index).copied()?;
+        near(e.coord(v.index)?).then_some((v.index, c))
+    });
+    let mut walker = r;
+    let mut calls = 0u64;
+    let mut bad = None;
+    let mut exited = false;
+    for _ in 0..walk_limit(&r) {
+        let end = walker.walk_dilated(raster, u32::MAX, |i, c| {
+            let want = expected.next();
+            if bad.is_none() && want != Some((i, c)) {
+                bad = Some(TubeViolation::Call {
+                    call: calls,
+                    got: Some((i, c)),
+                    expected: want,
+                });
+            }
+            calls += 1;
+            dilated_test(i, c)
+        });
+        match end {
+            Ok(WalkEnd::Exit) => {
+                exited = true;
+                break;
+            }
+            Ok(_) => {}
+            Err(err) => return Err(TubeViolation::Walk(err)),
+        }
+    }
+    if let Some(v) = bad {
+        return Err(v);
+    }
+    if !exited {
+        return Err(TubeViolation::Endless);
+    }
+    match expected.next() {
+        None => Ok(calls),
+        Some(w) => Err(TubeViolation::Call {
+            call: calls,
+            got: None,
+            expected: Some(w),
+        }),
+    }
 }
 
 /// Tunnel checks: every ray from a shape's centre towards the corners,

@@ -64,6 +64,7 @@ macro_rules! scene_storage {
                 ::rrt_core::voxel::VoxelRecord = $crate::scene::RECORD_INIT;
                 $crate::scene::MAX_RECORDS
             ),
+            lists: $crate::buffer!(u32 = 0; $crate::scene::MAX_LIST_ENTRIES),
             objects: $crate::buffer!(
                 ::rrt_core::object_table::Object = ::rrt_core::object_table::Object::UNUSED;
                 $crate::scene::MAX_OBJECTS
@@ -163,44 +164,18 @@ fn rasters<'a>(
     Ok((raster, lined))
 }
 
-/// Builds and renders the scene, reporting `scene.*` and `example.image`.
+/// Builds and renders the scene, reporting `scene.*` and `example.image`;
+/// then builds it again as the exact raster (object lists, the shadow
+/// classification), reporting `scene.exact.*`.
 pub fn scene_digests(
     st: &mut scene::Storage<'_>,
     image: &mut [u8],
     out: &mut dyn FnMut(Event<'_>),
 ) {
-    let report = match scene::build(st) {
-        Ok(r) => r,
-        Err(e) => {
-            out(Event::Failure("scene build", &e));
-            return;
-        }
+    let Some(report) = built_digests(st, scene::Variant::Paper, out) else {
+        return;
     };
     let records = st.records.get(..report.records).unwrap_or(&[]);
-    let mut d = Digest::new();
-    d.debug(&report);
-    out(Event::Digest(Line::of("scene.reports", &d)));
-    let mut d = Digest::new();
-    for &c in st.plane.iter() {
-        d.word(u64::from(c));
-    }
-    for &c in st.lines.iter() {
-        d.word(u64::from(c));
-    }
-    out(Event::Digest(Line::of("scene.plane", &d)));
-    let mut d = Digest::new();
-    for &w in st.dir.iter() {
-        d.word(u64::from(w));
-    }
-    for r in records {
-        d.item();
-        for w in bytemuck::bytes_of(r).chunks(4) {
-            let mut b = [0u8; 4];
-            b[..w.len()].copy_from_slice(w);
-            d.word(u64::from(u32::from_le_bytes(b)));
-        }
-    }
-    out(Event::Digest(Line::of("scene.records", &d)));
     match scene::render(st.plane, st.lines, st.dir, records, image) {
         Ok(r) => {
             let mut d = Digest::new();
@@ -213,4 +188,68 @@ pub fn scene_digests(
         }
         Err(e) => out(Event::Failure("scene render", &e)),
     }
+    built_digests(st, scene::Variant::Exact, out);
+}
+
+/// Builds the scene into `st` as `variant` and reports its digests: the
+/// reports (`scene.reports`), plane and line level (`scene.plane`), and
+/// directory, records and object lists (`scene.records`), each name with
+/// `.exact` after `scene` for the exact raster. `None` (and a failure)
+/// when the build fails.
+fn built_digests(
+    st: &mut scene::Storage<'_>,
+    variant: scene::Variant,
+    out: &mut dyn FnMut(Event<'_>),
+) -> Option<scene::SceneReport> {
+    let names = match variant {
+        scene::Variant::Paper => ["scene.reports", "scene.plane", "scene.records"],
+        scene::Variant::Exact => [
+            "scene.exact.reports",
+            "scene.exact.plane",
+            "scene.exact.records",
+        ],
+    };
+    let report = match scene::build_with(st, variant, &mut |_, pass| pass()) {
+        Ok(r) => r,
+        Err(e) => {
+            out(Event::Failure(
+                match variant {
+                    scene::Variant::Paper => "scene build",
+                    scene::Variant::Exact => "scene build (exact)",
+                },
+                &e,
+            ));
+            return None;
+        }
+    };
+    let records = st.records.get(..report.records).unwrap_or(&[]);
+    let lists = st.lists.get(..report.lists).unwrap_or(&[]);
+    let mut d = Digest::new();
+    d.debug(&report);
+    out(Event::Digest(Line::of(names[0], &d)));
+    let mut d = Digest::new();
+    for &c in st.plane.iter() {
+        d.word(u64::from(c));
+    }
+    for &c in st.lines.iter() {
+        d.word(u64::from(c));
+    }
+    out(Event::Digest(Line::of(names[1], &d)));
+    let mut d = Digest::new();
+    for &w in st.dir.iter() {
+        d.word(u64::from(w));
+    }
+    for r in records {
+        d.item();
+        for w in bytemuck::bytes_of(r).chunks(4) {
+            let mut b = [0u8; 4];
+            b[..w.len()].copy_from_slice(w);
+            d.word(u64::from(u32::from_le_bytes(b)));
+        }
+    }
+    for &w in lists {
+        d.word(u64::from(w));
+    }
+    out(Event::Digest(Line::of(names[2], &d)));
+    Some(report)
 }

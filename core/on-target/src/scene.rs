@@ -5,16 +5,26 @@
 //!
 //! This is the whole embedded pipeline, in the order an integrator calls
 //! it: count pass → [`Sizing::records`] (the record storage needed) → fill
-//! pass → [`Filler::finish`] → [`illuminate`] → [`distance_field`],
-//! [`write_rank_hints`], [`line_distances`] → per pixel one
+//! pass → [`Filler::finish`] → [`distance_field`], [`write_rank_hints`],
+//! [`line_distances`] (the plane finished) → [`illuminate`] → per pixel one
 //! [`DiscreteRay`] to its first hit and one record lookup.
+//!
+//! The scene is built as either of the host's two rasters ([`Variant`]):
+//! the paper's (one object per voxel, as thick as the rays need, the
+//! paper's light bits), which the example image is traced from, or the
+//! exact one (every object 26-separating, object lists, the shadow
+//! classification for records of exact objects), which the digests cover
+//! too.
+//!
+//! [`Sizing::records`]: rrt_core::store::Sizing::records
+//! [`Filler::finish`]: rrt_core::store::Filler::finish
 
 use rrt_core::csg::{self, CsgNode, CsgTree, IgnoreLeaf, LeafFill, Solid};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::error::{RasterError, RayError};
 use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::{BezierPatch, Cone, Cuboid, NORMAL_ONE, Point, Sphere, Torus, Triangle};
-use rrt_core::light::{LightError, LightParams, LightReport, illuminate};
+use rrt_core::light::{ExactRecords, LightError, LightParams, LightReport, illuminate};
 use rrt_core::object_table::{
     Light, Lights, Material, Materials, Object, ObjectTable, SCALAR_ONE, Shape, VolumeRef,
 };
@@ -37,8 +47,15 @@ pub const LINES_LEN: usize = rrt_core::raster::line_count(PLANE_LEN);
 /// Directory entries: one per 8×8×8 brick plus one.
 pub const DIR_LEN: usize = ((DIMS[0] / 8) * (DIMS[1] / 8) * (DIMS[2] / 8) + 1) as usize;
 /// Record storage the integrator provides (the count pass says how much of
-/// it the scene needs).
+/// it the scene needs: 9,192 records for the paper's raster, 10,788 for the
+/// exact one).
 pub const MAX_RECORDS: usize = 12_288;
+/// Object-list storage for the exact raster (`u32` entries; the fill pass
+/// uses it as working space, [`Sizing::list_entries`] bounds what it
+/// needs, the finished lists are the front of it).
+///
+/// [`Sizing::list_entries`]: rrt_core::store::Sizing::list_entries
+pub const MAX_LIST_ENTRIES: usize = 2_048;
 /// Object-table capacity.
 pub const MAX_OBJECTS: usize = 16;
 /// Image width and height.
@@ -70,6 +87,8 @@ pub struct Storage<'a> {
     pub dir: &'a mut [u32],
     /// Record storage (at least the scene's count).
     pub records: &'a mut [VoxelRecord],
+    /// Object-list storage (the exact raster only).
+    pub lists: &'a mut [u32],
     /// Object-table storage.
     pub objects: &'a mut [Object],
     /// Bézier-patch storage.
@@ -111,11 +130,61 @@ from_errors!(
     Ray(RayError)
 );
 
+/// Which of the host's two rasters the scene is built as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// The paper's raster: every object as thick as the rays need
+    /// ([`Separation::for_rays`] of [`MODE`]), one object per voxel, the
+    /// paper's light bits from one discrete shadow ray per record and light.
+    Paper,
+    /// The exact raster (the host's default, for rendering with
+    /// intersection verification): every object conservatively
+    /// ([`Separation::TwentySix`]), a voxel several objects pass through
+    /// lists all of them, and records of objects with exact geometry get the
+    /// shadow classification ([`ExactRecords::Classify`]: a tube walk,
+    /// [`DiscreteRay::walk_dilated`], instead of the paper's shadow ray);
+    /// the volume blob and the CSG ball (no exact geometry) keep the
+    /// paper's bits.
+    Exact,
+}
+
+impl Variant {
+    /// The separation every object is voxelized with.
+    #[must_use]
+    pub const fn separation(self) -> Separation {
+        match self {
+            Self::Paper => Separation::for_rays(MODE),
+            Self::Exact => Separation::TwentySix,
+        }
+    }
+
+    /// The light pass's parameters.
+    #[must_use]
+    pub fn light(self) -> LightParams {
+        match self {
+            Self::Paper => LightParams::default(),
+            Self::Exact => LightParams {
+                exact_records: ExactRecords::Classify,
+                ..LightParams::default()
+            },
+        }
+    }
+}
+
 /// What building the scene did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SceneReport {
     /// Records of the scene (the first entries of the record storage).
     pub records: usize,
+    /// Entries of the finished object lists (the first entries of the list
+    /// storage; 0 on the paper's raster).
+    pub lists: usize,
+    /// The count pass's bound on the list storage the fill pass may need
+    /// ([`Sizing::list_entries`]; a loose bound, and unused on the paper's
+    /// raster).
+    ///
+    /// [`Sizing::list_entries`]: rrt_core::store::Sizing::list_entries
+    pub list_bound: usize,
     /// The fill pass's counts.
     pub fill: FillReport,
     /// The light pass's counts.
@@ -229,9 +298,9 @@ fn checker(centre: [i64; 3], _normal: [i32; 3], base: [u8; 3]) -> [u8; 3] {
 /// ring, cone, canopy, four pyramid faces, blob, cut ball.
 const OBJECTS: u32 = 11;
 
-/// Offers object `id` (all but the cut ball) to `sink`.
-fn offer(id: u32, e: Extent, sink: &mut dyn VoxelSink) -> Result<(), SceneError> {
-    let sep = Separation::for_rays(MODE);
+/// Offers object `id` (all but the cut ball), voxelized with `sep`, to
+/// `sink`.
+fn offer(id: u32, e: Extent, sep: Separation, sink: &mut dyn VoxelSink) -> Result<(), SceneError> {
     let r = match id {
         0 => cuboid::solid(&FLOOR, sep, e, sink),
         1 => sphere::surface(&BALL, sep, e, sink),
@@ -348,26 +417,31 @@ fn with_cut_ball<R>(f: impl FnOnce(&CsgTree<'_>) -> R) -> Result<R, SceneError> 
     Ok(f(&tree))
 }
 
-/// Builds the scene into `st`: voxelized, lit, finished (distance field,
-/// rank hints, line level).
+/// Builds the scene into `st` as the paper's raster: voxelized, finished
+/// (distance field, rank hints, line level), lit.
 ///
 /// # Errors
 /// A [`SceneError`] when a buffer is too small or a pass refuses.
 pub fn build(st: &mut Storage<'_>) -> Result<SceneReport, SceneError> {
-    build_with(st, &mut |_, pass| pass())
+    build_with(st, Variant::Paper, &mut |_, pass| pass())
 }
 
 /// A hook around each stage of [`build_with`]: called with the stage's
 /// name and the stage, which it must run exactly once.
 pub type Probe<'p> = dyn FnMut(&'static str, &mut dyn FnMut()) + 'p;
 
-/// [`build`], each stage run through `probe` (the stack measurement wraps
-/// them; [`build`] just runs them).
+/// [`build`] as `variant`, each stage run through `probe` (the stack
+/// measurement wraps them; [`build`] just runs them).
 ///
 /// # Errors
 /// As [`build`].
-pub fn build_with(st: &mut Storage<'_>, probe: &mut Probe<'_>) -> Result<SceneReport, SceneError> {
+pub fn build_with(
+    st: &mut Storage<'_>,
+    variant: Variant,
+    probe: &mut Probe<'_>,
+) -> Result<SceneReport, SceneError> {
     let e = extent()?;
+    let sep = variant.separation();
     if directory_len(e) != Some(st.dir.len()) {
         return Err(SceneError::Capacity);
     }
@@ -376,7 +450,7 @@ pub fn build_with(st: &mut Storage<'_>, probe: &mut Probe<'_>) -> Result<SceneRe
     let mut done: Result<(), SceneError> = Ok(());
     probe("Counter: count pass, every object", &mut || {
         done = (0..OBJECTS - 1)
-            .try_for_each(|id| offer(id, e, &mut counter))
+            .try_for_each(|id| offer(id, e, sep, &mut counter))
             .and_then(|()| {
                 with_cut_ball(|t| csg::voxelize(t, e, &mut IgnoreLeaf(&mut counter))).map(|_| ())
             });
@@ -384,13 +458,17 @@ pub fn build_with(st: &mut Storage<'_>, probe: &mut Probe<'_>) -> Result<SceneRe
     done?;
     let sizing = counter.finish()?;
     let records = sizing.records();
+    let list_bound = sizing.list_entries();
     // Fill pass.
     let mats = materials()?;
     let limits = Limits {
         objects: OBJECTS,
         materials: mats.index_limit(),
     };
-    let mut filler = sizing.fill(st.records, limits)?;
+    let mut filler = match variant {
+        Variant::Paper => sizing.fill(st.records, limits)?,
+        Variant::Exact => sizing.fill_with_lists(st.records, st.lists, limits)?,
+    };
     let attrs = |id: u32| {
         let m = material(id);
         ObjectAttrs {
@@ -406,9 +484,9 @@ pub fn build_with(st: &mut Storage<'_>, probe: &mut Probe<'_>) -> Result<SceneRe
                 filler.begin_object(attrs(id))?;
                 if id == 0 {
                     let tex = checker;
-                    offer(id, e, &mut filler.textured(&tex))?;
+                    offer(id, e, sep, &mut filler.textured(&tex))?;
                 } else {
-                    offer(id, e, &mut filler)?;
+                    offer(id, e, sep, &mut filler)?;
                 }
             }
             let leaf_attrs = [attrs(OBJECTS - 1); 2];
@@ -423,35 +501,40 @@ pub fn build_with(st: &mut Storage<'_>, probe: &mut Probe<'_>) -> Result<SceneRe
     probe("Filler::finish", &mut || {
         finished = filler.take().map(|f| f.finish())
     });
-    let mut built = finished.ok_or(SceneError::Capacity)??;
+    let built = finished.ok_or(SceneError::Capacity)??;
     let fill = built.report();
-    // Light pass.
-    let mut table = ObjectTable::new(st.objects, st.patches);
-    push_objects(&mut table)?;
-    let lights = lights()?;
-    let (raster, mut store) = built.split();
-    let mut light = Err(SceneError::Capacity);
-    probe("illuminate", &mut || {
-        light = illuminate(
-            &raster,
-            &mut store,
-            &table,
-            &mats,
-            &lights,
-            &LightParams::default(),
-        )
-        .map_err(SceneError::from);
-    });
-    let light = light?;
-    // Finish the plane for skipping walks.
-    let (mut raster, store) = built.into_parts();
+    let lists = built.lists().len();
+    // Finish the plane for skipping walks (the light pass changes no cell
+    // and no record's place; its walks read the distance field, which the
+    // shadow classification needs).
+    let (mut raster, mut store) = built.into_parts();
     probe("distance_field + write_rank_hints", &mut || {
         distance_field(&mut raster);
         write_rank_hints(&mut raster, &store.as_store());
     });
     line_distances(&raster.as_raster(), st.lines)?;
+    // Light pass.
+    let raster = raster.as_raster().with_lines(st.lines)?;
+    let mut table = ObjectTable::new(st.objects, st.patches);
+    push_objects(&mut table)?;
+    let lights = lights()?;
+    let params = variant.light();
+    let mut light = Err(SceneError::Capacity);
+    probe(
+        match variant {
+            Variant::Paper => "illuminate",
+            Variant::Exact => "illuminate: shadow classification",
+        },
+        &mut || {
+            light = illuminate(&raster, &mut store, &table, &mats, &lights, &params)
+                .map_err(SceneError::from);
+        },
+    );
+    let light = light?;
     Ok(SceneReport {
         records,
+        lists,
+        list_bound,
         fill,
         light,
     })
@@ -480,7 +563,7 @@ pub fn voxelizer_probe(probe: &mut Probe<'_>) {
     for (id, name) in names {
         let mut c = Count(0);
         probe(name, &mut || {
-            let _ = offer(id, e, &mut c);
+            let _ = offer(id, e, Variant::Paper.separation(), &mut c);
         });
     }
     let mut c = Count(0);

@@ -1,5 +1,7 @@
 //! The traversal digests: the seeded ray set walked through a raster in a
-//! static buffer, scalar and packet, in all three connectivities.
+//! static buffer, scalar and packet, in all three connectivities, and
+//! through the raster dilated by one voxel ([`DiscreteRay::walk_dilated`],
+//! the shadow classification's tube walk).
 
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, Face, Hit, WalkEnd};
 use rrt_core::error::{RasterError, RayError};
@@ -132,6 +134,14 @@ pub const fn walk_test(index: usize, c: u8) -> bool {
     c & cell::OPAQUE != 0 && index % 3 != 1
 }
 
+/// The hit test of the tube walks ([`DiscreteRay::walk_dilated`], whose
+/// test sees the plane's own cell, often a transparent neighbour of an
+/// opaque voxel): as [`walk_test`].
+#[must_use]
+pub const fn dilated_test(index: usize, c: u8) -> bool {
+    walk_test(index, c)
+}
+
 /// A walk outcome as a word.
 #[must_use]
 pub const fn end_word(e: WalkEnd) -> u64 {
@@ -189,7 +199,8 @@ pub fn setup(e: Extent) -> Line {
 /// Upper bound on the walks of one ray until it exits (each walk visits
 /// at least one voxel); a ray that needs more is a failure, digested as
 /// such.
-fn walk_limit(r: &DiscreteRay) -> u32 {
+#[must_use]
+pub fn walk_limit(r: &DiscreteRay) -> u32 {
     r.crossings().iter().fold(3u32, |a, &c| a.saturating_add(c))
 }
 
@@ -286,6 +297,42 @@ pub fn walks(d: &mut Digest, raster: &Raster<'_>, r: DiscreteRay, mode: Connecti
     });
 }
 
+/// Ray `r`'s tube walk ([`DiscreteRay::walk_dilated`], no budget) with
+/// [`dilated_test`], resumed after each hit until it exits: every voxel
+/// the test is called on (index and plane cell, with the test's answer)
+/// and each hit voxel, into `d`. It records neither the step count nor
+/// the resume state, which the line level changes (its jumps are single
+/// steps), so it is the same over `raster` with and without a line level.
+pub fn tube(d: &mut Digest, raster: &Raster<'_>, r: DiscreteRay) {
+    resumed(d, r, |d, r| {
+        let e = r.walk_dilated(raster, u32::MAX, |i, c| {
+            let hit = dilated_test(i, c);
+            d.item();
+            d.index(i);
+            d.word(u64::from(c) | u64::from(hit) << 8);
+            hit
+        })?;
+        d.word(end_word(e));
+        let h = r.hit();
+        let [x, y, z] = h.voxel.map(u64::from);
+        d.word(x | y << 21 | z << 42);
+        d.index(h.index);
+        Ok(e == WalkEnd::Exit)
+    });
+}
+
+/// Ray `r`'s budgeted tube walks with [`dilated_test`] until it exits:
+/// each outcome and the whole resume state, into `d`.
+pub fn dilated_walks(d: &mut Digest, raster: &Raster<'_>, r: DiscreteRay, budget: u32) {
+    resumed(d, r, |d, r| {
+        let e = r.walk_dilated(raster, budget, dilated_test)?;
+        d.item();
+        d.word(end_word(e));
+        state(d, r, Connectivity::Adaptive);
+        Ok(e == WalkEnd::Exit)
+    });
+}
+
 /// Ray `r` resumed up to [`walk_limit`] times by `step`, which records its
 /// outcome into `d` and says whether the ray is done; an error ends the
 /// record with the error, running out of the limit with `u64::MAX`.
@@ -308,10 +355,13 @@ fn resumed(
 }
 
 /// Every traversal digest, in a fixed order: `ray.setup`, then per mode the
-/// scalar voxels, hits, budgeted walks and skipping hits, then per mode the
-/// packet hits and budgeted walks. The packet digests are built so that
-/// they equal the scalar `hits` and `walk` digests of the same mode (each
-/// lane's record is its ray's record, combined in ray order).
+/// scalar voxels, hits, budgeted walks and skipping hits, then the tube
+/// walks ([`tube`] over the plane and over the line level, and
+/// [`dilated_walks`] with the line level), then per mode the packet hits
+/// and budgeted walks. The packet digests are built so that they equal
+/// the scalar `hits` and `walk` digests of the same mode (each lane's
+/// record is its ray's record, combined in ray order), and the two tube
+/// digests so that they equal each other.
 pub fn digests(raster: &Raster<'_>, lined: &Raster<'_>, out: &mut impl FnMut(Line)) {
     let e = raster.extent();
     out(setup(e));
@@ -337,6 +387,32 @@ pub fn digests(raster: &Raster<'_>, lined: &Raster<'_>, out: &mut impl FnMut(Lin
         for (k, d) in all.iter().enumerate() {
             out(Line::of(NAMES[k][m], d));
         }
+    }
+    let mut all = [Digest::new(); 3];
+    for i in 0..RAYS {
+        let Some(r) = ray(e, i) else {
+            for d in &mut all {
+                d.word(Digest::new().value());
+            }
+            continue;
+        };
+        let mut one = [Digest::new(); 3];
+        tube(&mut one[0], raster, r);
+        tube(&mut one[1], lined, r);
+        dilated_walks(&mut one[2], lined, r, budget(i));
+        for (d, o) in all.iter_mut().zip(&one) {
+            fold(d, o);
+        }
+    }
+    for (name, d) in [
+        "ray.dilated.tube",
+        "ray.dilated.tube.lines",
+        "ray.dilated.walk",
+    ]
+    .into_iter()
+    .zip(&all)
+    {
+        out(Line::of(name, d));
     }
     for mode in Connectivity::ALL {
         let m = mode_index(mode);

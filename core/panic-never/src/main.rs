@@ -16,7 +16,7 @@ use core::panic::PanicInfo;
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use rrt_core::packet::RayPacket8;
 use rrt_core::proximity::flag_neighbourhood;
-use rrt_core::raster::{Extent, Raster, RasterMut};
+use rrt_core::raster::{Extent, Raster, RasterMut, line_count};
 
 unsafe extern "C" {
     /// Deliberately undefined: referencing it fails the link.
@@ -32,6 +32,9 @@ fn panic(_: &PanicInfo<'_>) -> ! {
 // The flash-size firmwares' opaque inputs, sink, plane and mode input.
 include!("../../on-target/src/bin/size/input.rs");
 include!("../../on-target/src/bin/size/plane.rs");
+
+/// A line level for the plane, filled from the inputs.
+static mut LINES: [u8; line_count(16384)] = [0; line_count(16384)];
 
 fn drive() {
     let Ok(extent) = Extent::new(u32_at(0), u32_at(4), u32_at(8)) else {
@@ -54,6 +57,14 @@ fn drive() {
     // SAFETY: as above.
     let plane: &[u8] = unsafe { &*addr_of!(PLANE) };
     let raster = Raster::new(extent, &plane[..len]);
+    // SAFETY: the only reference to LINES while `drive` runs.
+    let lines: &mut [u8] = unsafe { &mut *addr_of_mut!(LINES) };
+    for (k, l) in lines.iter_mut().enumerate() {
+        *l = input::<1>(k)[0];
+    }
+    let lines: &[u8] = lines;
+    let lined =
+        raster.and_then(|r| r.with_lines(&lines[..(u32_at(108) as usize).min(lines.len())]));
     let origin = point_at(32);
     let dir = [i32_at(56), i32_at(60), i32_at(64)];
     let end = point_at(68);
@@ -108,6 +119,17 @@ fn drive() {
             sink(v.index as u64);
         }
         let Ok(raster) = raster else { continue };
+        // The tube walk (the raster dilated by one voxel), over the plane
+        // and over a line level.
+        for r in [Ok(raster), lined] {
+            let Ok(r) = r else { continue };
+            let mut tube = ray;
+            match tube.walk_dilated(&r, budget, |i, c| (i as u8 ^ c) & 5 == 0) {
+                Ok(WalkEnd::Hit) => sink(tube.hit().index as u64),
+                Ok(WalkEnd::Budget | WalkEnd::Exit) => sink(u64::from(tube.steps())),
+                Err(_) => sink(8),
+            }
+        }
         match ray.walk(&raster, m, budget, |i, c| (i as u8 ^ c) & 3 == 0) {
             Ok(WalkEnd::Hit) => sink(ray.hit().index as u64 ^ u64::from(ray.hit().steps)),
             Ok(WalkEnd::Budget | WalkEnd::Exit) => sink(u64::from(ray.steps())),

@@ -36,7 +36,7 @@ use super::fixmath::{
     Counter, H, cell_floor, centre, centres_within, check_point, clip, dist_u32, length, split,
     sub, unit, window,
 };
-use super::{NORMAL_ONE, Separation, Surfel, UNREAD, VoxelSink};
+use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Cuboid;
 use crate::raster::Extent;
 
@@ -130,7 +130,11 @@ fn scan<S: VoxelSink + ?Sized>(
                     if sep == Separation::Six && !bx.meets_six(v) {
                         continue;
                     }
-                    let s = if reads { surfel(lo, hi, v) } else { UNREAD };
+                    let s = if reads {
+                        surfel(lo, hi, v)
+                    } else {
+                        Surfel::NONE
+                    };
                     sink.offer(v, s);
                     n.bump();
                 }
@@ -144,7 +148,7 @@ fn scan<S: VoxelSink + ?Sized>(
                             ..surfel(lo, hi, v)
                         }
                     } else {
-                        UNREAD
+                        Surfel::NONE
                     };
                     sink.offer(v, s);
                     n.bump();

@@ -100,6 +100,15 @@ pub struct Surfel {
     pub distance: u32,
 }
 
+impl Surfel {
+    /// The surfel offered to a sink that does not read surfels
+    /// ([`VoxelSink::reads_surfels`]).
+    pub const NONE: Self = Self {
+        normal: [0, 0, NORMAL_ONE],
+        distance: 0,
+    };
+}
+
 /// Receives the voxels a voxelizer generates.
 pub trait VoxelSink {
     /// Voxel `voxel` (inside the raster) belongs to the object being
@@ -117,21 +126,14 @@ pub trait VoxelSink {
         0..u32::MAX
     }
 
-    /// Whether the sink reads the surfels offered (yes unless it says
-    /// otherwise). To a sink that only counts voxels (the builder's count
-    /// pass) a voxelizer may offer [`UNREAD`] instead of computing them;
-    /// the voxels and their order are the same.
+    /// Whether the sink reads the surfels it is offered. Voxelizers offer
+    /// [`Surfel::NONE`] instead of computing surfels for a sink that does
+    /// not (the builder's count pass counts voxels only); the voxels
+    /// offered are the same.
     fn reads_surfels(&self) -> bool {
         true
     }
 }
-
-/// The surfel offered to a sink that does not read surfels
-/// ([`VoxelSink::reads_surfels`]).
-pub const UNREAD: Surfel = Surfel {
-    normal: [0, 0, NORMAL_ONE],
-    distance: 0,
-};
 
 pub mod cone;
 pub mod cuboid;

@@ -65,7 +65,7 @@ use super::fixmath::{
     Counter, H, V, ceil_sqrt, cell_floor, cells_overlapping, centre, centres_within, check_point,
     clip, dist_u32, isqrt, radial, split, sub, window,
 };
-use super::{NORMAL_ONE, Separation, Surfel, UNREAD, VoxelSink};
+use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::Sphere;
 use crate::raster::Extent;
 
@@ -216,28 +216,19 @@ impl Ball {
 
     #[inline]
     fn offer<S: VoxelSink + ?Sized>(&self, v: [u32; 3], sink: &mut S, n: &mut Counter) {
-        let s = if sink.reads_surfels() {
-            self.surfel(v)
-        } else {
-            UNREAD
-        };
-        sink.offer(v, s);
+        sink.offer(v, self.surfel_for(v, sink));
         n.bump();
     }
 
-    /// Offers `v`, a voxel inside the solid, with distance 0.
+    /// [`Ball::surfel`], or [`Surfel::NONE`] for a sink that does not read
+    /// surfels.
     #[inline]
-    fn offer_inside<S: VoxelSink + ?Sized>(&self, v: [u32; 3], sink: &mut S, n: &mut Counter) {
-        let s = if sink.reads_surfels() {
-            Surfel {
-                distance: 0,
-                ..self.surfel(v)
-            }
+    fn surfel_for<S: VoxelSink + ?Sized>(&self, v: [u32; 3], sink: &S) -> Surfel {
+        if sink.reads_surfels() {
+            self.surfel(v)
         } else {
-            UNREAD
-        };
-        sink.offer(v, s);
-        n.bump();
+            Surfel::NONE
+        }
     }
 
     /// TwentySix shell (and, with `fill`, the cells wholly inside). Columns
@@ -299,7 +290,9 @@ impl Ball {
                 if let (true, Some((k0, k1))) = (fill, inside) {
                     for ki in k0..=k1 {
                         let v = place(K, ai, bi, ki);
-                        self.offer_inside(v, sink, n);
+                        let s = self.surfel_for(v, sink);
+                        sink.offer(v, Surfel { distance: 0, ..s });
+                        n.bump();
                     }
                 }
             }
@@ -406,7 +399,10 @@ impl Ball {
                     .saturating_add(m.saturating_mul(V))
                     .saturating_add(H.saturating_mul(H));
                 if reach < self.r2 {
-                    self.offer_inside(place(K, ai, bi, ki), sink, n);
+                    let v = place(K, ai, bi, ki);
+                    let s = self.surfel_for(v, sink);
+                    sink.offer(v, Surfel { distance: 0, ..s });
+                    n.bump();
                 }
             }
         });

@@ -74,7 +74,7 @@ use super::fixmath::{
     floor_div, isqrt, low, sub, unit, window,
 };
 use super::sphere::{pick, place};
-use super::{NORMAL_ONE, Separation, Surfel, UNREAD, VoxelSink};
+use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::geometry::{Point, Triangle, UnitVector};
 use crate::raster::Extent;
 
@@ -490,6 +490,7 @@ impl Tri {
         S: VoxelSink + ?Sized,
         F: Fn(&Self, [u32; 3]) -> Surfel,
     {
+        let reads = sink.reads_surfels();
         // Quick reject: the probe reaches at most half a voxel beyond the
         // triangle's bounding box.
         let win = window(extent, sink.layers());
@@ -502,7 +503,6 @@ impl Tri {
         }
         let k = dominant(self.n);
         let (na, nb, nk) = pick(k, win);
-        let reads = sink.reads_surfels();
         // Axes in (a, b, k) coordinates, split by role.
         let mut rows = [Axis::default(); 32];
         let mut cols = [Axis::default(); 32];
@@ -597,8 +597,7 @@ impl Tri {
                 };
                 for ki in k0..=k1 {
                     let v = place(k, ai, bi, ki);
-                    let s = if reads { surfel(self, v) } else { UNREAD };
-                    sink.offer(v, s);
+                    sink.offer(v, if reads { surfel(self, v) } else { Surfel::NONE });
                     n.bump();
                 }
             }

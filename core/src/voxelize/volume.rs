@@ -46,7 +46,7 @@
 
 use super::error::{COORD_LIMIT, VoxelizeError};
 use super::fixmath::{Counter, V, dist_u32, dot, isqrt, unit, window};
-use super::{NORMAL_ONE, Separation, Surfel, UNREAD, VoxelSink};
+use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
 use crate::raster::Extent;
 
 /// A block of samples, x fastest (`samples[i + nx·(j + ny·k)]`), placed at
@@ -170,7 +170,7 @@ where
                 let s = if sink.reads_surfels() {
                     g.surfel(i, j, k, f, thr)
                 } else {
-                    UNREAD
+                    Surfel::NONE
                 };
                 sink.offer(c, s);
                 n.bump();

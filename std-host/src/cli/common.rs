@@ -11,7 +11,7 @@ use rrt_core::light::ExactRecords;
 
 use super::CliError;
 use super::ray::ConnectivityArg;
-use crate::fit::{FitOptions, default_max_memory};
+use crate::fit::{FitOptions, RasterNeed, default_max_memory, default_raster};
 use crate::output::rasterfile;
 use crate::scene::{Scene, View};
 use crate::trace::Mode;
@@ -26,14 +26,15 @@ pub const DEFAULT_SCENE_NAME: &str = "balls2.nff (built-in)";
 pub const MIN_RASTER: i64 = 2 * crate::fit::size::DEFAULT_MARGIN as i64 + 1;
 /// The largest `--raster`: the core's longest raster axis.
 pub const MAX_RASTER: i64 = rrt_core::raster::MAX_AXIS as i64;
-/// Voxels along the longest axis unless `--raster` says otherwise.
-pub const DEFAULT_RASTER: u32 = 1024;
 
 /// How to voxelize a scene.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RasterArgs {
     /// Voxels along the scene's longest axis, 5 to 65536 (two voxels of
-    /// margin on each side) [default: 1024].
+    /// margin on each side) [default: fitted to the scene and the image,
+    /// 64 to 1024: as many as the image has rays for, fewer where voxels
+    /// would only cost time; at least a pixel's footprint where voxels are
+    /// the picture (the paper's mode, volumes, .vox models, CSG)].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(MIN_RASTER..=MAX_RASTER))]
     pub raster: Option<u32>,
     /// Connectivity of the discrete rays (the surfaces are voxelized thick
@@ -94,10 +95,18 @@ pub enum Purpose {
 }
 
 impl RasterArgs {
-    /// The build options these arguments ask for, for `purpose`.
+    /// Whether hits are the voxels themselves.
     #[must_use]
-    pub fn build_options(&self, purpose: Purpose) -> BuildOptions {
-        let raster = self.raster.unwrap_or(DEFAULT_RASTER);
+    pub fn discrete(&self) -> bool {
+        self.mode == ModeArg::Paper
+    }
+
+    /// The build options these arguments ask for, for `purpose`, with
+    /// `default_raster` voxels along the longest axis unless `--raster`
+    /// says otherwise.
+    #[must_use]
+    pub fn build_options(&self, purpose: Purpose, default_raster: u32) -> BuildOptions {
+        let raster = self.raster.unwrap_or(default_raster);
         let mut o = match self.mode {
             ModeArg::Paper => BuildOptions::paper(raster),
             _ => BuildOptions::new(raster),
@@ -175,6 +184,56 @@ pub fn parse_memory(s: &str) -> Result<u64, String> {
         .ok_or_else(|| format!("{s:?} is not a usable size"))
 }
 
+/// The most `--threads`.
+pub const MAX_THREADS: usize = 1024;
+
+/// Parses a whole number from `lo` to `hi`; `what` names the range in
+/// the message ("expected 1 to 64, found 0").
+fn whole_in(s: &str, lo: i64, hi: i64, what: &str) -> Result<i64, String> {
+    match s.trim().parse::<i64>() {
+        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
+        Ok(v) => Err(format!("expected {what}, found {v}")),
+        Err(_) => Err(format!("expected a whole number, found {s:?}")),
+    }
+}
+
+/// Parses `--threads`: 0 (one per core) to [`MAX_THREADS`].
+///
+/// # Errors
+/// A message for anything else.
+pub fn parse_threads(s: &str) -> Result<usize, String> {
+    let hi = i64::try_from(MAX_THREADS).unwrap_or(i64::MAX);
+    let v = whole_in(s, 0, hi, &format!("0 (one per core) to {MAX_THREADS}"))?;
+    usize::try_from(v).map_err(|e| e.to_string())
+}
+
+/// Parses `--depth`: 1 to 64.
+///
+/// # Errors
+/// A message for anything else.
+pub fn parse_depth(s: &str) -> Result<u32, String> {
+    let v = whole_in(s, 1, 64, "1 to 64")?;
+    u32::try_from(v).map_err(|e| e.to_string())
+}
+
+/// Parses `--angle`: degrees strictly between 0 and 180.
+///
+/// # Errors
+/// A message for anything else.
+pub fn parse_angle(s: &str) -> Result<f64, String> {
+    let a = s
+        .trim()
+        .parse::<f64>()
+        .map_err(|_| format!("expected a number of degrees, found {s:?}"))?;
+    if a > 0.0 && a < 180.0 {
+        Ok(a)
+    } else {
+        Err(format!(
+            "expected degrees between 0 and 180 (both excluded), found {a}"
+        ))
+    }
+}
+
 /// Parses `X,Y,Z` as a finite world vector.
 ///
 /// # Errors
@@ -196,15 +255,16 @@ pub struct ViewArgs {
     /// Eye position, `X,Y,Z` (overrides the scene's `from`).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub from: Option<DVec3>,
-    /// Point looked at, `X,Y,Z`.
+    /// Point looked at, `X,Y,Z` (overrides the scene's `at`).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub at: Option<DVec3>,
-    /// Up direction, `X,Y,Z`.
+    /// Up direction, `X,Y,Z` (overrides the scene's `up`).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<DVec3>,
-    /// Vertical field of view in degrees: the angle between the centres
-    /// of the top and bottom pixel rows (overrides the scene's `angle`).
-    #[arg(long, value_name = "DEGREES")]
+    /// Vertical field of view in degrees, between 0 and 180 (both
+    /// excluded): the angle between the centres of the top and bottom
+    /// pixel rows (overrides the scene's `angle`).
+    #[arg(long, value_name = "DEGREES", value_parser = parse_angle, allow_hyphen_values = true)]
     pub angle: Option<f64>,
 }
 
@@ -232,22 +292,45 @@ pub fn progress(show: bool) -> ProgressBar {
     ProgressBar::new(0)
 }
 
-/// Reads an NFF or TOML scene (the built-in one for `None`), with a
-/// spinner on `bar` while it parses.
+/// Reads an NFF or TOML scene (the built-in one for `None`): the bytes
+/// of an NFF file parsed on `bar`, a spinner while a TOML scene and the
+/// files it names are read.
 ///
 /// # Errors
 /// The parser's located error.
 pub fn read_scene(path: Option<&Path>, bar: &ProgressBar) -> Result<(Scene, Duration), CliError> {
     let t = Instant::now();
     let scene = match path {
-        Some(p) => {
+        Some(p)
+            if p.extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
+        {
             crate::progress::spinner(bar, format!("reading {}", p.display()));
             Scene::load(p)
+        }
+        Some(p) => {
+            crate::progress::phase(bar, "reading", crate::progress::Unit::Bytes, 0);
+            Scene::load_with(p, bar)
         }
         None => Scene::parse(DEFAULT_SCENE_NAME, DEFAULT_SCENE.as_bytes()),
     };
     bar.disable_steady_tick();
     Ok((scene?, t.elapsed()))
+}
+
+/// The image a build is for, which the default raster is fitted to:
+/// the view with its overrides, and the size (the scene's resolution
+/// where `None`).
+#[derive(Debug, Clone, Copy)]
+pub struct ImageNeed<'a> {
+    /// View overrides.
+    pub view: &'a ViewArgs,
+    /// Width in pixels.
+    pub width: Option<u32>,
+    /// Height in pixels.
+    pub height: Option<u32>,
+    /// Rays per pixel.
+    pub samples: u32,
 }
 
 /// Where a render's scene comes from.
@@ -273,17 +356,21 @@ pub enum Loaded {
 
 /// Loads `path` as a saved raster when it starts with the raster magic,
 /// else parses and voxelizes it as an NFF or TOML scene (the built-in
-/// scene for `None`).
+/// scene for `None`). `check_view` sees the scene's view before any
+/// voxelizing (a bad view is refused before the long work).
 ///
 /// # Errors
 /// The parser's, builder's or raster file's error; `--raster` or
-/// `--bounds` given for a saved raster.
+/// `--bounds` given for a saved raster; `--bounds` that hold none of the
+/// scene's geometry; `check_view`'s error.
 pub fn load_or_build(
     path: Option<&PathBuf>,
     raster: &RasterArgs,
     purpose: Purpose,
+    image: &ImageNeed<'_>,
     threads: usize,
     show_progress: bool,
+    check_view: &dyn Fn(&View) -> Result<(), CliError>,
 ) -> Result<Loaded, CliError> {
     if let Some(p) = path
         && rasterfile::is_raster_file(p)
@@ -304,10 +391,11 @@ pub fn load_or_build(
         }
         let t = Instant::now();
         let bar = progress(show_progress);
-        crate::progress::spinner(&bar, format!("loading {}", p.display()));
-        let scene = rasterfile::load(p);
+        crate::progress::phase(&bar, "loading", crate::progress::Unit::Bytes, 0);
+        let scene = rasterfile::load_with(p, &bar);
         bar.finish_and_clear();
         let scene = scene?;
+        check_view(&scene.view)?;
         return Ok(Loaded::Saved {
             scene,
             load: t.elapsed(),
@@ -321,7 +409,21 @@ pub fn load_or_build(
             return Err(e);
         }
     };
-    let mut opts = raster.build_options(purpose);
+    if let Err(e) = check_view(&scene.view).and_then(|()| check_bounds(&scene, raster)) {
+        bar.finish_and_clear();
+        return Err(e);
+    }
+    let view = image.view.apply(&scene.view);
+    let need = RasterNeed {
+        view: &view,
+        image: [
+            image.width.unwrap_or(view.resolution[0]),
+            image.height.unwrap_or(view.resolution[1]),
+        ],
+        samples: image.samples,
+        discrete: raster.discrete(),
+    };
+    let mut opts = raster.build_options(purpose, default_raster(&scene, &need));
     opts.threads = threads;
     let built = build(&scene, &opts, &bar);
     bar.finish_and_clear();
@@ -331,6 +433,25 @@ pub fn load_or_build(
         report,
         parse,
     })
+}
+
+/// Refuses `--bounds` that do not meet the box around the scene's
+/// geometry, before the raster is sized (the builder refuses bounds that
+/// meet the box but hold no surface voxel).
+fn check_bounds(scene: &Scene, raster: &RasterArgs) -> Result<(), CliError> {
+    let Some(bounds) = raster.bounds else {
+        return Ok(());
+    };
+    let all = scene.bounds();
+    let meets = all.min.cmple(bounds.max).all() && bounds.min.cmple(all.max).all();
+    if meets {
+        return Ok(());
+    }
+    Err(crate::voxelize::BuildError::EmptyBounds {
+        file: scene.file.to_string(),
+        bounds,
+    }
+    .into())
 }
 
 /// Seconds with three decimals.
@@ -361,6 +482,26 @@ mod tests {
         assert!(parse_bounds("1,2,3").is_err());
         assert!(parse_bounds("0,0,0,1,1,0").is_err());
         assert!(parse_bounds("0,0,0,1,1,nan").is_err());
+    }
+
+    #[test]
+    fn counts_and_angles_in_range() {
+        assert_eq!(parse_threads("0"), Ok(0));
+        assert_eq!(parse_threads(" 8 "), Ok(8));
+        assert!(
+            parse_threads("-1")
+                .unwrap_err()
+                .contains("0 (one per core) to 1024")
+        );
+        assert!(parse_threads("100000").is_err());
+        assert!(parse_threads("two").unwrap_err().contains("whole number"));
+        assert_eq!(parse_depth("64"), Ok(64));
+        assert!(parse_depth("0").unwrap_err().contains("1 to 64, found 0"));
+        assert!(parse_depth("-3").is_err());
+        assert_eq!(parse_angle("40"), Ok(40.0));
+        for bad in ["0", "180", "-5", "nan", "inf", "wide"] {
+            assert!(parse_angle(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -10,9 +10,11 @@ pub mod voxelize;
 
 use std::io::Write;
 
-/// rrt: 3D raster (discrete) ray tracing.
+/// rrt: 3D raster (discrete) ray tracing. A scene (NFF or TOML) is
+/// voxelized once into a raster of surface voxels; rays are traced as
+/// integer 3D lines through it.
 #[derive(Debug, clap::Parser)]
-#[command(name = "rrt", version, about, long_about = None)]
+#[command(name = "rrt", version, long_about = None)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]

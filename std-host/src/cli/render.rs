@@ -4,7 +4,10 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, progress, secs};
+use super::common::{
+    ImageNeed, Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, parse_depth, parse_threads,
+    progress, secs,
+};
 use crate::output::image::{Encoding, ImageOutput};
 use crate::render::camera::Camera;
 use crate::render::{RenderOptions, check_sizes, render};
@@ -30,23 +33,27 @@ pub struct RenderArgs {
     /// are always linear.
     #[arg(long)]
     pub linear: bool,
-    /// Image width in pixels [default: the scene's resolution].
+    /// Image width in pixels, 1 to 32768 [default: the scene's
+    /// resolution].
     #[arg(long, value_name = "W", value_parser = parse_positive, allow_hyphen_values = true)]
     pub width: Option<u32>,
-    /// Image height in pixels [default: the scene's resolution].
+    /// Image height in pixels, 1 to 32768 [default: the scene's
+    /// resolution].
     #[arg(long, value_name = "H", value_parser = parse_positive, allow_hyphen_values = true)]
     pub height: Option<u32>,
     /// Voxelization.
     #[command(flatten)]
     pub raster: RasterArgs,
-    /// Depth of the ray tree (the eye ray counts as 1).
-    #[arg(long, value_name = "D", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=64))]
+    /// Depth of the ray tree, 1 to 64 (the eye ray counts as 1).
+    #[arg(long, value_name = "D", default_value_t = 3, value_parser = parse_depth, allow_hyphen_values = true)]
     pub depth: u32,
-    /// K×K rays per pixel, box-filtered.
+    /// K×K rays per pixel, box-filtered, K from 1 to 16 (and at most
+    /// 2^32 rays in all).
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = parse_positive, allow_hyphen_values = true)]
     pub supersample: u32,
-    /// Threads for the light pass and the render (0: one per core).
-    #[arg(long, value_name = "T", default_value_t = 0)]
+    /// Threads for the light pass and the render, 0 (one per core) to
+    /// 1024.
+    #[arg(long, value_name = "T", default_value_t = 0, value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: usize,
     /// Walk primary rays in 8-ray packets (4×2 pixel blocks) instead of
     /// one by one with empty-space skipping; the image is the same.
@@ -79,21 +86,33 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             linear: args.linear,
         },
     )?;
+    // The view with the overrides, the image size and the camera, checked
+    // before voxelizing and again for the render.
+    let camera_of = |scene_view: &crate::scene::View| -> Result<(Camera, u32, u32), CliError> {
+        let view = args.view.apply(scene_view);
+        let [rw, rh] = view.resolution;
+        let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
+        check_sizes(w, h, args.supersample)?;
+        Ok((Camera::new(&view, w, h)?, w, h))
+    };
     let loaded = load_or_build(
         args.scene.as_ref(),
         &args.raster,
         Purpose::Render,
+        &ImageNeed {
+            view: &args.view,
+            width: args.width,
+            height: args.height,
+            samples: args.supersample,
+        },
         args.threads,
         !args.quiet,
+        &|v| camera_of(v).map(|_| ()),
     )?;
     let scene = match &loaded {
         Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
     };
-    let view = args.view.apply(&scene.view);
-    let [rw, rh] = view.resolution;
-    let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
-    check_sizes(w, h, args.supersample)?;
-    let camera = Camera::new(&view, w, h)?;
+    let (camera, w, h) = camera_of(&scene.view)?;
     let tracer = Tracer::new(
         scene,
         TraceOptions {

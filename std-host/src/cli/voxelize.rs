@@ -4,7 +4,9 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
-use super::common::{Loaded, Purpose, RasterArgs, load_or_build, progress, secs};
+use super::common::{
+    ImageNeed, Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, parse_threads, progress, secs,
+};
 use crate::fit::Bytes;
 use crate::output::atomic::AtomicFile;
 use crate::output::rasterfile;
@@ -15,14 +17,14 @@ use crate::progress::Unit;
 pub struct VoxelizeArgs {
     /// An NFF or TOML scene [default: the built-in 91-sphereflake].
     pub scene: Option<PathBuf>,
-    /// The raster file to write.
+    /// The raster file to write; its name ends in .rrt.
     #[arg(short, long, value_name = "FILE.rrt")]
     pub output: PathBuf,
     /// Voxelization.
     #[command(flatten)]
     pub raster: RasterArgs,
-    /// Threads for the light pass (0: one per core).
-    #[arg(long, value_name = "T", default_value_t = 0)]
+    /// Threads for the light pass, 0 (one per core) to 1024.
+    #[arg(long, value_name = "T", default_value_t = 0, value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: usize,
     /// No progress bar and no summary line.
     #[arg(long, short)]
@@ -41,8 +43,28 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         return Err(CliError::Arg {
             arg: "SCENE",
             message: format!(
-                "{} is already a saved raster; give an NFF scene",
+                "{} is already a saved raster; give an NFF or TOML scene",
                 p.display()
+            ),
+        });
+    }
+    // A raster goes to a file named as one: not to standard output (`-`,
+    // which render reads as an image), nor over a scene or an image.
+    let is_rrt = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("rrt"));
+    if !is_rrt {
+        return Err(CliError::Arg {
+            arg: "--output",
+            message: format!(
+                "{}: a saved raster is written to a file whose name ends in .rrt{}",
+                args.output.display(),
+                if args.output.as_os_str() == "-" {
+                    " (not to standard output)"
+                } else {
+                    ""
+                }
             ),
         });
     }
@@ -53,12 +75,28 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         path: args.output.clone(),
         source,
     })?;
+    // A saved raster is rendered from any view: its default size is fitted
+    // to the scene's own view and resolution.
+    let view = ViewArgs {
+        from: None,
+        at: None,
+        up: None,
+        angle: None,
+    };
+    let image = ImageNeed {
+        view: &view,
+        width: None,
+        height: None,
+        samples: 1,
+    };
     let loaded = load_or_build(
         args.scene.as_ref(),
         &args.raster,
         Purpose::Save,
+        &image,
         args.threads,
         !args.quiet,
+        &|_| Ok(()),
     );
     let Loaded::Built {
         scene,
@@ -68,7 +106,7 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
     else {
         return Err(CliError::Arg {
             arg: "SCENE",
-            message: "expected an NFF scene".into(),
+            message: "expected an NFF or TOML scene".into(),
         });
     };
     let t = std::time::Instant::now();

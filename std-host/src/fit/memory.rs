@@ -97,6 +97,71 @@ impl fmt::Display for MemoryEstimate {
     }
 }
 
+/// The surface primitives' extent, in world units: what bounds the
+/// surface voxels of a raster of any voxel size
+/// ([`SurfaceMeasure::voxels`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfaceMeasure {
+    /// Total surface area (world units²).
+    pub area: f64,
+    /// Total length of boundary edges and rims (world units).
+    pub perimeter: f64,
+    /// Surface primitives (spheres, cones, polygon triangles, tori).
+    pub objects: usize,
+}
+
+impl SurfaceMeasure {
+    /// The measure of `scene`'s spheres, cones, polygons (as their fan
+    /// triangles) and tori; volumes, `.vox` models and CSG trees are not
+    /// counted.
+    #[must_use]
+    pub fn of(scene: &Scene) -> Self {
+        let mut m = Self::default();
+        let mut add = |area: f64, perimeter: f64| {
+            m.area += area;
+            m.perimeter += perimeter;
+            m.objects += 1;
+        };
+        for sp in &scene.spheres {
+            let r = sp.shape.radius;
+            add(4.0 * PI * r * r, 0.0);
+        }
+        for c in &scene.cones {
+            let slant = (c.shape.apex - c.shape.base)
+                .length()
+                .hypot(c.shape.apex_radius - c.shape.base_radius);
+            let area = PI * (c.shape.base_radius + c.shape.apex_radius) * slant;
+            add(area, 2.0 * PI * (c.shape.base_radius + c.shape.apex_radius));
+        }
+        for p in &scene.polygons {
+            let v = scene.polygon_vertices(p);
+            let Some(&v0) = v.first() else { continue };
+            for w in v.windows(2).skip(1) {
+                let area = 0.5 * (w[0] - v0).cross(w[1] - v0).length();
+                let perimeter =
+                    (w[0] - v0).length() + (w[1] - w[0]).length() + (v0 - w[1]).length();
+                add(area, perimeter);
+            }
+        }
+        for t in &scene.tori {
+            let (big, small) = (t.shape.major, t.shape.minor);
+            add(4.0 * PI * PI * big * small, 0.0);
+        }
+        m
+    }
+
+    /// An upper bound on the surface voxels these primitives generate with
+    /// voxels of edge `voxel` in the thickest (26-tunnel-free)
+    /// voxelization: `1.8·(A + P + 3)` per primitive, `A` its area and `P`
+    /// its perimeter in voxel units (the `P` and constant terms covering
+    /// edges and tiny objects).
+    #[must_use]
+    pub fn voxels(&self, voxel: f64) -> f64 {
+        SURFACE_VOXELS_PER_AREA
+            * (self.area / (voxel * voxel) + self.perimeter / voxel + 3.0 * self.objects as f64)
+    }
+}
+
 /// Upper-bound memory estimate for `scene` voxelized into `frame`,
 /// computed from the world geometry without allocating.
 ///
@@ -113,37 +178,12 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
     let [nx, ny, nz] = frame.dims().map(u64::from);
     let voxels = nx.saturating_mul(ny).saturating_mul(nz);
     let s = frame.voxel_size;
-    let surface = |area: f64, perimeter: f64| {
-        SURFACE_VOXELS_PER_AREA * (area / (s * s) + perimeter / s + 3.0)
-    };
-    let mut count = 0.0;
-    for sp in &scene.spheres {
-        let r = sp.shape.radius;
-        count += surface(4.0 * PI * r * r, 0.0);
-        if solid_spheres {
-            let rv = r / s + 1.0;
+    let mut count = SurfaceMeasure::of(scene).voxels(s);
+    if solid_spheres {
+        for sp in &scene.spheres {
+            let rv = sp.shape.radius / s + 1.0;
             count += 4.0 / 3.0 * PI * rv * rv * rv;
         }
-    }
-    for c in &scene.cones {
-        let slant = (c.shape.apex - c.shape.base)
-            .length()
-            .hypot(c.shape.apex_radius - c.shape.base_radius);
-        let area = PI * (c.shape.base_radius + c.shape.apex_radius) * slant;
-        count += surface(area, 2.0 * PI * (c.shape.base_radius + c.shape.apex_radius));
-    }
-    for p in &scene.polygons {
-        let v = scene.polygon_vertices(p);
-        let Some(&v0) = v.first() else { continue };
-        for w in v.windows(2).skip(1) {
-            let area = 0.5 * (w[0] - v0).cross(w[1] - v0).length();
-            let perimeter = (w[0] - v0).length() + (w[1] - w[0]).length() + (v0 - w[1]).length();
-            count += surface(area, perimeter);
-        }
-    }
-    for t in &scene.tori {
-        let (big, small) = (t.shape.major, t.shape.minor);
-        count += surface(4.0 * PI * PI * big * small, 0.0);
     }
     let record_voxels = if count.is_finite() && count < voxels as f64 {
         count.ceil() as u64

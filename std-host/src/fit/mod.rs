@@ -37,8 +37,9 @@ use rrt_core::object_table as table;
 use rrt_core::raster::MAX_AXIS;
 
 pub use self::meminfo::{default_max_memory, parse_meminfo, total_memory};
-pub use self::memory::{Bytes, Dims, MemoryEstimate, estimate_memory};
+pub use self::memory::{Bytes, Dims, MemoryEstimate, SurfaceMeasure, estimate_memory};
 pub use self::size::{DEFAULT_MARGIN, frame};
+pub use self::size::{MAX_DEFAULT_RASTER, MIN_DEFAULT_RASTER, RasterNeed, default_raster};
 
 use crate::frame::{MAX_FIXED_VOXEL_BITS, RasterFrame};
 use crate::scene::{Object, Scene, SourceLoc};

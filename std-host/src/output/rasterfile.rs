@@ -15,7 +15,9 @@
 //! 16+24n     4  crc32 of the bytes before it
 //! 20+24n     4  zero, then zeros up to H
 //!      H        sections, in table order, each starting at a multiple of 64
-//!               (H = 192 for version 1, 256 for version 2)
+//!               (H = 192 for version 1, 256 for version 2), zeros between
+//!               them; the file ends with the last section padded with
+//!               zeros to a multiple of 64
 //! ```
 //!
 //! The paper's raster (one object per voxel) is written as version 1,
@@ -30,7 +32,7 @@
 //! | 2 | plane | one cell per voxel, x fastest ([`rrt_core::raster`]) |
 //! | 3 | directory | brick directory, `bricks + 1` × u32 ([`rrt_core::store`]) |
 //! | 4 | records | the 20-byte [`VoxelRecord`]s, field by field as in [`rrt_core::voxel`] |
-//! | 5 | objects | per object 168 bytes: kind u32 (1 sphere, 2 cone, 3 triangle, 4 triangle with vertex normals, 5 voxels only: volume, `.vox` or CSG, all slots 0, 6 torus), material u32, 20 × f64, the shape's saved form ([`crate::shape`]): sphere centre, radius; cone base, base radius, apex, apex radius; triangle v0 v1 v2, then n0 n1 n2; torus centre, axis, major, minor; unused slots 0 |
+//! | 5 | objects | per object 168 bytes: kind u32 (1 sphere, 2 cone, 3 triangle, 4 triangle with vertex normals, 5 voxels only: volume, `.vox` or CSG, slot 0 is 1 where the stored normals are interpolated (volumes, CSG) and 0 otherwise, the other slots 0, 6 torus), material u32, 20 × f64, the shape's saved form ([`crate::shape`]): sphere centre, radius; cone base, base radius, apex, apex radius; triangle v0 v1 v2, then n0 n1 n2; torus centre, axis, major, minor; unused slots 0 |
 //! | 6 | materials | per material 8 × f64: colour r g b, Kd, Ks, Shine, T, index of refraction |
 //! | 7 | lights | per light 6 × f64: position, colour |
 //! | 8 | lists | version 2 only: the store's object-list array, u32 each ([`rrt_core::store`], *Object lists*) |
@@ -40,8 +42,9 @@
 //! # Loading
 //! [`load`] refuses, with the file's name and what is wrong: a file that is
 //! not a raster, another version, a header or section whose checksum does
-//! not match (corrupt), a section that ends past the end of the file
-//! (truncated) or whose length disagrees with the counts, and contents
+//! not match (corrupt), a section that ends past the end of the file or a
+//! file shorter than its last section's padding (truncated), bytes after
+//! that padding, a section whose length disagrees with the counts, and contents
 //! that break an invariant (dimensions, the record store's directory and
 //! sort order, object and material indices, non-finite numbers). Sizes are
 //! checked against the file's length before anything is allocated.
@@ -84,6 +87,8 @@ const HEADER_LEN: u64 = 192;
 /// The header of a version 2 file.
 const HEADER2_LEN: u64 = 256;
 const META_LEN: u64 = 192;
+/// Every section starts at a multiple of this, and the file ends at one.
+const SECTION_ALIGN: u64 = 64;
 /// Kind, material and the shape's saved numbers.
 const OBJECT_LEN: u64 = 8 + 8 * SLOTS as u64;
 const MATERIAL_LEN: u64 = 64;
@@ -391,10 +396,15 @@ pub fn save_to(
     let (sections, header_len) = layout(version);
     w.write_all(&vec![0u8; header_len as usize])
         .map_err(io("cannot write"))?;
+    // Every section's bytes, as the writer below counts them.
     progress.set_length(
-        scene.plane.len() as u64
+        META_LEN
+            + scene.plane.len() as u64
             + scene.directory.len() as u64 * DIRECTORY_ENTRY_LEN
             + scene.records.len() as u64 * RECORD_LEN
+            + scene.objects.len() as u64 * OBJECT_LEN
+            + scene.materials.len() as u64 * MATERIAL_LEN
+            + scene.lights.len() as u64 * LIGHT_LEN
             + scene.lists.len() as u64 * 4,
     );
     progress.set_position(0);
@@ -445,7 +455,7 @@ pub fn save_to(
         let (len, crc) = (c.len, c.crc.finalize());
         table.push((kind, crc, offset, len));
         offset += len;
-        let pad = offset.next_multiple_of(64) - offset;
+        let pad = offset.next_multiple_of(SECTION_ALIGN) - offset;
         w.write_all(&vec![0u8; pad as usize])
             .map_err(io("cannot write"))?;
         offset += pad;
@@ -607,6 +617,28 @@ fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> 
         end = stop;
         *s = (crc, off, len);
     }
+    // The writer pads the last section to a multiple of 64 like every
+    // other: a shorter file lost bytes (of padding only, perhaps, but it
+    // is not the file that was written), a longer one has something after
+    // the raster.
+    let written = end.next_multiple_of(SECTION_ALIGN);
+    if file_len < written {
+        return Err(RasterFileError::Truncated {
+            path: p(),
+            what: format!(
+                "the file has {file_len} bytes, its sections and padding end at byte {written}"
+            ),
+        });
+    }
+    if file_len > written {
+        return Err(RasterFileError::Invalid {
+            path: p(),
+            what: format!(
+                "{} bytes after the end of the raster (byte {written})",
+                file_len - written
+            ),
+        });
+    }
     Ok(Header {
         version,
         file_len,
@@ -628,13 +660,14 @@ fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
 }
 
 /// Reads section `k` into `buf` (whose length is the section's) and checks
-/// its checksum.
+/// its checksum; `progress` counts the bytes read.
 fn read_section(
     file: &mut File,
     path: &Path,
     h: &Header,
     k: usize,
     buf: &mut [u8],
+    progress: &ProgressBar,
 ) -> Result<(), RasterFileError> {
     let (crc, off, _) = h.sections[k];
     let io = |source| RasterFileError::Io {
@@ -643,8 +676,14 @@ fn read_section(
         source,
     };
     file.seek(SeekFrom::Start(off)).map_err(io)?;
-    file.read_exact(buf).map_err(io)?;
-    if crc32fast::hash(buf) != crc {
+    // In pieces, so that the bar moves while a large plane is read.
+    let mut hasher = crc32fast::Hasher::new();
+    for piece in buf.chunks_mut(1 << 22) {
+        file.read_exact(piece).map_err(io)?;
+        hasher.update(piece);
+        progress.inc(piece.len() as u64);
+    }
+    if hasher.finalize() != crc {
         return Err(RasterFileError::Checksum {
             path: path.to_path_buf(),
             section: NAMES[k],
@@ -679,7 +718,7 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
         )));
     }
     let mut b = vec![0u8; META_LEN as usize];
-    read_section(file, path, h, 0, &mut b)?;
+    read_section(file, path, h, 0, &mut b, &ProgressBar::hidden())?;
     let mut c = Cursor::new(&b);
     let dims = [c.u32(), c.u32(), c.u32()];
     let separation = match c.u8() {
@@ -861,6 +900,15 @@ pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError
 /// # Errors
 /// [`RasterFileError`] naming the file and what is wrong.
 pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
+    load_with(path, &ProgressBar::hidden())
+}
+
+/// [`load`], counting the bytes read on `progress` (its length is set to
+/// the file's).
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, RasterFileError> {
     let invalid = |what: String| RasterFileError::Invalid {
         path: path.to_path_buf(),
         what,
@@ -868,6 +916,8 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     let mut file = open(path)?;
     let h = read_header(&mut file, path)?;
     let m = read_meta(&mut file, path, &h)?;
+    progress.set_length(h.file_len);
+    progress.set_position(0);
     let extent =
         Extent::new(m.dims[0], m.dims[1], m.dims[2]).map_err(|e| invalid(e.to_string()))?;
     let expect = |k: usize, len: u64| -> Result<usize, RasterFileError> {
@@ -897,7 +947,7 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     let lists_len = expect(7, lists_bytes)?;
     let section = |file: &mut File, k: usize, len: usize| -> Result<Vec<u8>, RasterFileError> {
         let mut b = vec![0u8; len];
-        read_section(file, path, &h, k, &mut b)?;
+        read_section(file, path, &h, k, &mut b, progress)?;
         Ok(b)
     };
 
@@ -906,9 +956,9 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
         what: "cannot allocate the raster plane",
         source,
     })?;
-    read_section(&mut file, path, &h, 1, &mut plane)?;
+    read_section(&mut file, path, &h, 1, &mut plane, progress)?;
     let directory = directory_from(&section(&mut file, 2, dir_len)?);
-    let records = read_records(&mut file, path, &h, rec_len)?;
+    let records = read_records(&mut file, path, &h, rec_len, progress)?;
     let materials = materials_from(&section(&mut file, 5, mat_len)?).map_err(invalid)?;
     let objects =
         objects_from(&section(&mut file, 4, obj_len)?, materials.len()).map_err(invalid)?;
@@ -1032,6 +1082,7 @@ fn read_records(
     path: &Path,
     h: &Header,
     len: usize,
+    progress: &ProgressBar,
 ) -> Result<Vec<VoxelRecord>, RasterFileError> {
     let (crc, off, _) = h.sections[3];
     let io = |source| RasterFileError::Io {
@@ -1055,6 +1106,7 @@ fn read_records(
                 .map(record_from),
         );
         left -= take;
+        progress.inc(take as u64);
     }
     if hasher.finalize() != crc {
         return Err(RasterFileError::Checksum {

@@ -264,6 +264,18 @@ impl Scene {
     /// empty file, binary data, and every syntax or range error of the
     /// format (and of the files a TOML scene refers to).
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self, SceneError> {
+        Self::load_with(path, &indicatif::ProgressBar::hidden())
+    }
+
+    /// [`Scene::load`], counting an NFF file's bytes parsed on `progress`
+    /// (a TOML scene is parsed in one step: nothing is counted).
+    ///
+    /// # Errors
+    /// As [`Scene::load`].
+    pub fn load_with(
+        path: impl AsRef<std::path::Path>,
+        progress: &indicatif::ProgressBar,
+    ) -> Result<Self, SceneError> {
         let path = path.as_ref();
         if path
             .extension()
@@ -271,7 +283,7 @@ impl Scene {
         {
             toml::load(path, &toml::Options::default())
         } else {
-            nff::load(path, &ParseOptions::default())
+            nff::load_with(path, &ParseOptions::default(), progress)
         }
     }
 

@@ -60,6 +60,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::DVec3;
+use indicatif::ProgressBar;
 
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
@@ -102,6 +103,19 @@ impl Default for ParseOptions {
 /// [`SceneError::Io`] (missing, unreadable), [`SceneError::IsDirectory`],
 /// [`SceneError::FileTooLarge`], and everything [`parse_bytes`] refuses.
 pub fn load(path: &Path, opts: &ParseOptions) -> Result<Scene, SceneError> {
+    load_with(path, opts, &ProgressBar::hidden())
+}
+
+/// [`load`], counting the bytes parsed on `progress` (its length is set to
+/// the file's).
+///
+/// # Errors
+/// As [`load`].
+pub fn load_with(
+    path: &Path,
+    opts: &ParseOptions,
+    progress: &ProgressBar,
+) -> Result<Scene, SceneError> {
     let io = |source| SceneError::Io {
         path: path.to_owned(),
         source,
@@ -128,7 +142,8 @@ pub fn load(path: &Path, opts: &ParseOptions) -> Result<Scene, SceneError> {
         .take(opts.max_file_bytes.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(io)?;
-    parse_in(name, &bytes, opts)
+    progress.set_length(bytes.len() as u64);
+    parse_in(name, &bytes, opts, Some(progress))
 }
 
 /// Parses NFF held in memory; `file` names it in messages. This is the
@@ -140,10 +155,15 @@ pub fn load(path: &Path, opts: &ParseOptions) -> Result<Scene, SceneError> {
 /// invalid UTF-8), [`SceneError::Empty`], and every error of the format
 /// (see the module docs).
 pub fn parse_bytes(file: &str, bytes: &[u8], opts: &ParseOptions) -> Result<Scene, SceneError> {
-    parse_in(Arc::from(file), bytes, opts)
+    parse_in(Arc::from(file), bytes, opts, None)
 }
 
-fn parse_in(file: Arc<str>, bytes: &[u8], opts: &ParseOptions) -> Result<Scene, SceneError> {
+fn parse_in(
+    file: Arc<str>,
+    bytes: &[u8],
+    opts: &ParseOptions,
+    progress: Option<&ProgressBar>,
+) -> Result<Scene, SceneError> {
     let size = u64::try_from(bytes.len()).unwrap_or(u64::MAX);
     if size > opts.max_file_bytes {
         return Err(SceneError::FileTooLarge {
@@ -167,7 +187,9 @@ fn parse_in(file: Arc<str>, bytes: &[u8], opts: &ParseOptions) -> Result<Scene, 
             });
         }
     };
-    Parser::new(file, text, opts).parse()
+    let mut parser = Parser::new(file, text, opts);
+    parser.progress = progress.filter(|p| !p.is_hidden());
+    parser.parse()
 }
 
 /// The location of byte `at`, whose prefix is valid UTF-8 up to the last
@@ -208,6 +230,8 @@ struct Parser<'a> {
     background: Option<(DVec3, u32)>,
     material: Option<usize>,
     scene: Builder,
+    /// Counts the bytes parsed (every few thousand lines).
+    progress: Option<&'a ProgressBar>,
 }
 
 #[derive(Default)]
@@ -242,6 +266,7 @@ impl<'a> Parser<'a> {
             background: None,
             material: None,
             scene: Builder::default(),
+            progress: None,
         }
     }
 
@@ -260,6 +285,11 @@ impl<'a> Parser<'a> {
             };
             self.next += len;
             self.consumed = self.consumed.saturating_add(1);
+            if self.consumed.is_multiple_of(4096)
+                && let Some(p) = self.progress
+            {
+                p.set_position(self.next as u64);
+            }
             let content = raw.find('#').map_or(raw, |h| &raw[..h]);
             if content.bytes().any(|b| !b.is_ascii_whitespace()) {
                 self.line_no = u32::try_from(self.consumed).unwrap_or(u32::MAX);

@@ -176,9 +176,15 @@ pub enum Shape {
     Torus(Torus),
     /// No continuous definition: the voxels are the object (volumes,
     /// `.vox` models, CSG results). It has no exact intersection, so
-    /// intersection verification keeps the discrete hit with the stored
-    /// normal.
-    Voxels,
+    /// intersection verification keeps the discrete hit, shaded with the
+    /// stored normals: interpolated between the neighbouring voxels of the
+    /// object where `smooth` (volumes and CSG results, whose voxels sample
+    /// a smooth surface), the hit voxel's own otherwise (`.vox` models,
+    /// blocky by design).
+    Voxels {
+        /// Whether the stored normals are interpolated at the hit point.
+        smooth: bool,
+    },
 }
 
 /// Each surface primitive is a [`Shape`].
@@ -203,7 +209,7 @@ macro_rules! each_surface {
             Shape::Cone($s) => $body,
             Shape::Triangle($s) => $body,
             Shape::Torus($s) => $body,
-            Shape::Voxels => $voxels,
+            Shape::Voxels { .. } => $voxels,
         }
     };
 }
@@ -230,7 +236,23 @@ impl Shape {
     /// but [`Shape::Voxels`]).
     #[must_use]
     pub const fn is_exact(&self) -> bool {
-        !matches!(self, Self::Voxels)
+        !matches!(self, Self::Voxels { .. })
+    }
+
+    /// Whether a ray leaving a point of this shape's surface, towards the
+    /// side its normal there faces, can meet the shape again: `front` says
+    /// that side is the one the shape's own normal points to (the outside
+    /// of a closed shape). A flat triangle (whose normal is its plane's)
+    /// never meets its plane again, a sphere left from outside never meets
+    /// itself again (it is convex); everything else may, a triangle with
+    /// interpolated normals too (its shading normal is not its plane's).
+    #[must_use]
+    pub const fn meets_itself_leaving(&self, front: bool) -> bool {
+        match self {
+            Self::Triangle(t) => t.normals.is_some(),
+            Self::Sphere(_) => !front,
+            Self::Cone(_) | Self::Torus(_) | Self::Voxels { .. } => true,
+        }
     }
 
     /// Checks the world-space invariants of its primitive.
@@ -246,6 +268,9 @@ impl Shape {
     pub fn save(&self) -> (u32, Slots) {
         let mut slots = [0.0; SLOTS];
         let kind = each_surface!(self, s => s.save(&mut slots), voxels => VOXELS_KIND);
+        if let Self::Voxels { smooth: true } = self {
+            slots[0] = 1.0;
+        }
         (kind, slots)
     }
 
@@ -253,7 +278,9 @@ impl Shape {
     #[must_use]
     pub fn load(kind: u32, slots: &Slots) -> Option<Self> {
         if kind == VOXELS_KIND {
-            return Some(Self::Voxels);
+            return Some(Self::Voxels {
+                smooth: slots[0] != 0.0,
+            });
         }
         Sphere::load(kind, slots)
             .map(Self::Sphere)

@@ -13,24 +13,27 @@
 //!        +  Ks·reflected  +  T·refracted
 //! ```
 //!
-//! as `embree_nff` shades (see [`shading`]): `N` the stored normal
-//! turned towards the viewer (two-sided shading), `R` the reflection of the
-//! light direction `L`, `V` towards the eye. Shadow rays are fired at render
-//! time only for lights whose bits say *translucent*; `att` multiplies the
-//! transmittance `T` of each translucent object the shadow ray passes
-//! (each object once). With [`TraceOptions::exact_shadows`] (and
-//! verification), every verified hit fires a shadow ray to each light it
-//! faces; it walks adaptively with empty-space skipping (exact: every
-//! opaque voxel the segment's line passes through is visited) and counts
-//! only objects of those voxels' lists that the continuous segment really
-//! intersects (voxels of objects without exact geometry count as they
-//! are): exact shadow edges, at the cost of those rays. The reflected ray
-//! (when `Ks > 0`) and the refracted ray (when `T > 0`: Snell's law with
-//! the material's index of refraction,
-//! total internal reflection falling back to the mirror direction) are
-//! spawned from the stored normal and traced recursively to
-//! [`TraceOptions::depth`] (the eye ray is depth 1). A ray that leaves the
-//! raster takes the background colour.
+//! as `embree_nff` shades (see [`shading`]): `N` the normal (stored, or
+//! true under verification) turned towards the viewer (two-sided
+//! shading), `R` the reflection of the light direction `L`, `V` towards
+//! the eye. In the paper's and the verified [`Mode`], lights are decided by
+//! the precomputed bits, and shadow rays are fired at render time only for
+//! lights whose bits say *translucent* (`att` multiplies the transmittance
+//! `T` of each translucent object the shadow ray passes, each object
+//! once). In the exact mode every light a verified hit faces is decided
+//! exactly: where the voxel holding the shadow ray's start is proven lit by
+//! the shadow classification ([`rrt_core::light`], *Shadow
+//! classification*), only the voxel's own objects are intersected;
+//! otherwise an exact shadow ray walks adaptively with empty-space skipping
+//! (exact: every opaque voxel the segment's line passes through is
+//! visited) and counts only objects of those voxels' lists that the
+//! continuous segment really intersects (voxels of objects without exact
+//! geometry count as they are). The reflected ray (when `Ks > 0`) and the
+//! refracted ray (when `T > 0`: Snell's law with the material's index of
+//! refraction, total internal reflection falling back to the mirror
+//! direction) are traced recursively to [`TraceOptions::depth`] (the eye
+//! ray is depth 1). A ray that leaves the raster takes the background
+//! colour.
 //!
 //! `illum` holds the lit side the stored normal faces. When the other
 //! side of an open surface (a polygon, an open cone) is seen, or the inside
@@ -38,7 +41,7 @@
 //! whose bits say that side sees them are computed here instead.
 //!
 //! # Intersection verification
-//! With [`TraceOptions::verify`], on a raster voxelized for it
+//! In the exact and the verified [`Mode`], on a raster voxelized for it
 //! ([`BuildOptions::exact`](crate::voxelize::BuildOptions::exact): every
 //! exact object owns every voxel whose closed cube its surface meets, and a
 //! voxel several objects share lists all of them), the walk stops at every
@@ -64,24 +67,24 @@
 //! *false hits* ([`RayStats::false_hits`]).
 //!
 //! # No acne
-//! A secondary ray starts on the surface it leaves: at the point where the
-//! incoming ray entered the hit voxel, or at the true intersection under
-//! verification. In the paper's raw mode the surface's voxel layer is up
-//! to two voxels thick there, so the ray would hit its own surface at once.
-//! The tracer applies the light pass's rule ([`LeavingSurface`], see
-//! [`rrt_core::light`]): a voxel met by a ray leaving voxel `c₀` towards
-//! the side of unit normal `N₀` is ignored when its centre lies at most two
-//! voxels above `c₀`'s tangent plane (`(c − c₀)·N₀ ≤ 2`) *and* its owner is
-//! the same object or its surface is oriented within 60° of this one. `N₀`
-//! is the side the ray goes to: the viewer's side for reflections and the
-//! render-time shadow rays, the other side for a refracted ray entering
-//! the object. Concave objects still reflect and shadow themselves beyond
-//! the two-voxel slab (the far side of a torus hole, a teapot's body seen
-//! in its spout); a refracted ray still meets the far wall of a sphere.
-//! Under verification no voxel is ignored for exact objects: an exact
-//! intersection counts when `t` is above a thousandth of a voxel, so the
-//! surface point itself is never its own next hit, and the rule is kept
-//! only for objects without exact geometry.
+//! A ray leaving a verified hit starts [`surface_offset`] off the surface,
+//! towards the side it goes to, and counts every exact intersection after
+//! its start, as `embree_nff`'s rays do; shadow rays end twice that short
+//! of the light. A flat triangle or a sphere left from outside is not
+//! tested against its own rays ([`crate::shape::Shape::meets_itself_leaving`]).
+//! A ray leaving a discrete hit (the paper's mode, objects without exact
+//! geometry) starts at the point where the incoming ray entered the hit
+//! voxel; there the surface's voxel layer is up to two voxels thick, so the
+//! ray would hit its own surface at once. The tracer applies the light
+//! pass's rule ([`LeavingSurface`], see [`rrt_core::light`]): a voxel met
+//! by a ray leaving voxel `c₀` towards the side of unit normal `N₀` is
+//! ignored when its centre lies at most two voxels above `c₀`'s tangent
+//! plane (`(c − c₀)·N₀ ≤ 2`) *and* its owner is the same object or its
+//! surface is oriented within 60° of this one. `N₀` is the side the ray
+//! goes to: the viewer's side for reflections and the render-time shadow
+//! rays, the other side for a refracted ray entering the object. Concave
+//! objects still reflect and shadow themselves beyond the two-voxel slab
+//! in that mode.
 //!
 //! # Packets
 //! [`Tracer::trace_block`] traces eight primary rays (a 4×2 pixel block)
@@ -293,6 +296,10 @@ struct SurfaceHit {
     /// Unit normal (stored, or true under verification), not turned.
     normal: DVec3,
     verified: bool,
+    /// The normal is interpolated between voxels (an object without exact
+    /// geometry): the precomputed illumination, which is the hit voxel's,
+    /// is not used.
+    smoothed: bool,
 }
 
 /// What a ray hits ([`Tracer::hit`]).

@@ -63,7 +63,7 @@ impl Tracer<'_> {
         let i = self.intensity;
         // The precomputed illumination is the stored normal's side, at the
         // voxel centre: used as it is for the basic algorithm on that side.
-        let use_illum = front && !h.verified;
+        let use_illum = front && !h.verified && !h.smoothed;
         let mut local = if use_illum {
             rgb(h.rec.illum)
         } else {
@@ -233,7 +233,8 @@ impl Tracer<'_> {
         if let Some(own) = self.classified_lit(origin, k) {
             stats.classified += 1;
             let mut att = 1.0;
-            for &id in own {
+            let skip = (!self.meets_itself(h, n)).then_some(h.object);
+            for &id in own.iter().filter(|&&id| Some(id) != skip) {
                 let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) else {
                     continue;
                 };
@@ -285,6 +286,15 @@ impl Tracer<'_> {
             .then_some(own)
     }
 
+    /// Whether a ray leaving verified hit `h` towards the side `n` can
+    /// meet the hit object again ([`Shape::meets_itself_leaving`](crate::shape::Shape::meets_itself_leaving)).
+    fn meets_itself(&self, h: &SurfaceHit, n: DVec3) -> bool {
+        usize::try_from(h.object)
+            .ok()
+            .and_then(|i| self.objects.get(i))
+            .is_none_or(|o| o.shape.meets_itself_leaving(h.normal.dot(n) > 0.0))
+    }
+
     /// The transmittance `T` of material `m` (0: opaque).
     fn transmittance(&self, m: u16) -> f64 {
         self.materials
@@ -320,11 +330,17 @@ impl Tracer<'_> {
         };
         let rule = self.leaving(h, n);
         let store = self.store;
+        let extent = self.extent;
         let materials = self.materials;
         let objects = self.objects;
         let tmin = 0.0;
         let mut att = 1.0;
         let mut mail = Mailbox::default();
+        // The surface left, where it cannot meet the ray again, is tested
+        // already.
+        if !self.meets_itself(h, n) {
+            mail.tested(h.object);
+        }
         // Translucent objects already counted (each attenuates once).
         let mut seen: Vec<u32> = Vec::new();
         let mut missing = 0u64;
@@ -337,7 +353,7 @@ impl Tracer<'_> {
                     if c & cell::OPAQUE == 0 {
                         return false;
                     }
-                    let Some(b) = store.get(index) else {
+                    let Some(b) = extent.coord(index).and_then(|v| store.get_hinted(v, c)) else {
                         missing += 1;
                         return false;
                     };

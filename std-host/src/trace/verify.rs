@@ -9,6 +9,7 @@ use rrt_core::voxel::VoxelRecord;
 
 use super::{RayStats, SurfaceHit, Tracer};
 use crate::frame::RasterFrame;
+use crate::shape::Shape;
 use crate::voxelize::WorldObject;
 use crate::world::{Hit, Ray};
 
@@ -82,6 +83,34 @@ pub fn verify(
         None => Verdict::False,
     }
 }
+
+/// The 26 neighbours of a voxel, nearest first (6 faces, 12 edges, 8
+/// corners), each group in z, y, x order.
+const NEIGHBOURS_BY_DISTANCE: [[i32; 3]; 26] = {
+    let mut out = [[0i32; 3]; 26];
+    let mut n = 0;
+    let mut far = 1;
+    while far <= 3 {
+        let mut dz: i32 = -1;
+        while dz <= 1 {
+            let mut dy: i32 = -1;
+            while dy <= 1 {
+                let mut dx: i32 = -1;
+                while dx <= 1 {
+                    if dx.abs() + dy.abs() + dz.abs() == far {
+                        out[n] = [dx, dy, dz];
+                        n += 1;
+                    }
+                    dx += 1;
+                }
+                dy += 1;
+            }
+            dz += 1;
+        }
+        far += 1;
+    }
+    out
+};
 
 /// Objects one ray has already been tested against: its *mailbox*. A ray
 /// meets an object in many voxels; each exact object is intersected once
@@ -187,6 +216,7 @@ impl Tracer<'_> {
             point: ray.at(t),
             normal: decode(rec),
             verified: false,
+            smoothed: false,
         }
     }
 
@@ -251,53 +281,114 @@ impl Tracer<'_> {
     /// of the nearest neighbouring voxel it owns, else its material's),
     /// the true point and normal.
     pub(super) fn candidate_hit(&self, ray: &Ray, c: &Candidate) -> SurfaceHit {
+        let point = ray.at(c.t);
+        let smooth = !c.exact
+            && usize::try_from(c.object)
+                .ok()
+                .and_then(|i| self.objects.get(i))
+                .is_some_and(|o| matches!(o.shape, Shape::Voxels { smooth: true }));
+        let normal = smooth
+            .then(|| self.smooth_normal(c.object, point))
+            .flatten();
         SurfaceHit {
             voxel: c.voxel,
             rec: self.attributes_of(c.object, c.voxel, &c.rec),
             object: c.object,
             t: c.t,
-            point: ray.at(c.t),
-            normal: c.normal,
+            point,
+            normal: normal.unwrap_or(c.normal),
             verified: c.exact,
+            smoothed: normal.is_some(),
         }
     }
 
-    /// A record with object `id`'s attributes near voxel `v` (record
-    /// `rec`): see [`Tracer::candidate_hit`].
-    fn attributes_of(&self, id: u32, v: [u32; 3], rec: &VoxelRecord) -> VoxelRecord {
-        if self.store.owner(rec) == id {
-            return *rec;
-        }
-        let mut nearest: Option<(i32, VoxelRecord)> = None;
+    /// The stored normals of object `id` interpolated at world point `p`:
+    /// the object's voxels whose centres lie within 1.5 voxels of `p` on
+    /// every axis, weighted by the product over the axes of the quadratic
+    /// B-spline of the centre's offset (smooth, and zero at 1.5 voxels, so
+    /// the interpolant does not jump as `p` moves); `None` where no voxel
+    /// of the object is near, or the normals cancel. Volumes and CSG
+    /// results, which have no exact normal, are shaded with it instead of
+    /// one voxel's normal, so that their surfaces are not faceted.
+    pub(super) fn smooth_normal(&self, id: u32, p: DVec3) -> Option<DVec3> {
+        let q = self.frame.world_to_raster(p) - 0.5;
+        let near = q.round();
+        let dims = self.extent.dims();
+        // The quadratic B-spline with support (−1.5, 1.5).
+        let spline = |x: f64| {
+            let x = x.abs();
+            if x < 0.5 {
+                0.75 - x * x
+            } else if x < 1.5 {
+                0.5 * (1.5 - x) * (1.5 - x)
+            } else {
+                0.0
+            }
+        };
+        let mut sum = DVec3::ZERO;
         for dz in -1i32..=1 {
             for dy in -1i32..=1 {
                 for dx in -1i32..=1 {
-                    let (Some(x), Some(y), Some(z)) = (
-                        v[0].checked_add_signed(dx),
-                        v[1].checked_add_signed(dy),
-                        v[2].checked_add_signed(dz),
-                    ) else {
-                        continue;
-                    };
-                    let Some(index) = self.extent.index([x, y, z]) else {
-                        continue;
-                    };
-                    let c = self.raster.plane().get(index).copied().unwrap_or(0);
-                    if c & cell::OPAQUE == 0 {
+                    let c = near + DVec3::new(f64::from(dx), f64::from(dy), f64::from(dz));
+                    let mut v = [0u32; 3];
+                    let mut w = 1.0;
+                    for k in 0..3 {
+                        if !(c[k] >= 0.0 && c[k] < f64::from(dims[k])) {
+                            w = 0.0;
+                            break;
+                        }
+                        // In range: a whole number below the axis length.
+                        v[k] = c[k] as u32;
+                        w *= spline(q[k] - c[k]);
+                    }
+                    if w <= 0.0 {
                         continue;
                     }
-                    let far = dx.abs() + dy.abs() + dz.abs();
-                    if let Some(n) = self.store.get_hinted([x, y, z], c)
-                        && self.store.owner(n) == id
-                        && nearest.as_ref().is_none_or(|(d, _)| far < *d)
+                    let Some(index) = self.extent.index(v) else {
+                        continue;
+                    };
+                    let cell = self.raster.plane().get(index).copied().unwrap_or(0);
+                    if cell & cell::OPAQUE == 0 {
+                        continue;
+                    }
+                    if let Some(rec) = self.store.get_hinted(v, cell)
+                        && self.store.owner(rec) == id
                     {
-                        nearest = Some((far, *n));
+                        sum += decode(rec) * w;
                     }
                 }
             }
         }
-        if let Some((_, n)) = nearest {
-            return n;
+        sum.try_normalize()
+    }
+
+    /// A record with object `id`'s attributes near voxel `v` (record
+    /// `rec`): see [`Tracer::candidate_hit`]; of the neighbours it owns,
+    /// the nearest ([`NEIGHBOURS_BY_DISTANCE`]).
+    fn attributes_of(&self, id: u32, v: [u32; 3], rec: &VoxelRecord) -> VoxelRecord {
+        if self.store.owner(rec) == id {
+            return *rec;
+        }
+        for d in NEIGHBOURS_BY_DISTANCE {
+            let (Some(x), Some(y), Some(z)) = (
+                v[0].checked_add_signed(d[0]),
+                v[1].checked_add_signed(d[1]),
+                v[2].checked_add_signed(d[2]),
+            ) else {
+                continue;
+            };
+            let Some(index) = self.extent.index([x, y, z]) else {
+                continue;
+            };
+            let c = self.raster.plane().get(index).copied().unwrap_or(0);
+            if c & cell::OPAQUE == 0 {
+                continue;
+            }
+            if let Some(n) = self.store.get_hinted([x, y, z], c)
+                && self.store.owner(n) == id
+            {
+                return *n;
+            }
         }
         let mut r = *rec;
         if let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) {

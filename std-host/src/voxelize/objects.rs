@@ -69,7 +69,8 @@ impl TableObject<'_> {
     pub fn shape(&self) -> Shape {
         match self {
             Self::Primitive(o) => o.shape,
-            _ => Shape::Voxels,
+            Self::Vox(_) => Shape::Voxels { smooth: false },
+            Self::Volume(_) | Self::Csg(_) => Shape::Voxels { smooth: true },
         }
     }
 

@@ -58,6 +58,9 @@ mod firmware {
         let t = systick::ticks();
         let rays = core::hint::black_box(bench::setup(&raster, specs));
         println!("insns setup {} {}", systick::ticks() - t, rays);
+        let t = systick::ticks();
+        let voxels = core::hint::black_box(bench::dilated(&lined, specs));
+        println!("insns dilated {} {}", systick::ticks() - t, voxels);
         for mode in Connectivity::ALL {
             for (name, f) in [
                 (
@@ -113,6 +116,11 @@ mod firmware {
             };
             worst.note(name, b);
             let Ok(Some(r)) = r else { continue };
+            let mut a = r;
+            let (_, b) = stack_use(WINDOW, || {
+                a.walk_dilated(&lined, u32::MAX, traversal::dilated_test)
+            });
+            worst.note("DiscreteRay::walk_dilated", b);
             for mode in Connectivity::ALL {
                 let mut a = r;
                 let (_, b) = stack_use(WINDOW, || a.first_hit(&raster, mode));
@@ -164,7 +172,7 @@ mod firmware {
             let (_, b) = stack_use(WINDOW, f);
             worst.note(name, b);
         });
-        let built = scene::build_with(&mut st, &mut |name, f| {
+        let built = scene::build_with(&mut st, scene::Variant::Paper, &mut |name, f| {
             let (_, b) = stack_use(WINDOW, f);
             worst.note(name, b);
         });
@@ -175,6 +183,15 @@ mod firmware {
             scene::render(st.plane, st.lines, st.dir, records, image)
         });
         worst.note("scene::render: 64x64 pixels", b);
+        // The exact raster: its passes count under the same names, but for
+        // the light pass, whose shadow classification is its own entry.
+        let built = scene::build_with(&mut st, scene::Variant::Exact, &mut |name, f| {
+            let (_, b) = stack_use(WINDOW, f);
+            worst.note(name, b);
+        });
+        if built.is_err() {
+            exit(3)
+        }
         for (name, b) in worst.list.iter().flatten() {
             println!("stack {} {}", b, name);
         }
@@ -219,7 +236,10 @@ fn main() -> std::process::ExitCode {
         eprintln!("measure: {e}");
         return std::process::ExitCode::FAILURE;
     }
-    let Ok(raster) = traversal::extent().and_then(|e| Raster::new(e, &plane)) else {
+    let Ok((raster, lined)) = traversal::extent()
+        .and_then(|e| Raster::new(e, &plane))
+        .and_then(|r| Ok((r, r.with_lines(&lines)?)))
+    else {
         return std::process::ExitCode::FAILURE;
     };
     let mut st = rrt_on_target::scene_storage!();
@@ -245,6 +265,7 @@ fn main() -> std::process::ExitCode {
         ["camera_walk"] => bench::camera_walk(&shown, &cam),
         ["camera_packet"] => bench::camera_packet(&shown, &cam),
         ["setup"] => bench::setup(&raster, &specs),
+        ["dilated"] => bench::dilated(&lined, &specs),
         ["walk", m] if mode(m).is_some() => {
             bench::walk(&raster, &specs, mode(m).unwrap_or_default())
         }
@@ -253,7 +274,7 @@ fn main() -> std::process::ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: measure setup | walk MODE | packet MODE | camera_setup | camera_walk | camera_packet (MODE: six, twenty-six, adaptive)"
+                "usage: measure setup | walk MODE | packet MODE | dilated | camera_setup | camera_walk | camera_packet (MODE: six, twenty-six, adaptive)"
             );
             return std::process::ExitCode::FAILURE;
         }

@@ -1,14 +1,16 @@
 //! Flash of the traversal API with the scene builder: everything
 //! `size-traversal` links, plus every voxelizer (sphere, box, triangle,
 //! cone, torus, Bézier patch, volume block), CSG, the two-pass record
-//! store, the light pass and a record lookup at a hit.
+//! store (with or without object lists), the light pass (the paper's
+//! shadow rays and the shadow classification's tube walks) and a record
+//! lookup at a hit.
 #![no_std]
 #![no_main]
 
 use rrt_core::csg::{self, CsgNode, CsgTree, IgnoreLeaf, Solid};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::geometry::{BezierPatch, Cone, Cuboid, Sphere, Torus, Triangle};
-use rrt_core::light::{LightParams, illuminate};
+use rrt_core::light::{ExactRecords, LightParams, illuminate};
 use rrt_core::object_table::{Light, Lights, Material, Materials, Object, ObjectTable, Shape};
 use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{Counter, Limits, ObjectAttrs};
@@ -21,6 +23,7 @@ include!("size/common.rs");
 static mut PLANE: [u8; 16384] = [0; 16384];
 static mut DIR: [u32; 65] = [0; 65];
 static mut RECORDS: [VoxelRecord; 1024] = [bytemuck::zeroed(); 1024];
+static mut LISTS: [u32; 256] = [0; 256];
 static mut OBJECTS: [Object; 4] = [Object::UNUSED; 4];
 static mut SAMPLES: [u16; 64] = [0; 64];
 
@@ -96,11 +99,12 @@ fn drive() {
         return sink(1);
     };
     // SAFETY: the only references to these statics while `drive` runs.
-    let (plane, dir, records, objects) = unsafe {
+    let (plane, dir, records, lists, objects) = unsafe {
         (
             &mut *addr_of_mut!(PLANE),
             &mut *addr_of_mut!(DIR),
             &mut *addr_of_mut!(RECORDS),
+            &mut *addr_of_mut!(LISTS),
             &mut *addr_of_mut!(OBJECTS),
         )
     };
@@ -141,7 +145,13 @@ fn drive() {
         objects: 1,
         materials: 1,
     };
-    let Ok(mut filler) = sizing.fill(records, limits) else {
+    let exact = input::<1>(201)[0];
+    let filler = if exact & 1 == 0 {
+        sizing.fill(records, limits)
+    } else {
+        sizing.fill_with_lists(records, lists, limits)
+    };
+    let Ok(mut filler) = filler else {
         return sink(5);
     };
     let _ = filler.begin_object(ObjectAttrs {
@@ -173,15 +183,16 @@ fn drive() {
         color: [u32_at(12); 3],
         intensity: u32_at(16),
     });
+    let params = LightParams {
+        exact_records: match exact >> 1 & 3 {
+            0 => ExactRecords::Paper,
+            1 => ExactRecords::Classify,
+            _ => ExactRecords::Skip,
+        },
+        ..LightParams::default()
+    };
     let (r, mut store) = built.split();
-    if let Ok(rep) = illuminate(
-        &r,
-        &mut store,
-        &table,
-        &mats,
-        &lights,
-        &LightParams::default(),
-    ) {
+    if let Ok(rep) = illuminate(&r, &mut store, &table, &mats, &lights, &params) {
         sink(rep.visible);
     }
     let raster = built.raster();

@@ -135,12 +135,17 @@ impl Builder<'_> {
             self.entry.set(Some(("light", i)));
             let s = l.span();
             let d = l.get_ref();
+            let position = self.vec3(&s, "light.position", d.position)?;
+            let colour = d
+                .colour
+                .map(|c| self.vec3(&s, "light.colour", c))
+                .transpose()?;
+            if colour.is_some_and(|c| !c.cmpge(DVec3::ZERO).all()) {
+                return Err(self.err(s, "light.colour", "expected channels ≥ 0"));
+            }
             scene.lights.push(Light {
-                position: self.vec3(&s, "light.position", d.position)?,
-                colour: d
-                    .colour
-                    .map(|c| self.vec3(&s, "light.colour", c))
-                    .transpose()?,
+                position,
+                colour,
                 loc: self.loc(s),
             });
         }

@@ -19,19 +19,24 @@ impl Builder<'_> {
         s: &std::ops::Range<usize>,
         key: &str,
     ) -> Result<Cone, SceneError> {
-        let base = self.vec3(s, key, c.base)?;
-        let apex = self.vec3(s, key, c.apex)?;
-        let ok = base != apex
-            && c.base_radius.is_finite()
-            && c.apex_radius.is_finite()
-            && c.base_radius >= 0.0
-            && c.apex_radius >= 0.0
-            && c.base_radius + c.apex_radius > 0.0;
-        if !ok {
+        let base = self.vec3(s, &format!("{key}.base"), c.base)?;
+        let apex = self.vec3(s, &format!("{key}.apex"), c.apex)?;
+        if base == apex {
+            return Err(self.err(s.clone(), &format!("{key}.apex"), "equals the base"));
+        }
+        for (k, r) in [
+            ("base_radius", c.base_radius),
+            ("apex_radius", c.apex_radius),
+        ] {
+            if !(r.is_finite() && r >= 0.0) {
+                return Err(self.err(s.clone(), &format!("{key}.{k}"), "expected a number ≥ 0"));
+            }
+        }
+        if c.base_radius + c.apex_radius <= 0.0 {
             return Err(self.err(
                 s.clone(),
-                key,
-                "expected base ≠ apex and radii ≥ 0, not both 0",
+                &format!("{key}.base_radius"),
+                "expected base_radius or apex_radius > 0",
             ));
         }
         Ok(Cone {
@@ -48,13 +53,15 @@ impl Builder<'_> {
         s: &std::ops::Range<usize>,
         key: &str,
     ) -> Result<Torus, SceneError> {
-        let centre = self.vec3(s, key, t.centre)?;
+        let centre = self.vec3(s, &format!("{key}.centre"), t.centre)?;
         let axis = self
-            .vec3(s, key, t.axis)?
+            .vec3(s, &format!("{key}.axis"), t.axis)?
             .try_normalize()
             .ok_or_else(|| self.err(s.clone(), &format!("{key}.axis"), "zero axis"))?;
-        if !(t.major.is_finite() && t.minor.is_finite() && t.major > 0.0 && t.minor > 0.0) {
-            return Err(self.err(s.clone(), key, "expected major > 0 and minor > 0"));
+        for (k, r) in [("major", t.major), ("minor", t.minor)] {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(self.err(s.clone(), &format!("{key}.{k}"), "expected a number > 0"));
+            }
         }
         Ok(Torus {
             centre,
@@ -64,17 +71,18 @@ impl Builder<'_> {
         })
     }
 
+    /// The `[solid.NAME]` a tree's leaf at `leaf_key` names.
     pub(super) fn solid(
         &self,
         doc: &Doc,
         name: &str,
-        at: &std::ops::Range<usize>,
+        (at, leaf_key): (&std::ops::Range<usize>, &str),
         default_material: Option<usize>,
     ) -> Result<CsgLeaf, SceneError> {
         let Some(def) = doc.solid.get(name) else {
             return Err(self.err(
                 at.clone(),
-                "object.csg",
+                leaf_key,
                 format!("no [solid.{name}] in this scene"),
             ));
         };
@@ -101,7 +109,7 @@ impl Builder<'_> {
         ];
         self.exactly_one(&given, &s, &key, "sphere, box, cone, torus, volume")?;
         let shape = if let Some(sp) = &d.sphere {
-            let centre = self.vec3(&s, &key, sp.centre)?;
+            let centre = self.vec3(&s, &format!("{key}.sphere.centre"), sp.centre)?;
             if !(sp.radius.is_finite() && sp.radius > 0.0) {
                 return Err(self.err(s, &format!("{key}.sphere.radius"), "expected a number > 0"));
             }
@@ -110,10 +118,14 @@ impl Builder<'_> {
                 radius: sp.radius,
             })
         } else if let Some(b) = &d.cuboid {
-            let min = self.vec3(&s, &key, b.min)?;
-            let max = self.vec3(&s, &key, b.max)?;
+            let min = self.vec3(&s, &format!("{key}.box.min"), b.min)?;
+            let max = self.vec3(&s, &format!("{key}.box.max"), b.max)?;
             if !min.cmplt(max).all() {
-                return Err(self.err(s, &format!("{key}.box"), "expected min < max on every axis"));
+                return Err(self.err(
+                    s,
+                    &format!("{key}.box.max"),
+                    "expected min < max on every axis",
+                ));
             }
             Solid::Cuboid(Cuboid { min, max })
         } else if let Some(c) = &d.cone {
@@ -158,7 +170,7 @@ impl Builder<'_> {
         self.csg_op(
             doc,
             root.get_ref(),
-            &root.span(),
+            (&root.span(), "object.csg"),
             default_material,
             &mut csg,
             0,
@@ -196,11 +208,13 @@ impl Builder<'_> {
         Ok(())
     }
 
+    /// One operation of a tree, at key path `path` (`object.csg`, then
+    /// `object.csg.difference[1]`, …).
     pub(super) fn csg_op(
         &self,
         doc: &Doc,
         d: &CsgOp,
-        at: &std::ops::Range<usize>,
+        (at, path): (&std::ops::Range<usize>, &str),
         material: Option<usize>,
         csg: &mut Csg,
         depth: usize,
@@ -216,26 +230,31 @@ impl Builder<'_> {
         if depth > MAX_NODES {
             return Err(too_big());
         }
-        let (kind, args) = match (&d.union, &d.intersection, &d.difference) {
-            (Some(a), None, None) => (0, a),
-            (None, Some(a), None) => (1, a),
-            (None, None, Some(a)) => (2, a),
+        let (kind, op, args) = match (&d.union, &d.intersection, &d.difference) {
+            (Some(a), None, None) => (0, "union", a),
+            (None, Some(a), None) => (1, "intersection", a),
+            (None, None, Some(a)) => (2, "difference", a),
             _ => {
                 return Err(self.err(
                     s,
-                    "object.csg",
+                    path,
                     "expected exactly one of union, intersection, difference",
                 ));
             }
         };
         if args.len() < 2 || args.len() > MAX_NODES {
-            return Err(self.err(s, "object.csg", "an operation takes 2 or more operands"));
+            return Err(self.err(
+                s,
+                &format!("{path}.{op}"),
+                "an operation takes 2 or more operands",
+            ));
         }
         let mut acc: Option<u16> = None;
-        for a in args {
+        for (i, a) in args.iter().enumerate() {
+            let operand = format!("{path}.{op}[{i}]");
             let id = match a {
                 CsgExpr::Leaf(name) => {
-                    let leaf = self.solid(doc, name, at, material)?;
+                    let leaf = self.solid(doc, name, (at, &operand), material)?;
                     let l = u16::try_from(csg.leaves.len()).map_err(|_| too_big())?;
                     csg.leaves.push(leaf);
                     if csg.nodes.len() >= MAX_NODES {
@@ -244,7 +263,9 @@ impl Builder<'_> {
                     csg.nodes.push(CsgNode::Leaf(l));
                     u16::try_from(csg.nodes.len() - 1).map_err(|_| too_big())?
                 }
-                CsgExpr::Op(inner) => self.csg_op(doc, inner, at, material, csg, depth + 1)?,
+                CsgExpr::Op(inner) => {
+                    self.csg_op(doc, inner, (at, &operand), material, csg, depth + 1)?
+                }
             };
             acc = Some(match acc {
                 None => id,

@@ -4,7 +4,7 @@ use ::toml::Spanned;
 use glam::DVec3;
 
 use super::build::Builder;
-use super::schema::{MaterialDef, TextureDef};
+use super::schema::{MaterialDef, NoiseDef, TextureDef};
 use crate::assets::texture::{
     AnyTexture, Blend, Checker, ImageTexture, Mapping, Marble, Wood, Wrap,
 };
@@ -76,75 +76,131 @@ impl Builder<'_> {
             d.image.is_some(),
         ];
         self.exactly_one(&given, &s, key, "checker, marble, wood, image")?;
-        let bad = |e: crate::assets::texture::TextureError| self.err(s.clone(), key, e.to_string());
+        // Each value checked here, at its own key; the constructors' checks
+        // are the same, so their errors (named after the texture) do not
+        // happen.
+        let k = |sub: &str| format!("{key}.{sub}");
+        let positive = |v: f64, sub: &str| {
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(self.err(s.clone(), &k(sub), "expected a number > 0"))
+            }
+        };
+        let direction = |v, sub: &str| {
+            let d = self.vec3(&s, &k(sub), v)?;
+            if d.length_squared() > 0.0 {
+                Ok(d)
+            } else {
+                Err(self.err(s.clone(), &k(sub), "expected a non-zero vector"))
+            }
+        };
+        let noise = |n: &NoiseDef, kind: &str| -> Result<(), SceneError> {
+            positive(n.period, &format!("{kind}.period"))?;
+            positive(n.noise_scale, &format!("{kind}.noise_scale"))?;
+            if !n.turbulence.is_finite() {
+                return Err(self.err(
+                    s.clone(),
+                    &k(&format!("{kind}.turbulence")),
+                    "expected a finite number",
+                ));
+            }
+            if !(1..=16).contains(&n.octaves) {
+                return Err(self.err(
+                    s.clone(),
+                    &k(&format!("{kind}.octaves")),
+                    "expected 1 to 16",
+                ));
+            }
+            Ok(())
+        };
+        let bad = |sub: &str| {
+            let (at, span) = (k(sub), s.clone());
+            move |e: crate::assets::texture::TextureError| self.err(span, &at, e.to_string())
+        };
         let any = if let Some(c) = &d.checker {
-            AnyTexture::Checker(
-                Checker::new(self.vec3(&s, key, c.origin)?, c.size, c.colours).map_err(bad)?,
-            )
+            let origin = self.vec3(&s, &k("checker.origin"), c.origin)?;
+            let size = positive(c.size, "checker.size")?;
+            AnyTexture::Checker(Checker::new(origin, size, c.colours).map_err(bad("checker"))?)
         } else if let Some(m) = &d.marble {
+            let dir = direction(m.direction, "marble.direction")?;
+            noise(m, "marble")?;
             AnyTexture::Marble(
                 Marble::new(
                     m.seed,
-                    self.vec3(&s, key, m.direction)?,
+                    dir,
                     m.period,
                     m.noise_scale,
                     m.turbulence,
                     m.octaves,
                     m.colours,
                 )
-                .map_err(bad)?,
+                .map_err(bad("marble"))?,
             )
         } else if let Some(w) = &d.wood {
+            let origin = self.vec3(&s, &k("wood.origin"), w.origin)?;
+            let dir = direction(w.direction, "wood.direction")?;
+            noise(w, "wood")?;
             AnyTexture::Wood(
                 Wood::new(
                     w.seed,
-                    self.vec3(&s, key, w.origin)?,
-                    self.vec3(&s, key, w.direction)?,
+                    origin,
+                    dir,
                     w.period,
                     w.noise_scale,
                     w.turbulence,
                     w.octaves,
                     w.colours,
                 )
-                .map_err(bad)?,
+                .map_err(bad("wood"))?,
             )
         } else if let Some(i) = &d.image {
-            let mapping = match (&i.planar, &i.cylindrical, &i.spherical) {
-                (Some(p), None, None) => Mapping::Planar {
-                    origin: self.vec3(&s, key, p.origin)?,
-                    u_axis: self.vec3(&s, key, p.u)?,
-                    v_axis: self.vec3(&s, key, p.v)?,
-                },
-                (None, Some(a), None) => Mapping::Cylindrical {
-                    origin: self.vec3(&s, key, a.centre)?,
-                    axis: self.vec3(&s, key, a.axis)?,
-                    reference: self.vec3(&s, key, a.reference)?,
-                },
-                (None, None, Some(a)) => Mapping::Spherical {
-                    centre: self.vec3(&s, key, a.centre)?,
-                    pole: self.vec3(&s, key, a.axis)?,
-                    reference: self.vec3(&s, key, a.reference)?,
-                },
+            let v = |sub: &str, x| self.vec3(&s, &k(&format!("image.{sub}")), x);
+            let (mapping, which) = match (&i.planar, &i.cylindrical, &i.spherical) {
+                (Some(p), None, None) => (
+                    Mapping::Planar {
+                        origin: v("planar.origin", p.origin)?,
+                        u_axis: v("planar.u", p.u)?,
+                        v_axis: v("planar.v", p.v)?,
+                    },
+                    "image.planar",
+                ),
+                (None, Some(a), None) => (
+                    Mapping::Cylindrical {
+                        origin: v("cylindrical.centre", a.centre)?,
+                        axis: v("cylindrical.axis", a.axis)?,
+                        reference: v("cylindrical.reference", a.reference)?,
+                    },
+                    "image.cylindrical",
+                ),
+                (None, None, Some(a)) => (
+                    Mapping::Spherical {
+                        centre: v("spherical.centre", a.centre)?,
+                        pole: v("spherical.axis", a.axis)?,
+                        reference: v("spherical.reference", a.reference)?,
+                    },
+                    "image.spherical",
+                ),
                 _ => {
                     return Err(self.err(
                         s,
-                        key,
-                        "an image needs exactly one of planar, cylindrical, spherical",
+                        &k("image"),
+                        "expected exactly one of planar, cylindrical, spherical",
                     ));
                 }
             };
+            mapping.validate().map_err(bad(which))?;
             let wrap = match i.wrap.as_deref() {
                 None | Some("repeat") => Wrap::Repeat,
                 Some("mirror") => Wrap::Mirror,
                 Some("clamp") => Wrap::Clamp,
                 Some(_) => {
-                    return Err(self.err(s, key, "wrap: expected repeat, mirror or clamp"));
+                    return Err(self.err(s, &k("image.wrap"), "expected repeat, mirror or clamp"));
                 }
             };
-            let (path, _) = self.path(&i.file, &format!("{key}.image.file"))?;
-            let img = ImageTexture::open(&path, mapping).map_err(|e| {
-                self.err(i.file.span(), &format!("{key}.image.file"), e.to_string())
-            })?;
+            let (path, _) = self.path(&i.file, &k("image.file"))?;
+            let img = ImageTexture::open(&path, mapping)
+                .map_err(|e| self.err(i.file.span(), &k("image.file"), e.to_string()))?;
             AnyTexture::Image(img.with_wrap(wrap))
         } else {
             return Err(self.err(s, key, "no texture"));

@@ -110,19 +110,26 @@ pub fn load(path: &Path, opts: &Options) -> Result<Scene, SceneError> {
 pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene, SceneError> {
     let file: Arc<str> = Arc::from(file);
     let doc: Doc = ::toml::from_str(text).map_err(|e| {
-        let at = e.span().map_or(0, |s| s.start);
-        // The full path of the key at the error (an unknown key inside an
-        // inline table, a wrong-typed value); the key on the line for a
-        // document that does not parse.
-        let path = Spans::new(text).path_at(at);
+        let span = e.span().unwrap_or(0..0);
+        let at = span.start;
+        // The full path of the key or table at the error (an unknown key
+        // inside an inline table, a wrong-typed value, a table missing a
+        // key); the key at or before the error for a document that does
+        // not parse.
+        let spans = Spans::new(text);
+        let path = spans.path_of(span);
+        let mut msg = e.message().trim().to_owned();
+        if spans.parsed() && path.is_empty() && msg == "missing field `camera`" {
+            msg.push_str(": every scene needs a [camera] table (from, at, angle, resolution)");
+        }
         SceneError::Toml {
             loc: byte_loc(&file, text.as_bytes(), at),
-            key: if path.is_empty() {
-                key_before(text, at)
+            key: if path.is_empty() && !spans.parsed() {
+                key_near(text, at)
             } else {
                 path
             },
-            msg: e.message().trim().to_owned(),
+            msg,
         }
     })?;
     Builder {
@@ -138,20 +145,26 @@ pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene
     .build(&doc)
 }
 
-/// The key whose value starts at byte `at` (`key = value` on that line),
-/// or empty: names the key of a wrong-typed value, which toml's message
-/// does not.
-fn key_before(text: &str, at: usize) -> String {
+/// In a document that does not parse: the key whose value starts at byte
+/// `at` (`key = value` on that line), or the key that starts at `at` (a
+/// duplicate key), or empty.
+fn key_near(text: &str, at: usize) -> String {
+    let is_key = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.';
     let Some(before) = text.get(..at) else {
         return String::new();
     };
     let line = before.rsplit('\n').next().unwrap_or("");
-    let Some(lhs) = line.trim_end().strip_suffix('=') else {
-        return String::new();
-    };
-    let lhs = lhs.trim_end();
-    let start = lhs
-        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.'))
-        .map_or(0, |i| i + 1);
-    lhs.get(start..).unwrap_or("").to_owned()
+    if let Some(lhs) = line.trim_end().strip_suffix('=') {
+        let lhs = lhs.trim_end();
+        let start = lhs.rfind(|c: char| !is_key(c)).map_or(0, |i| i + 1);
+        return lhs.get(start..).unwrap_or("").to_owned();
+    }
+    let after = text.get(at..).unwrap_or("");
+    let key = &after[..after.find(|c: char| !is_key(c)).unwrap_or(after.len())];
+    // Only a key followed by `=`.
+    if !key.is_empty() && after[key.len()..].trim_start().starts_with('=') {
+        key.to_owned()
+    } else {
+        String::new()
+    }
 }

@@ -94,15 +94,17 @@ impl Builder<'_> {
     /// translation.
     fn transform(&self, t: &TransformDef, s: &Range<usize>) -> Result<DAffine3, SceneError> {
         let tr = self.vec3(s, "object.transform.translate", t.translate)?;
-        let angles_ok = [t.rotate_x, t.rotate_y, t.rotate_z]
-            .iter()
-            .all(|a| a.is_finite());
-        if !(t.scale.is_finite() && t.scale > 0.0 && angles_ok) {
-            return Err(self.err(
-                s.clone(),
-                "object.transform",
-                "expected scale > 0 and finite angles",
-            ));
+        if !(t.scale.is_finite() && t.scale > 0.0) {
+            return Err(self.err(s.clone(), "object.transform.scale", "expected a number > 0"));
+        }
+        for (key, a) in [
+            ("object.transform.rotate_x", t.rotate_x),
+            ("object.transform.rotate_y", t.rotate_y),
+            ("object.transform.rotate_z", t.rotate_z),
+        ] {
+            if !a.is_finite() {
+                return Err(self.err(s.clone(), key, "expected a finite angle in degrees"));
+            }
         }
         let q = DQuat::from_rotation_z(t.rotate_z.to_radians())
             * DQuat::from_rotation_y(t.rotate_y.to_radians())
@@ -154,8 +156,9 @@ impl Builder<'_> {
         }
         let v = p
             .iter()
-            .map(|&q| {
-                self.vec3(s, "object.polygon", q)
+            .enumerate()
+            .map(|(i, &q)| {
+                self.vec3(s, &format!("object.polygon[{i}]"), q)
                     .map(|q| at.transform.transform_point3(q))
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -168,7 +171,11 @@ impl Builder<'_> {
         let lo = self.vec3(s, "object.box.min", b.min)?;
         let hi = self.vec3(s, "object.box.max", b.max)?;
         if !lo.cmplt(hi).all() {
-            return Err(self.err(s.clone(), "object.box", "expected min < max on every axis"));
+            return Err(self.err(
+                s.clone(),
+                "object.box.max",
+                "expected min < max on every axis",
+            ));
         }
         for face in box_faces(lo, hi) {
             self.push_polygon(scene, &face, None, at.material, &at.loc, s)?;
@@ -252,7 +259,11 @@ impl Builder<'_> {
             let idx = t.map(|i| i as usize);
             let (Some(a), Some(b2), Some(c)) = (pos.get(idx[0]), pos.get(idx[1]), pos.get(idx[2]))
             else {
-                return Err(self.err(s.clone(), "object.mesh", "index out of range"));
+                return Err(self.err(
+                    m.file.span(),
+                    "object.mesh.file",
+                    "a vertex index out of range",
+                ));
             };
             let n = normals.as_ref().map(|n| {
                 idx.map(|i| {

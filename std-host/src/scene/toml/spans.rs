@@ -46,6 +46,11 @@ impl<'t> Spans<'t> {
         }
     }
 
+    /// Whether the document parsed (else every lookup finds nothing).
+    pub(super) fn parsed(&self) -> bool {
+        self.root.is_some()
+    }
+
     /// The span of the value at `path`, or of the deepest value on the
     /// way that exists.
     pub(super) fn value(&self, path: &str) -> Option<Range<usize>> {
@@ -79,20 +84,25 @@ impl<'t> Spans<'t> {
     }
 
     /// The full key path of the innermost key or value whose span holds
-    /// byte `at` (for toml's own errors: an unknown key in an inline
-    /// table, a wrong type), or empty.
-    pub(super) fn path_at(&self, at: usize) -> String {
+    /// all of `at` (for toml's own errors: an unknown key in an inline
+    /// table, a wrong type, a missing key of a table), or empty for an
+    /// empty span (toml's for an error about the whole document, such as
+    /// a missing `[camera]`).
+    pub(super) fn path_of(&self, at: Range<usize>) -> String {
         let Some(root) = self.root.as_ref() else {
             return String::new();
         };
+        if at.is_empty() {
+            return String::new();
+        }
         let mut best: Option<(usize, String)> = None;
-        walk_table(root.get_ref(), "", at, &mut best);
+        walk_table(root.get_ref(), "", &at, &mut best);
         best.map(|(_, p)| p).unwrap_or_default()
     }
 }
 
-fn consider(span: Range<usize>, path: &str, at: usize, best: &mut Option<(usize, String)>) {
-    if span.contains(&at) || (span.is_empty() && span.start == at) {
+fn consider(span: Range<usize>, path: &str, at: &Range<usize>, best: &mut Option<(usize, String)>) {
+    if span.start <= at.start && at.end <= span.end {
         let len = span.len();
         if best.as_ref().is_none_or(|(l, _)| len <= *l) {
             *best = Some((len, path.to_owned()));
@@ -100,7 +110,12 @@ fn consider(span: Range<usize>, path: &str, at: usize, best: &mut Option<(usize,
     }
 }
 
-fn walk_table(t: &DeTable<'_>, prefix: &str, at: usize, best: &mut Option<(usize, String)>) {
+fn walk_table(
+    t: &DeTable<'_>,
+    prefix: &str,
+    at: &Range<usize>,
+    best: &mut Option<(usize, String)>,
+) {
     for (k, v) in t {
         let path = if prefix.is_empty() {
             k.get_ref().to_string()
@@ -112,7 +127,12 @@ fn walk_table(t: &DeTable<'_>, prefix: &str, at: usize, best: &mut Option<(usize
     }
 }
 
-fn walk_value(v: &Spanned<DeValue<'_>>, path: &str, at: usize, best: &mut Option<(usize, String)>) {
+fn walk_value(
+    v: &Spanned<DeValue<'_>>,
+    path: &str,
+    at: &Range<usize>,
+    best: &mut Option<(usize, String)>,
+) {
     consider(v.span(), path, at, best);
     match v.get_ref() {
         DeValue::Table(t) => walk_table(t, path, at, best),
@@ -147,8 +167,15 @@ mod tests {
     #[test]
     fn paths_by_position() {
         let s = Spans::new(DOC);
-        let scale = DOC.find("scale").unwrap();
-        assert_eq!(s.path_at(scale), "object[1].box.max.scale");
-        assert_eq!(s.path_at(DOC.find("40").unwrap()), "camera.angle");
+        let at = |needle: &str| {
+            let i = DOC.find(needle).unwrap();
+            s.path_of(i..i + needle.len())
+        };
+        assert_eq!(at("scale"), "object[1].box.max.scale");
+        assert_eq!(at("40"), "camera.angle");
+        assert_eq!(at("{ scale = 2 }"), "object[1].box.max");
+        // The whole document (a missing top-level table): no key.
+        assert_eq!(s.path_of(0..0), "");
+        assert_eq!(s.path_of(0..DOC.len()), "");
     }
 }

@@ -65,6 +65,19 @@ impl Builder<'_> {
                     ));
                 }
             };
+            if let Some(&n) = r.dims.iter().find(|&&n| n == 0 || n > volume::MAX_AXIS) {
+                return Err(self.err(
+                    s,
+                    &key("raw.dims"),
+                    format!(
+                        "expected 1 to {} samples per axis, found {n}",
+                        volume::MAX_AXIS
+                    ),
+                ));
+            }
+            if !r.spacing.iter().all(|&x| x.is_finite() && x > 0.0) {
+                return Err(self.err(s, &key("raw.spacing"), "expected numbers > 0"));
+            }
             let (path, _) = self.path(&r.file, &key("raw.file"))?;
             let spec = RawSpec {
                 dims: r.dims,
@@ -78,7 +91,7 @@ impl Builder<'_> {
                 skip: r.skip,
             };
             raw::read(&path, &spec, &self.opts.volume)
-                .map_err(|e| self.err(r.file.span(), &key("raw"), e.to_string()))
+                .map_err(|e| self.err(r.file.span(), &key("raw.file"), e.to_string()))
         } else if let Some(m) = &d.metaballs {
             let lo = self.vec3(&s, &key("metaballs.min"), m.min)?;
             let hi = self.vec3(&s, &key("metaballs.max"), m.max)?;
@@ -89,11 +102,11 @@ impl Builder<'_> {
                 (hi.z - lo.z) / n[2],
             ];
             let mut balls = Vec::with_capacity(m.balls.len().min(1024));
-            for b in &m.balls {
+            for (i, b) in m.balls.iter().enumerate() {
                 if !(b.iter().all(|x| x.is_finite()) && b[3] > 0.0) {
                     return Err(self.err(
                         s,
-                        &key("metaballs.balls"),
+                        &key(&format!("metaballs.balls[{i}]")),
                         "expected finite [x, y, z, radius > 0, strength]",
                     ));
                 }
@@ -109,7 +122,7 @@ impl Builder<'_> {
                 Grid::axis_aligned(spacing, lo),
                 &self.opts.volume,
             )
-            .map_err(|e| self.err(s.clone(), &key("metaballs"), e.to_string()))
+            .map_err(|e| self.err(s.clone(), &key("metaballs.dims"), e.to_string()))
         } else {
             Err(self.err(s.clone(), &key("file"), "no data"))
         }
@@ -137,20 +150,43 @@ impl Builder<'_> {
         };
         let mut classifier = Classifier::iso(iso);
         if let Some(o) = &d.opacity {
+            for (i, p) in o.iter().enumerate() {
+                if !(p[0].is_finite() && (0.0..=1.0).contains(&p[1])) {
+                    return Err(self.err(
+                        s,
+                        &key(&format!("opacity[{i}]")),
+                        "expected [value, alpha] with alpha in [0, 1]",
+                    ));
+                }
+                if i > 0 && !(p[0] > o[i - 1][0]) {
+                    return Err(self.err(
+                        s,
+                        &key(&format!("opacity[{i}][0]")),
+                        "expected values that increase along the ramp",
+                    ));
+                }
+            }
             let ramp = Ramp::new(o.iter().map(|p| (p[0], p[1])).collect())
                 .map_err(|e| self.err(s.clone(), &key("opacity"), e.to_string()))?;
             classifier = classifier.with_opacity(ramp);
         }
         if let Some(c) = &d.colours {
             let mut pts = Vec::with_capacity(c.len().min(4096));
-            for p in c {
+            for (i, p) in c.iter().enumerate() {
                 if !p.iter().all(|x| x.is_finite())
                     || p[1..].iter().any(|&x| !(0.0..=1.0).contains(&x))
                 {
                     return Err(self.err(
                         s,
-                        &key("colours"),
+                        &key(&format!("colours[{i}]")),
                         "expected [value, r, g, b] with channels in [0, 1]",
+                    ));
+                }
+                if i > 0 && !(p[0] > c[i - 1][0]) {
+                    return Err(self.err(
+                        s,
+                        &key(&format!("colours[{i}][0]")),
+                        "expected values that increase along the ramp",
                     ));
                 }
                 let ch = |x: f64| (x * 255.0).round() as u8;
@@ -176,21 +212,25 @@ impl Builder<'_> {
     ) -> Result<Placement, SceneError> {
         let s = s.clone();
         match (&d.fit, d.translate, d.scale) {
-            (Some(b), None, None) => Placement::fit_into(
-                data,
-                crate::world::Bounds {
-                    min: self.vec3(&s, &key("fit.min"), b.min)?,
-                    max: self.vec3(&s, &key("fit.max"), b.max)?,
-                },
-            ),
-            (None, t, sc) => Placement::new(
-                self.vec3(&s, &key("translate"), t.unwrap_or_default())?,
-                sc.unwrap_or(1.0),
-            ),
-            _ => {
-                return Err(self.err(s, &key("fit"), "give fit, or translate and scale, not both"));
+            (Some(b), None, None) => {
+                let min = self.vec3(&s, &key("fit.min"), b.min)?;
+                let max = self.vec3(&s, &key("fit.max"), b.max)?;
+                if !min.cmplt(max).all() {
+                    return Err(self.err(s, &key("fit.max"), "expected min < max on every axis"));
+                }
+                Placement::fit_into(data, crate::world::Bounds { min, max })
+                    .map_err(|e| self.err(s.clone(), &key("fit"), e.to_string()))
             }
+            (None, t, sc) => {
+                let translate = self.vec3(&s, &key("translate"), t.unwrap_or_default())?;
+                let scale = sc.unwrap_or(1.0);
+                if !(scale.is_finite() && scale > 0.0) {
+                    return Err(self.err(s, &key("scale"), "expected a number > 0"));
+                }
+                Placement::new(translate, scale)
+                    .map_err(|e| self.err(s.clone(), &key("translate"), e.to_string()))
+            }
+            _ => Err(self.err(s, &key("fit"), "give fit, or translate and scale, not both")),
         }
-        .map_err(|e| self.err(s.clone(), &key("fit"), e.to_string()))
     }
 }

@@ -1,0 +1,427 @@
+//! The user's job against Embree, as whole processes: `rrt render
+//! SCENE.nff` with the defaults (the exact mode, the default raster)
+//! against `embree_nff` on the same scene, from the scene file and from a
+//! saved raster, 1 and 2 threads; the image's PSNR against Embree's in
+//! the exact and the paper's mode; the phases, the peak memory, and what
+//! the exact mode's rays did.
+
+use crate::common::*;
+use crate::embree::find_embree;
+
+/// The scenes of the comparison: the SPD scenes in `shared/data/spd` and
+/// the one-sphere scene of the repository.
+const SCENES: [&str; 7] = [
+    "balls2",
+    "balls3",
+    "balls4",
+    "teapot",
+    "rings",
+    "tetra",
+    "one-sphere",
+];
+
+/// One process's figures.
+#[derive(Clone, Debug, Default)]
+struct Run {
+    /// Wall time, s.
+    wall: f64,
+    /// Peak resident memory, MiB (NaN without `/usr/bin/time`).
+    rss: f64,
+    /// Standard output and error.
+    out: String,
+}
+
+impl Run {
+    /// A phase's seconds from rrt's summary line (`name 0.123 s`).
+    fn phase(&self, name: &str) -> f64 {
+        self.out
+            .split(&format!("{name} "))
+            .nth(1)
+            .and_then(|t| t.split_whitespace().next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(f64::NAN)
+    }
+
+    /// A count from rrt's summary line (`123 name`).
+    fn count(&self, name: &str) -> f64 {
+        self.out
+            .split(&format!(" {name}"))
+            .next()
+            .and_then(|t| t.split([' ', '(']).next_back())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(f64::NAN)
+    }
+}
+
+/// Runs `cmd` under `/usr/bin/time` (wall time and peak memory) when it
+/// exists, else timed here.
+fn run(cmd: &Path, args: &[String]) -> Res<Run> {
+    let time = Path::new("/usr/bin/time");
+    let t = Instant::now();
+    let o = if time.is_file() {
+        Command::new(time)
+            .args(["-f", "TIME %e %M"])
+            .arg(cmd)
+            .args(args)
+            .output()?
+    } else {
+        Command::new(cmd).args(args).output()?
+    };
+    let wall = t.elapsed().as_secs_f64();
+    let mut out = String::from_utf8_lossy(&o.stdout).into_owned();
+    out.push_str(&String::from_utf8_lossy(&o.stderr));
+    if !o.status.success() {
+        return Err(format!("{} {}: {out}", cmd.display(), args.join(" ")).into());
+    }
+    let (wall, rss) = out
+        .lines()
+        .find_map(|l| l.strip_prefix("TIME "))
+        .and_then(|l| {
+            let mut it = l.split_whitespace();
+            let w: f64 = it.next()?.parse().ok()?;
+            let kb: f64 = it.next()?.parse().ok()?;
+            Some((w, kb / 1024.0))
+        })
+        .unwrap_or((wall, f64::NAN));
+    Ok(Run { wall, rss, out })
+}
+
+/// The `rrt` binary beside the bench's: for a full run built now (`cargo
+/// build -p rrt-host` with the bench's profile and flags, so both have the
+/// same instruction set); a quick run takes it as it is, `None` if absent.
+fn rrt_binary(ctx: &Ctx) -> Res<Option<PathBuf>> {
+    let exe = std::env::current_exe()?;
+    let dir = exe.parent().ok_or("no folder for the bench binary")?;
+    if ctx.cfg.quick {
+        let rrt = dir.join("rrt");
+        return Ok(rrt.is_file().then_some(rrt));
+    }
+    let profile = if dir.ends_with("release") {
+        "release"
+    } else {
+        "dev"
+    };
+    ctx.log(&format!("building rrt ({profile})"));
+    let status = Command::new(env!("CARGO"))
+        .args([
+            "build",
+            "-q",
+            "-p",
+            "rrt-host",
+            "--bin",
+            "rrt",
+            "--profile",
+            profile,
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .status()?;
+    if !status.success() {
+        return Err("cargo build -p rrt-host failed".into());
+    }
+    Ok(Some(dir.join("rrt")))
+}
+
+/// The scene file of `stem`.
+fn scene_path(ctx: &Ctx, stem: &str) -> PathBuf {
+    if stem == "one-sphere" {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/one-sphere.toml")
+    } else {
+        ctx.spd(stem)
+    }
+}
+
+fn strings(a: &[&str]) -> Vec<String> {
+    a.iter().map(|s| (*s).to_string()).collect()
+}
+
+/// PSNR of two PNG files' pixels (NaN if one cannot be read).
+fn png_psnr(a: &Path, b: &Path) -> f64 {
+    match (image::open(a), image::open(b)) {
+        (Ok(a), Ok(b)) => psnr(a.to_rgb8().as_raw(), b.to_rgb8().as_raw()),
+        _ => f64::NAN,
+    }
+}
+
+pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
+    let cfg = ctx.cfg.clone();
+    let (embree, how) = if ctx.no_embree {
+        (None, "skipped (`--no-embree`)".to_string())
+    } else {
+        find_embree(ctx, ctx.embree_bin.as_deref())
+    };
+    let Some(rrt) = rrt_binary(ctx)? else {
+        ctx.md.h2("The whole job against Embree");
+        ctx.md
+            .para("Not measured: no `rrt` binary beside the bench's (quick runs do not build it).");
+        return Ok(());
+    };
+    let tmp = std::env::temp_dir().join(format!("rrt-whole-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp)?;
+    let side = cfg.image.to_string();
+    let mut rows = Vec::new();
+    let mut saved_rows = Vec::new();
+    let mut balls4 = None;
+    let mut one_sphere = None;
+    let mut worst = (f64::INFINITY, String::new());
+    for stem in SCENES {
+        let path = scene_path(ctx, stem);
+        if !path.is_file() {
+            ctx.log(&format!("whole job: {} missing, skipped", path.display()));
+            continue;
+        }
+        ctx.log(&format!("whole job: {stem}"));
+        let p = path.display().to_string();
+        let ours_png = |t: usize| tmp.join(format!("{stem}-{t}.png"));
+        let rrt_args = |t: usize, extra: &[&str]| -> Vec<String> {
+            let out = ours_png(t).display().to_string();
+            let mut a = strings(&["render", &p, "-o", &out, "--linear", "--width", &side]);
+            a.extend(strings(&["--height", &side, "--threads", &t.to_string()]));
+            a.extend(strings(extra));
+            a
+        };
+        let embree_png = tmp.join(format!("{stem}-embree.png"));
+        let embree_args = |t: usize| {
+            strings(&[
+                "-w",
+                &side,
+                "-h",
+                &side,
+                "-d",
+                "3",
+                "-T",
+                "-t",
+                &t.to_string(),
+                "-o",
+                &embree_png.display().to_string(),
+                &p,
+            ])
+        };
+        // [threads][rrt, embree]
+        let mut t = [[Vec::new(), Vec::new()], [Vec::new(), Vec::new()]];
+        let mut last = [Run::default(), Run::default()];
+        for _ in 0..cfg.reps {
+            for (ti, th) in [1usize, 2].into_iter().enumerate() {
+                let r = run(&rrt, &rrt_args(th, &[]))?;
+                t[ti][0].push(r.wall);
+                last[ti] = r;
+                if let Some(e) = &embree
+                    && stem != "one-sphere"
+                {
+                    t[ti][1].push(run(e, &embree_args(th))?.wall);
+                }
+            }
+        }
+        // The paper's mode, once, for its PSNR.
+        let paper_png = tmp.join(format!("{stem}-paper.png"));
+        let pp = paper_png.display().to_string();
+        let paper_args = strings(&[
+            "render", &p, "-o", &pp, "--linear", "--width", &side, "--height", &side, "--mode",
+            "paper", "-q",
+        ]);
+        run(&rrt, &paper_args)?;
+        let has_embree = embree_png.is_file();
+        let exact_psnr = if has_embree {
+            png_psnr(&ours_png(1), &embree_png)
+        } else {
+            f64::NAN
+        };
+        let paper_psnr = if has_embree {
+            png_psnr(&paper_png, &embree_png)
+        } else {
+            f64::NAN
+        };
+        if exact_psnr < worst.0 {
+            worst = (exact_psnr, stem.to_string());
+        }
+        let r1 = &last[0];
+        let raster = r1
+            .out
+            .split("raster ")
+            .nth(1)
+            .and_then(|s| s.split_whitespace().next())
+            .unwrap_or("?")
+            .to_string();
+        let [o1, e1, o2, e2] = [&t[0][0], &t[0][1], &t[1][0], &t[1][1]].map(|v| median(v));
+        rows.push(vec![
+            stem.to_string(),
+            raster,
+            secs(o1),
+            secs(e1),
+            f(o1 / e1, 1),
+            secs(o2),
+            secs(e2),
+            f(o2 / e2, 1),
+            secs(last[1].phase("voxelize")),
+            secs(last[1].phase("light visibility")),
+            secs(last[1].phase("render")),
+            f(last[1].rss, 0),
+            f(exact_psnr, 2),
+            f(paper_psnr, 2),
+        ]);
+        if stem == "balls4" {
+            balls4 = Some((o2, e2, o1, e1));
+        }
+        if stem == "one-sphere" {
+            one_sphere = Some((o1, o2, last[1].rss));
+        }
+
+        // From a saved raster, one thread: `rrt voxelize` once, then the
+        // renders interleaved with Embree's.
+        if stem == "one-sphere" {
+            continue;
+        }
+        let rrt_file = tmp.join(format!("{stem}.rrt")).display().to_string();
+        run(&rrt, &strings(&["voxelize", &p, "-o", &rrt_file, "-q"]))?;
+        let saved_args = |th: usize| {
+            let out = tmp.join(format!("{stem}-saved.png")).display().to_string();
+            strings(&[
+                "render",
+                &rrt_file,
+                "-o",
+                &out,
+                "--linear",
+                "--width",
+                &side,
+                "--height",
+                &side,
+                "--threads",
+                &th.to_string(),
+            ])
+        };
+        let mut ts = [
+            [Vec::new(), Vec::new(), Vec::new()],
+            [Vec::new(), Vec::new(), Vec::new()],
+        ];
+        let mut saved_last = Run::default();
+        for _ in 0..cfg.reps {
+            for (ti, th) in [1usize, 2].into_iter().enumerate() {
+                let r = run(&rrt, &saved_args(th))?;
+                ts[ti][0].push(r.wall);
+                ts[ti][1].push(r.phase("render"));
+                if th == 1 {
+                    saved_last = r;
+                }
+                if let Some(e) = &embree {
+                    ts[ti][2].push(run(e, &embree_args(th))?.wall);
+                }
+            }
+        }
+        let rays = saved_last.count("primary")
+            + saved_last.count("reflected")
+            + saved_last.count("refracted");
+        let shadow = saved_last.count("shadow");
+        let lit = saved_last.count("lights proven lit");
+        saved_rows.push(vec![
+            stem.to_string(),
+            secs(median(&ts[0][0])),
+            secs(median(&ts[0][1])),
+            secs(median(&ts[0][2])),
+            f(median(&ts[0][0]) / median(&ts[0][2]), 2),
+            secs(median(&ts[1][0])),
+            secs(median(&ts[1][1])),
+            secs(median(&ts[1][2])),
+            f(median(&ts[1][0]) / median(&ts[1][2]), 2),
+            f(100.0 * shadow / (shadow + lit), 1),
+            f(100.0 * saved_last.count("false hits") / rays.max(1.0), 0),
+        ]);
+        if stem == "balls4" {
+            let (w, e) = (median(&ts[0][0]), median(&ts[0][2]));
+            ctx.targets.push(vec![
+                "balls4 from a saved raster, default mode, 1 thread: whole process ≤ Embree's"
+                    .into(),
+                format!("{} against {} s: {}×", secs(w), secs(e), f(w / e, 2)),
+                yes(w <= e),
+            ]);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+    if let Some((o2, e2, o1, e1)) = balls4 {
+        ctx.targets.push(vec![
+            "`rrt render balls4.nff`, defaults, 2 threads: whole process ≤ 3× Embree's".into(),
+            format!(
+                "{} s against {} s: {}× (1 thread: {}×)",
+                secs(o2),
+                secs(e2),
+                f(o2 / e2, 1),
+                f(o1 / e1, 1)
+            ),
+            yes(o2 <= 3.0 * e2),
+        ]);
+    }
+    if let Some((o1, o2, rss)) = one_sphere {
+        ctx.targets.push(vec![
+            "`rrt render scenes/one-sphere.toml`: ≤ 1 s and ≤ 200 MB".into(),
+            format!(
+                "{} s (1 thread), {} s (2 threads), {} MiB",
+                secs(o1),
+                secs(o2),
+                f(rss, 0)
+            ),
+            yes(o2 <= 1.0 && rss <= 200.0),
+        ]);
+    }
+    if worst.0.is_finite() {
+        ctx.targets.push(vec![
+            "Default (exact) mode ≥ 35 dB and ≥ 40 dB against Embree on the SPD scenes here".into(),
+            format!("lowest {} dB ({})", f(worst.0, 2), worst.1),
+            yes(worst.0 >= 40.0),
+        ]);
+    }
+    let md = &mut ctx.md;
+    md.h2("The whole job against Embree");
+    md.para(&format!(
+        "Whole processes, {0}×{0}, depth 3, every run of one configuration interleaved with the \
+         others round by round (medians of {1}). **rrt**: `rrt render SCENE -o x.png --linear \
+         --width {0} --height {0} --threads T` with every other setting at its default: the \
+         exact mode and the raster fitted to the scene and the image. **Embree**: `embree_nff -w \
+         {0} -h {0} -d 3 -T -t T` ({how}; `-T` traces refraction, which only scenes with T > 0 \
+         use). Phases from rrt's summary line (2 threads). **PSNR**: the image against \
+         Embree's, in the default (exact) mode and in the paper's (`--mode paper`, same default \
+         raster rule). Peak memory from `/usr/bin/time` (2 threads).",
+        cfg.image, cfg.reps
+    ));
+    md.table(
+        &[
+            "scene",
+            "raster",
+            "rrt s, 1 thread",
+            "Embree s, 1 thread",
+            "rrt / Embree",
+            "rrt s, 2 threads",
+            "Embree s, 2 threads",
+            "rrt / Embree",
+            "voxelize s",
+            "light s",
+            "render s",
+            "rrt peak MiB",
+            "exact PSNR dB",
+            "paper PSNR dB",
+        ],
+        &rows,
+    );
+    md.h3("From a saved raster");
+    md.para(
+        "The same renders from the raster `rrt voxelize SCENE` saved (the default raster, with \
+         the shadow classification), interleaved with Embree's whole process from the scene \
+         file. **Uncertain**: the share of the shadow queries of verified hits that the \
+         classification did not prove lit, which fired an exact shadow ray. **False hits**: \
+         discrete hits verification rejected, per traced ray (eye, reflected, refracted).",
+    );
+    md.table(
+        &[
+            "scene",
+            "rrt s, 1 thread",
+            "of which render s",
+            "Embree s, 1 thread",
+            "rrt / Embree",
+            "rrt s, 2 threads",
+            "of which render s",
+            "Embree s, 2 threads",
+            "rrt / Embree",
+            "uncertain %",
+            "false hits per 100 rays",
+        ],
+        &saved_rows,
+    );
+    Ok(())
+}
