@@ -12,8 +12,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 /// What a phase counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Unit {
-    /// Objects voxelized.
-    Objects,
+    /// Objects voxelized into slabs of the raster: each object counts
+    /// once per slab.
+    SlabObjects,
     /// Surface voxels (records).
     Voxels,
     /// Image tiles.
@@ -28,8 +29,8 @@ impl Unit {
             Self::Bytes => {
                 "{msg:26} [{bar:32}] {binary_bytes}/{binary_total_bytes} ({binary_bytes_per_sec}) {elapsed} eta {eta}"
             }
-            Self::Objects => {
-                "{msg:26} [{bar:32}] {human_pos}/{human_len} objects {elapsed} eta {eta}"
+            Self::SlabObjects => {
+                "{msg:26} [{bar:32}] {human_pos}/{human_len} objects×slabs {elapsed} eta {eta}"
             }
             Self::Voxels => {
                 "{msg:26} [{bar:32}] {human_pos}/{human_len} voxels {elapsed} eta {eta}"

@@ -214,7 +214,7 @@ impl Passes<'_> {
         crate::progress::phase(
             progress,
             "voxelizing (count pass)",
-            Unit::Objects,
+            Unit::SlabObjects,
             objects.saturating_mul(slabs),
         );
         // Slabs in order: nothing says yet which hold more.
@@ -261,7 +261,7 @@ impl Passes<'_> {
         crate::progress::phase(
             progress,
             "voxelizing (fill pass)",
-            Unit::Objects,
+            Unit::SlabObjects,
             objects.saturating_mul(slabs),
         );
         // The slabs with the most records first.
