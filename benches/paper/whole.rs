@@ -322,7 +322,12 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             secs(median(&ts[1][2])),
             f(median(&ts[1][0]) / median(&ts[1][2]), 2),
             f(100.0 * shadow / (shadow + lit), 1),
+            f(saved_last.count("steps/shadow ray"), 1),
             f(100.0 * saved_last.count("false hits") / rays.max(1.0), 0),
+            f(
+                100.0 * saved_last.count("in shared voxels") / saved_last.count("hits").max(1.0),
+                1,
+            ),
         ]);
         if stem == "balls4" {
             let (w, e) = (median(&ts[0][0]), median(&ts[0][2]));
@@ -404,8 +409,11 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
         "The same renders from the raster `rrt voxelize SCENE` saved (the default raster, with \
          the shadow classification), interleaved with Embree's whole process from the scene \
          file. **Uncertain**: the share of the shadow queries of verified hits that the \
-         classification did not prove lit, which fired an exact shadow ray. **False hits**: \
-         discrete hits verification rejected, per traced ray (eye, reflected, refracted).",
+         classification did not prove lit, which fired an exact shadow ray; **steps per shadow \
+         ray**: the voxels each of those rays visited (an empty-space jump counts as one). \
+         **False hits**: discrete hits verification rejected, per traced ray (eye, reflected, \
+         refracted). **Shared-voxel hits**: the share of verified hits found in a voxel that \
+         several objects share (through its object list).",
     );
     md.table(
         &[
@@ -419,7 +427,9 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             "Embree s, 2 threads",
             "rrt / Embree",
             "uncertain %",
+            "steps per shadow ray",
             "false hits per 100 rays",
+            "shared-voxel hits %",
         ],
         &saved_rows,
     );

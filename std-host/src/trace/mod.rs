@@ -240,6 +240,8 @@ pub struct RayStats {
     pub classified: u64,
     /// Voxels visited by all rays (an empty-space jump counts as one).
     pub steps: u64,
+    /// Of `steps`, the voxels visited by render-time shadow rays.
+    pub shadow_steps: u64,
     /// Rays that ended on a surface.
     pub hits: u64,
     /// Discrete hits that verification rejected: the continuous ray does
@@ -266,6 +268,7 @@ impl RayStats {
         self.shadow += o.shadow;
         self.classified += o.classified;
         self.steps += o.steps;
+        self.shadow_steps += o.shadow_steps;
         self.hits += o.hits;
         self.false_hits += o.false_hits;
         self.deferred += o.deferred;

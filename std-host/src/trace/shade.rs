@@ -194,6 +194,7 @@ impl Tracer<'_> {
             })
             .unwrap_or(WalkEnd::Exit);
         stats.steps += u64::from(dray.steps());
+        stats.shadow_steps += u64::from(dray.steps());
         stats.missing += missing;
         if end == WalkEnd::Hit { 0.0 } else { att }
     }
@@ -386,6 +387,7 @@ impl Tracer<'_> {
             )
             .unwrap_or(WalkEnd::Exit);
         stats.steps += u64::from(dray.steps());
+        stats.shadow_steps += u64::from(dray.steps());
         stats.missing += missing;
         if end == WalkEnd::Hit { 0.0 } else { att }
     }
