@@ -150,6 +150,17 @@ fn assert_same_cells(vs: &VoxelScene, what: &str) {
     }
 }
 
+/// `scene` voxelized with `opts` on `threads` threads.
+fn build_on(scene: &Scene, opts: BuildOptions, threads: usize) -> VoxelScene {
+    build(
+        scene,
+        &BuildOptions { threads, ..opts },
+        &ProgressBar::hidden(),
+    )
+    .unwrap()
+    .0
+}
+
 #[test]
 fn rasters_and_saved_files_are_identical_for_every_thread_count() {
     let dir = fresh_dir("rrt-build-threads", "scene");
@@ -162,13 +173,7 @@ fn rasters_and_saved_files_are_identical_for_every_thread_count() {
         ("exact", BuildOptions::new(120)),
         ("paper", BuildOptions::paper(120)),
     ] {
-        let one = build(
-            &scene,
-            &BuildOptions { threads: 1, ..opts },
-            &ProgressBar::hidden(),
-        )
-        .unwrap()
-        .0;
+        let one = build_on(&scene, opts, 1);
         assert!(one.extent().dims()[2] > 3 * 8, "{:?}", one.extent());
         assert_eq!(one.exact, what == "exact");
         if one.exact {
@@ -177,8 +182,7 @@ fn rasters_and_saved_files_are_identical_for_every_thread_count() {
         assert_same_cells(&one, what);
         let want = bytes(&one, &dir, &format!("{what}-1"));
         for threads in [2, 3] {
-            let o = BuildOptions { threads, ..opts };
-            let vs = build(&scene, &o, &ProgressBar::hidden()).unwrap().0;
+            let vs = build_on(&scene, opts, threads);
             let got = bytes(&vs, &dir, &format!("{what}-{threads}"));
             // Field by field, for a readable failure.
             assert!(got.plane == want.plane, "{what}, {threads} threads: plane");
@@ -203,22 +207,10 @@ fn an_spd_scene_is_identical_for_every_thread_count() {
     let scene = Scene::load(data("balls1.nff")).unwrap();
     let dir = fresh_dir("rrt-build-threads", "balls1");
     for opts in [BuildOptions::paper(200), BuildOptions::new(200)] {
-        let one = build(
-            &scene,
-            &BuildOptions { threads: 1, ..opts },
-            &ProgressBar::hidden(),
-        )
-        .unwrap()
-        .0;
+        let one = build_on(&scene, opts, 1);
         assert_same_cells(&one, "balls1");
         let want = bytes(&one, &dir, "one");
-        let vs = build(
-            &scene,
-            &BuildOptions { threads: 2, ..opts },
-            &ProgressBar::hidden(),
-        )
-        .unwrap()
-        .0;
+        let vs = build_on(&scene, opts, 2);
         assert!(bytes(&vs, &dir, "two") == want, "exact {}", opts.exact);
     }
 }

@@ -80,7 +80,8 @@ fn render_writes_a_png_and_one_summary_line() {
             "render ",
             "4800 primary",
             "steps/ray",
-            "hits",
+            "steps/shadow ray",
+            "in shared voxels",
             "false hits",
         ] {
             assert!(s.contains(part), "{s:?} lacks {part:?}");
@@ -113,11 +114,21 @@ fn render_writes_a_png_and_one_summary_line() {
             s.contains("(exact mode,") && !s.contains(" 0 shadow"),
             "{s}"
         );
+        // The exact mode's shadow rays walk; the number before the label.
+        let shadow_steps: f64 = s
+            .split(" steps/shadow ray")
+            .next()
+            .and_then(|t| t.rsplit(' ').next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0.0);
+        assert!(shadow_steps > 0.0, "{s}");
         let s = x(&["--mode", "verified"]).unwrap();
         assert!(s.contains("(verified mode,"), "{s}");
         let s = x(&["--mode", "paper"]).unwrap();
         assert!(
-            s.contains("(paper mode,") && s.contains(" 0 false hits"),
+            s.contains("(paper mode,")
+                && s.contains(" 0 false hits")
+                && s.contains("(0 in shared voxels)"),
             "{s}"
         );
         let e = x(&["--mode", "fast"]).unwrap_err();
