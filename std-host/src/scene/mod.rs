@@ -73,6 +73,50 @@ pub struct View {
     pub loc: SourceLoc,
 }
 
+impl View {
+    /// Frame `k` of an orbit of `n` frames: the eye at [`View::from`]
+    /// rotated by 360°·k/n about the axis through [`View::at`] along
+    /// [`View::up`] (right-handed about `up`); `at`, `up`, `angle`,
+    /// `hither` and the resolution unchanged. Frame 0 (and every multiple
+    /// of `n`) is this view itself, bit for bit; `n = 0` is taken as 1.
+    /// The result keeps the parser's guarantees: the eye keeps its distance
+    /// from `at` and its angle to `up`.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use rrt_host::scene::View;
+    /// let view = View {
+    ///     from: DVec3::new(1.0, 0.0, 0.0),
+    ///     at: DVec3::ZERO,
+    ///     up: DVec3::Z,
+    ///     angle: 45.0,
+    ///     hither: 0.0,
+    ///     resolution: [64, 64],
+    ///     loc: rrt_host::scene::SourceLoc::new("doc", 1, 1),
+    /// };
+    /// assert_eq!(view.orbit(0, 4), view);
+    /// assert!(view.orbit(1, 4).from.distance(DVec3::Y) < 1e-12);
+    /// assert_eq!(view.orbit(4, 4), view);
+    /// ```
+    #[must_use]
+    pub fn orbit(&self, k: u64, n: u64) -> View {
+        let n = n.max(1);
+        let k = k % n;
+        if k == 0 {
+            return self.clone();
+        }
+        let axis = self.up.normalize();
+        let theta = std::f64::consts::TAU * (k as f64) / (n as f64);
+        let (sin, cos) = theta.sin_cos();
+        let v = self.from - self.at;
+        let rotated = v * cos + axis.cross(v) * sin + axis * axis.dot(v) * (1.0 - cos);
+        View {
+            from: self.at + rotated,
+            ..self.clone()
+        }
+    }
+}
+
 /// A positional light (`l`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
