@@ -175,7 +175,7 @@ fn png_is_identical_for_every_thread_count() {
 /// blocks), with packets or scalar walks, with and without supersampling.
 #[test]
 fn bands_are_the_rows_of_the_whole_image() {
-    let scene = Scene::load(&balls2()).unwrap();
+    let scene = Scene::load(balls2()).unwrap();
     let paper = voxelize(&scene, 64, Connectivity::Adaptive);
     let exact = voxelize_exact(&scene, 64);
     let (w, h) = (37, 23);

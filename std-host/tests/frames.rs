@@ -391,7 +391,7 @@ fn stitch_refuses_what_is_not_one_image_in_order() {
     let three = bands(&d, "s.rrt", "png", 3, &[]);
     let [b0, b1, b2] = [&three[0], &three[1], &three[2]].map(String::as_str);
     // Other images' bands, renamed so as not to clash.
-    let mut other = |extra: &[&str], tile: &str, name: &str| {
+    let other = |extra: &[&str], tile: &str, name: &str| {
         let args = [
             &["render", "-q", "s.rrt", "--tile", tile, "-o", name][..],
             extra,

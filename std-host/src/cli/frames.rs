@@ -192,12 +192,13 @@ impl Names {
             }
             return Ok(Self::Fixed(output.to_path_buf()));
         };
-        let mut parts = vec![String::new()];
+        // The texts between the numbers, and the numbers' widths.
+        let (mut parts, mut current) = (Vec::new(), String::new());
         let mut widths = Vec::new();
         let mut chars = text.char_indices().peekable();
         while let Some((at, c)) = chars.next() {
             if c != '%' {
-                parts.last_mut().map(|p| p.push(c));
+                current.push(c);
                 continue;
             }
             let mut spec = String::new();
@@ -215,11 +216,11 @@ impl Names {
             };
             match chars.next() {
                 Some((_, '%')) if spec.is_empty() => {
-                    parts.last_mut().map(|p| p.push('%'));
+                    current.push('%');
                 }
                 Some((_, 'd')) if spec.is_empty() => {
                     widths.push(0);
-                    parts.push(String::new());
+                    parts.push(std::mem::take(&mut current));
                 }
                 Some((_, 'd')) if spec.starts_with('0') && spec.len() > 1 => {
                     let w = spec[1..].parse::<usize>().unwrap_or(usize::MAX);
@@ -230,11 +231,12 @@ impl Names {
                         )));
                     }
                     widths.push(w);
-                    parts.push(String::new());
+                    parts.push(std::mem::take(&mut current));
                 }
                 _ => return Err(garbage()),
             }
         }
+        parts.push(current);
         match (widths.as_slice(), written) {
             ([], 0 | 1) => Ok(Self::Fixed(PathBuf::from(parts.concat()))),
             ([], n) => Err(arg(format!(
@@ -276,25 +278,17 @@ mod tests {
 
     #[test]
     fn patterns() {
-        let n = names("out/frame-%04d.png", 10).unwrap();
-        assert_eq!(n.path(7), PathBuf::from("out/frame-0007.png"));
-        assert_eq!(n.path(123_456), PathBuf::from("out/frame-123456.png"));
-        assert_eq!(
-            names("f%d.exr", 3).unwrap().path(12),
-            PathBuf::from("f12.exr")
-        );
-        assert_eq!(
-            names("100%%-%02d.png", 3).unwrap().path(5),
-            PathBuf::from("100%-05.png")
-        );
-        assert_eq!(
-            names("one.png", 1).unwrap().path(9),
-            PathBuf::from("one.png")
-        );
-        assert_eq!(
-            names("a%%b.png", 1).unwrap().path(0),
-            PathBuf::from("a%b.png")
-        );
+        for (pattern, written, k, want) in [
+            ("out/frame-%04d.png", 10, 7, "out/frame-0007.png"),
+            ("out/frame-%04d.png", 10, 123_456, "out/frame-123456.png"),
+            ("f%d.exr", 3, 12, "f12.exr"),
+            ("100%%-%02d.png", 3, 5, "100%-05.png"),
+            ("one.png", 1, 9, "one.png"),
+            ("a%%b.png", 1, 0, "a%b.png"),
+        ] {
+            let n = names(pattern, written).unwrap();
+            assert_eq!(n.path(k), PathBuf::from(want), "{pattern}");
+        }
         for (bad, want) in [
             ("frame.png", "has no frame number, but 4 frames"),
             ("a%d-%d.png", "has 2 frame numbers"),

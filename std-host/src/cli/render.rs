@@ -24,7 +24,10 @@ pub struct RenderArgs {
     pub scene: Option<PathBuf>,
     /// The image to write; its extension chooses the format: .png (8-bit
     /// sRGB by default), .ppm (binary), .exr or .pfm (32-bit float,
-    /// linear), or - for PNG on standard output.
+    /// linear), or - for PNG on standard output. With --orbit or --path,
+    /// a file name pattern: %d, or %0Nd (N from 1 to 20), for the frame
+    /// number zero-padded to N digits (%% is a %), required when several
+    /// frames are written.
     #[arg(short, long, value_name = "OUT", default_value = "rrt.png")]
     pub output: PathBuf,
     /// Bits per channel of .png and .ppm output: 8 or 16.

@@ -291,12 +291,13 @@ fn header(path: &Path) -> Result<Header, StitchError> {
     })
 }
 
-/// A PNG decoder past the header, with the raw samples (no
-/// transformations) and room for the largest band.
+/// A PNG decoder past the header, for the raw samples (no
+/// transformations), with the decoder's default limit on what it
+/// allocates itself (the caller allocates the pixels, after checking
+/// their size).
 fn png_reader(path: &Path) -> Result<png::Reader<BufReader<File>>, StitchError> {
     let file = File::open(path).map_err(io_error(path))?;
-    let max = 2 * 3 * (crate::render::MAX_SIDE as usize).pow(2);
-    let mut d = png::Decoder::new_with_limits(BufReader::new(file), png::Limits { bytes: max });
+    let mut d = png::Decoder::new(BufReader::new(file));
     d.set_transformations(png::Transformations::IDENTITY);
     d.read_info()
         .map_err(|e| band_error(path, format!("not a readable PNG file: {e}")))

@@ -71,8 +71,20 @@ pub fn load(path: &Path, name: &str) -> Result<Vec<PathView>, SceneError> {
 
 /// The fields of a line, in order.
 const FIELDS: [&str; 10] = [
-    "from x", "from y", "from z", "at x", "at y", "at z", "up x", "up y", "up z", "angle",
+    "path view from x",
+    "path view from y",
+    "path view from z",
+    "path view at x",
+    "path view at y",
+    "path view at z",
+    "path view up x",
+    "path view up y",
+    "path view up z",
+    ANGLE,
 ];
+
+/// The last field.
+const ANGLE: &str = "path view angle";
 
 /// Parses a camera path; `file` names it in messages.
 ///
@@ -105,7 +117,7 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PathView>, SceneError> {
             let Some((at, t)) = tokens.next() else {
                 return Err(SceneError::BadField {
                     loc: loc(content.trim_end().len()),
-                    field: path_field(field),
+                    field,
                     expected: "a number",
                     found: Found::EndOfLine,
                 });
@@ -113,7 +125,7 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PathView>, SceneError> {
             last_tok_at = at;
             let bad = |expected| SceneError::BadField {
                 loc: loc(at),
-                field: path_field(field),
+                field,
                 expected,
                 found: Found::token(t),
             };
@@ -122,7 +134,7 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PathView>, SceneError> {
                 Ok(_) => return Err(bad("a finite number")),
                 Err(_) => return Err(bad("a number")),
             };
-            if field == "angle" && !(*slot > 0.0 && *slot < 180.0) {
+            if field == ANGLE && !(*slot > 0.0 && *slot < 180.0) {
                 return Err(bad("an angle in degrees between 0 and 180 (exclusive)"));
             }
         }
@@ -177,22 +189,6 @@ fn tokens_at(line: &str, i: usize) -> Option<usize> {
     tokens(line).nth(i).map(|(at, _)| at)
 }
 
-/// The message's name of a field.
-fn path_field(field: &'static str) -> &'static str {
-    match field {
-        "from x" => "path view from x",
-        "from y" => "path view from y",
-        "from z" => "path view from z",
-        "at x" => "path view at x",
-        "at y" => "path view at y",
-        "at z" => "path view at z",
-        "up x" => "path view up x",
-        "up y" => "path view up y",
-        "up z" => "path view up z",
-        _ => "path view angle",
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -212,7 +208,7 @@ mod tests {
         for (text, want) in [
             (
                 "0 -4 1 0 0 0 0 0 1\n",
-                "p:1:18: path view angle: expected a number, found end of line",
+                "p:1:19: path view angle: expected a number, found end of line",
             ),
             (
                 "0 -4 x 0 0 0 0 0 1 45\n",
