@@ -107,6 +107,7 @@
 //! 64 plane cells, small enough to stay in cache). [`RayStats::steps`]
 //! counts voxels visited, a jump as one.
 
+pub mod composite;
 pub mod shade;
 pub mod shading;
 pub mod verify;
@@ -119,6 +120,7 @@ use rrt_core::raster::{Extent, Raster};
 use rrt_core::store::RecordStore;
 use rrt_core::voxel::VoxelRecord;
 
+pub use self::composite::Composite;
 pub use self::verify::{Verdict, verify};
 pub use self::walk::FirstWalk;
 
@@ -257,6 +259,8 @@ pub struct RayStats {
     pub deferred: u64,
     /// Opaque cells without a record (a damaged raster), stepped over.
     pub missing: u64,
+    /// Samples of volumes rendered directly composited along rays.
+    pub samples: u64,
 }
 
 impl RayStats {
@@ -275,6 +279,7 @@ impl RayStats {
         self.shared_hits += o.shared_hits;
         self.false_hit_rays += o.false_hit_rays;
         self.missing += o.missing;
+        self.samples += o.samples;
     }
 
     /// All rays traced.
@@ -347,6 +352,8 @@ pub struct Tracer<'s> {
     materials: &'s [Material],
     lights: &'s [WorldLight],
     lights_fx: Vec<Option<[i64; 3]>>,
+    /// The volumes rendered directly, by object id.
+    direct: &'s [crate::voxelize::direct::DirectVolume],
     /// The records of exact objects hold the shadow classification, and
     /// the shadow segments stay close enough to the ones it covers
     /// ([`Tracer::exact_light`]) to use it.
@@ -419,6 +426,7 @@ impl<'s> Tracer<'s> {
             materials: &scene.materials,
             lights: &scene.lights,
             lights_fx,
+            direct: &scene.direct,
             classified: scene.exact
                 && scene.exact_records == ExactRecords::Classify
                 && surface_offset(&scene.frame) < scene.frame.voxel_size / 8.0,
@@ -452,13 +460,34 @@ impl<'s> Tracer<'s> {
             // t > tmin: no voxel is skipped by the acne rule on the way.
             _ => self.first_walk(ray),
         };
-        match self.resolve(ray, &mut walk, tmin, leave, stats) {
+        let mut acc = Composite::default();
+        let hit = self.resolve(ray, &mut walk, tmin, leave, &mut acc, stats);
+        self.behind(ray, hit, depth, &acc, stats)
+    }
+
+    /// The colour of a ray whose walk composited `acc` and ended on `hit`
+    /// (or left the raster): the hit shaded, or the background, seen
+    /// through what was composited (nothing more once compositing
+    /// stopped).
+    fn behind(
+        &self,
+        ray: &Ray,
+        hit: Option<SurfaceHit>,
+        depth: u32,
+        acc: &Composite,
+        stats: &mut RayStats,
+    ) -> DVec3 {
+        if acc.done() {
+            return acc.colour;
+        }
+        let c = match hit {
             None => self.background,
             Some(h) => {
                 stats.hits += 1;
                 self.shade(ray, &h, depth, stats)
             }
-        }
+        };
+        acc.over(c)
     }
 
     /// Traces up to eight primary rays (a 4×2 pixel block; `None` lanes lie
@@ -491,22 +520,21 @@ impl<'s> Tracer<'s> {
     /// Stage two of a primary ray: resolve its walk and shade the hit.
     fn primary(&self, r: &Ray, w: &mut FirstWalk, stats: &mut RayStats) -> DVec3 {
         stats.primary += 1;
-        match self.resolve(r, w, 0.0, None, stats) {
-            None => self.background,
-            Some(h) => {
-                stats.hits += 1;
-                self.shade(r, &h, 1, stats)
-            }
-        }
+        let mut acc = Composite::default();
+        let hit = self.resolve(r, w, 0.0, None, &mut acc, stats);
+        self.behind(r, hit, 1, &acc, stats)
     }
 
     /// The surface a primary ray (unit direction) hits, resolved as the
     /// renderer resolves it (the discrete hit, or under verification the
     /// nearest exact intersection), without shading; `None` when it leaves
-    /// the raster. Counts go to `stats` as for a traced ray.
+    /// the raster or the volumes rendered directly in front of the surface
+    /// are opaque enough to end it. Counts go to `stats` as for a traced
+    /// ray.
     pub fn hit(&self, ray: &Ray, stats: &mut RayStats) -> Option<RayHit> {
         let mut walk = self.first_walk(ray);
-        self.resolve(ray, &mut walk, 0.0, None, stats)
+        let mut acc = Composite::default();
+        self.resolve(ray, &mut walk, 0.0, None, &mut acc, stats)
             .map(|h| RayHit {
                 object: h.object,
                 t: h.t,
