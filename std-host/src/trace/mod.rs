@@ -86,6 +86,39 @@
 //! objects still reflect and shadow themselves beyond the two-voxel slab
 //! in that mode.
 //!
+//! # Direct volume rendering
+//! A volume rendered directly ([`Render::Direct`](crate::assets::volume::Render))
+//! has every voxel whose sample has an opacity above 0 in the raster
+//! ([`crate::voxelize::direct`]), so walks stop there and skip the empty
+//! space around it; such a voxel is never a hit. Its sample (the volume's
+//! value at the voxel centre) is classified by the transfer function and
+//! composited front to back ([`composite::Composite`]:
+//! `C += (1 − A)·α·c`, `A += (1 − A)·α`) by every ray that visits it: eye,
+//! reflected and refracted rays. `α` is the transfer function's opacity
+//! corrected for the length `ℓ` of the ray the sample stands for,
+//! `1 − (1 − α)^(ℓ / spacing)` (the opacity is that of one sample spacing
+//! of the data): for six-connected and adaptive walks, which visit every
+//! voxel of the volume the line passes through, `ℓ` is the ray's chord
+//! through the voxel (so the lengths add up to the length crossed, on
+//! axis or diagonal steps alike); for 26-connected walks, one voxel per
+//! slice across the driving axis, the ray's length across a slice. A
+//! sample is shaded as a surface whose normal is the gray-level gradient
+//! (central differences of the neighbouring voxels' samples, the volume's
+//! material, lit by every light it faces, no shadows) where the gradient
+//! is strong ([`composite::STRONG_GRADIENT`]) and shows its transfer
+//! colour where the gray levels are flat, in between in proportion.
+//! Compositing stops when the opacity reaches
+//! [`composite::OPAQUE_ENOUGH`] (0.99; what lies behind would add at most
+//! 1 % of its colour, and no further ray is traced). Otherwise the
+//! surface the walk ends on is shaded as usual and seen through what was
+//! composited, `C + (1 − A)·colour`; a surface inside the volume ends the
+//! compositing at its depth (the voxel holding the hit contributes its
+//! chord up to the hit). In the exact mode, shadow rays take the
+//! transmittance `1 − α` of every voxel of such a volume they cross; in
+//! the verified and paper modes the precomputed light bits count its
+//! voxels as opaque. Everything is computed per ray in a fixed order, so
+//! images are byte-identical for every thread count.
+//!
 //! # Packets
 //! [`Tracer::trace_block`] traces eight primary rays (a 4×2 pixel block)
 //! in two stages: first every ray is walked to its first non-transparent
