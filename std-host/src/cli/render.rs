@@ -154,7 +154,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         let rays = stats.rays().max(1);
         writeln!(
             out,
-            "{}: {w}×{h}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit, {:.1} steps/shadow ray); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays)",
+            "{}: {w}×{h}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit, {:.1} steps/shadow ray); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays){}",
             args.output.display(),
             d[0],
             d[1],
@@ -175,6 +175,11 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             stats.false_hits,
             100.0 * stats.false_hit_rays as f64
                 / (stats.primary + stats.reflected + stats.refracted).max(1) as f64,
+            if stats.samples > 0 {
+                format!("; {} volume samples composited", stats.samples)
+            } else {
+                String::new()
+            },
         )?;
     }
     Ok(())
