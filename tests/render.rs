@@ -167,6 +167,87 @@ fn png_is_identical_for_every_thread_count() {
     }
 }
 
+/// A volume rendered directly, mixed with a sphere and a mirror (eye,
+/// reflected and shadow rays composite it): the image is byte-identical for
+/// 1, 2 and 3 threads, in every mode, and the volume is composited.
+#[test]
+fn direct_volume_png_is_identical_for_every_thread_count() {
+    let d = temp_dir("dvr-threads");
+    let p = d.join("dvr.toml");
+    std::fs::write(
+        &p,
+        r#"
+[camera]
+from = [3, 4, 2.5]
+at = [0, 0, 0.5]
+angle = 40
+resolution = [40, 30]
+
+[[light]]
+position = [4, 3, 6]
+
+[material.cloud]
+colour = [0.9, 0.6, 0.3]
+ks = 0.2
+shine = 10
+
+[material.ball]
+colour = [0.2, 0.5, 0.9]
+
+[material.mirror]
+colour = [0.2, 0.2, 0.2]
+kd = 0.2
+ks = 0.8
+
+[volume.cloud]
+metaballs = { dims = [24, 24, 24], min = [-1, -1, 0], max = [1, 1, 2], balls = [[-0.3, 0, 0.8, 0.8, 1], [0.4, 0.2, 1.2, 0.6, 1]] }
+opacity = [[0.2, 0], [0.5, 0.1], [1.5, 0.6]]
+colours = [[0.2, 1, 0.8, 0.5], [1.5, 0.9, 0.3, 0.2]]
+
+[[object]]
+material = "cloud"
+volume = "cloud"
+
+[[object]]
+material = "ball"
+sphere = { centre = [0.2, 0.1, 0.9], radius = 0.35 }
+
+[[object]]
+material = "mirror"
+polygon = [[-2, -1.5, 0], [2, -1.5, 0], [2, -1.5, 2.5], [-2, -1.5, 2.5]]
+"#,
+    )
+    .unwrap();
+    let scene = Scene::load(&p).unwrap();
+    assert!(scene.volumes[0].data.classifier.is_direct());
+    let exact = voxelize_exact(&scene, 64);
+    let paper = voxelize(&scene, 64, Connectivity::Adaptive);
+    assert_eq!(exact.direct.len(), 1);
+    for (mode, vs) in [
+        (Mode::Exact, &exact),
+        (Mode::Verified, &exact),
+        (Mode::Paper, &paper),
+    ] {
+        let trace = TraceOptions {
+            mode,
+            ..TraceOptions::default()
+        };
+        let (one, s1) = draw(vs, 40, 30, trace, 2, 1);
+        assert!(s1.samples > 0 && s1.reflected > 0, "{mode:?}: {s1:?}");
+        let png1 = png_bytes(&one).unwrap();
+        for threads in [2, 3] {
+            let (img, s) = draw(vs, 40, 30, trace, 2, threads);
+            assert_eq!(
+                png_bytes(&img).unwrap(),
+                png1,
+                "{threads} threads, {mode:?}"
+            );
+            assert_eq!(img.linear, one.linear, "{threads} threads, {mode:?}");
+            assert_eq!(s, s1);
+        }
+    }
+}
+
 /// `rrt voxelize` then `rrt render FILE.rrt` writes the same PNG as
 /// `rrt render SCENE` with the same raster; view overrides apply to a saved
 /// raster; `rrt info` reports it.

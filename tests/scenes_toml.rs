@@ -853,6 +853,46 @@ fn every_bad_value_is_located_at_itself() {
             "alpha in [0, 1]",
         ),
         (
+            "opacity order",
+            volume("render = \"direct\"\nopacity = [[0, 0], [0.5, 0.1], [0.5, 0.2]]"),
+            "0.5, 0.2",
+            "volume.v.opacity[2][0]",
+            "increase along the ramp",
+        ),
+        (
+            "opacity range",
+            volume("render = \"direct\"\nopacity = [[0, 0], [0.5, -0.1]]"),
+            "[0.5, -0.1]",
+            "volume.v.opacity[1]",
+            "alpha in [0, 1]",
+        ),
+        (
+            "render",
+            volume("opacity = [[0, 0], [1, 0.5]]\nrender = \"cloud\""),
+            "\"cloud\"",
+            "volume.v.render",
+            "expected \"iso\" or \"direct\"",
+        ),
+        (
+            "render without a transfer function",
+            volume("iso = 0.5\nrender = \"direct\""),
+            "\"direct\"",
+            "volume.v.render",
+            "needs a transfer function",
+        ),
+        (
+            "direct CSG leaf",
+            second_object(
+                "csg = { difference = [\"a\", \"b\"] }",
+                &format!(
+                    "{metaballs}opacity = [[0, 0], [1, 0.5]]\n[solid.a]\nvolume = \"v\"\n[solid.b]\nbox = {{ min = [0,0,0], max = [1,1,1] }}\n"
+                ),
+            ),
+            "\"v\"\n[solid.b]",
+            "solid.a.volume",
+            "a CSG leaf takes an iso-surface volume",
+        ),
+        (
             "colours",
             volume("iso = 0.5\ncolours = [[1, 0, 0, 0], [0.5, 1, 1, 1]]"),
             "0.5, 1",

@@ -195,6 +195,7 @@ pub fn build(
             }],
             background: DVec3::new(0.078, 0.361, 0.753),
             view,
+            direct: Vec::new(),
         },
         voxelize,
         lights: lights_time,

@@ -5,6 +5,7 @@
 //! ```sh
 //! RUSTFLAGS="-C target-cpu=x86-64-v3" cargo run --release -p rrt-benches --bin paper -- --out BENCHMARKS.md
 //! cargo run --release -p rrt-benches --bin paper -- --quick --out /tmp/b.md   # tiny, < 1 min
+//! cargo run --release -p rrt-benches --bin paper -- --section dvr --out /tmp/dvr.md   # one section
 //! ```
 //!
 //! The peers are compiled with `-march=native`; `x86-64-v3` (AVX2, FMA,
@@ -18,6 +19,7 @@
 mod arts;
 mod common;
 mod connectivity;
+mod dvr;
 mod embree;
 mod head;
 mod plot;
@@ -62,6 +64,10 @@ struct Args {
     /// Seed of the random sphere scenes.
     #[arg(long, default_value_t = 1992)]
     seed: u64,
+    /// Run only this section (repeatable): table1, table2, connectivity,
+    /// verification, skipping, embree, dvr, whole [default: all].
+    #[arg(long = "section", value_name = "NAME")]
+    sections: Vec<String>,
 }
 
 fn main() {
@@ -113,16 +119,29 @@ fn run() -> Res<()> {
     let mut body = Md::default();
     std::mem::swap(&mut body, &mut ctx.md);
 
-    let sections: [(&str, Section); 7] = [
-        ("Table 1", table1::table1),
-        ("Table 2", table2::table2),
-        ("connectivity", connectivity::connectivity),
-        ("verification", verification::verification),
-        ("skipping", skipping::skipping),
-        ("Embree", embree::embree),
-        ("whole job", whole::whole),
+    let sections: [(&str, &str, Section); 8] = [
+        ("Table 1", "table1", table1::table1),
+        ("Table 2", "table2", table2::table2),
+        ("connectivity", "connectivity", connectivity::connectivity),
+        ("verification", "verification", verification::verification),
+        ("skipping", "skipping", skipping::skipping),
+        ("Embree", "embree", embree::embree),
+        ("direct volume rendering", "dvr", dvr::dvr),
+        ("whole job", "whole", whole::whole),
     ];
-    for (name, section) in sections {
+    if let Some(bad) = args
+        .sections
+        .iter()
+        .find(|s| !sections.iter().any(|(_, key, _)| key == s))
+    {
+        return Err(format!(
+            "--section {bad}: expected one of {}",
+            sections.map(|(_, key, _)| key).join(", ")
+        )
+        .into());
+    }
+    let chosen = |key: &str| args.sections.is_empty() || args.sections.iter().any(|s| s == key);
+    for (name, _, section) in sections.into_iter().filter(|(_, key, _)| chosen(key)) {
         ctx.log(&format!("{name} …"));
         let t = Instant::now();
         if let Err(e) = section(&mut ctx) {
@@ -169,6 +188,12 @@ fn run() -> Res<()> {
         },
         ctx.cfg.reps
     ));
+    if !args.sections.is_empty() {
+        md.para(&format!(
+            "**Sections run**: {} (`--section`); the others are not in this file.",
+            args.sections.join(", ")
+        ));
+    }
     if ctx.cfg.quick {
         md.para("**Quick mode**: tiny rasters and images, for checking the command only; these figures mean nothing.");
     }

@@ -409,7 +409,24 @@ pub fn load_or_build(
             return Err(e);
         }
     };
-    if let Err(e) = check_view(&scene.view).and_then(|()| check_bounds(&scene, raster)) {
+    let check_save = || {
+        // A saved raster cannot hold a volume rendered directly: said
+        // before voxelizing.
+        match scene.volumes.iter().find(|v| v.data.classifier.is_direct()) {
+            Some(v) if purpose == Purpose::Save => Err(CliError::Arg {
+                arg: "SCENE",
+                message: format!(
+                    "{}: a volume rendered directly (render = \"direct\") cannot be saved in a raster file; render the scene itself, or give the volume render = \"iso\"",
+                    v.loc
+                ),
+            }),
+            _ => Ok(()),
+        }
+    };
+    if let Err(e) = check_view(&scene.view)
+        .and_then(|()| check_bounds(&scene, raster))
+        .and_then(|()| check_save())
+    {
         bar.finish_and_clear();
         return Err(e);
     }

@@ -288,7 +288,7 @@ fn summary(
     let rays = stats.rays().max(1);
     writeln!(
         out,
-        "{}: {size}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit, {:.1} steps/shadow ray); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays)",
+        "{}: {size}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit, {:.1} steps/shadow ray); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays){}",
         path.display(),
         d[0],
         d[1],
@@ -309,6 +309,11 @@ fn summary(
         stats.false_hits,
         100.0 * stats.false_hit_rays as f64
             / (stats.primary + stats.reflected + stats.refracted).max(1) as f64,
+        if stats.samples > 0 {
+            format!("; {} volume samples composited", stats.samples)
+        } else {
+            String::new()
+        },
     )?;
     Ok(())
 }

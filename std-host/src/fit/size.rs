@@ -108,7 +108,8 @@ pub struct RasterNeed<'v> {
 /// which voxels do not crowd ([`CROWDING`]). Where voxels are the picture (the paper's mode;
 /// volumes, `.vox` models and CSG results, which have no exact geometry),
 /// a voxel is in addition no larger than a pixel's footprint at the
-/// scene's nearest point to the eye.
+/// scene's nearest point to the eye. With volumes rendered directly, a
+/// voxel is no smaller than their finest sample spacing.
 #[must_use]
 pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
     let bounds = scene.bounds();
@@ -136,6 +137,21 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
         !(scene.volumes.is_empty() && scene.voxes.is_empty() && scene.csgs.is_empty());
     if need.discrete || voxel_objects {
         r = r.max(pixel_raster(&bounds, longest, need));
+    }
+    // Volumes rendered directly are pictures of their samples: voxels
+    // finer than the finest sample spacing add records, not detail.
+    let spacing = scene
+        .volumes
+        .iter()
+        .filter(|v| v.data.classifier.is_direct())
+        .map(|v| v.data.sample_spacing())
+        .fold(f64::INFINITY, f64::min);
+    if spacing > 0.0 && spacing.is_finite() {
+        let samples = (longest / spacing).ceil() + f64::from(2 * DEFAULT_MARGIN);
+        if samples < f64::from(r) {
+            // Below r ≤ 2^16.
+            r = samples as u32;
+        }
     }
     r.clamp(lo, hi)
 }

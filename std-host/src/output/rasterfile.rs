@@ -163,6 +163,14 @@ pub enum RasterFileError {
         /// Which section (or the header).
         section: &'static str,
     },
+    /// The scene holds what the format cannot store.
+    #[error("{}: cannot save {what} in a raster file; render the scene itself", path.display())]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// What cannot be saved.
+        what: String,
+    },
     /// The contents break an invariant.
     #[error("{}: corrupt: {what}", path.display())]
     Invalid {
@@ -383,6 +391,15 @@ pub fn save_to(
     progress: &ProgressBar,
 ) -> Result<u64, RasterFileError> {
     let path = &out.target().to_path_buf();
+    if let Some(d) = scene.direct.first() {
+        return Err(RasterFileError::Unsupported {
+            path: path.clone(),
+            what: format!(
+                "a volume rendered directly (object {}: its samples and transfer function)",
+                d.object
+            ),
+        });
+    }
     let io = |what| {
         move |source| RasterFileError::Io {
             path: path.to_path_buf(),
@@ -1004,6 +1021,7 @@ pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, Rast
         lights,
         background: m.background,
         view: m.view,
+        direct: Vec::new(),
     })
 }
 

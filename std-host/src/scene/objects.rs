@@ -42,6 +42,18 @@ impl SceneVolume {
     pub fn world_bounds(&self) -> Bounds {
         self.placed().world_bounds()
     }
+
+    /// The smallest world distance between neighbouring samples (along
+    /// one of the data's axes): the length the opacities of direct volume
+    /// rendering are for.
+    #[must_use]
+    pub fn sample_spacing(&self) -> f64 {
+        let m = self.placed().index_to_world_matrix();
+        [m.x_axis, m.y_axis, m.z_axis]
+            .map(DVec3::length)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
 }
 
 /// A sampled or computed volume as an object: its boundary layer, normals

@@ -86,6 +86,39 @@
 //! objects still reflect and shadow themselves beyond the two-voxel slab
 //! in that mode.
 //!
+//! # Direct volume rendering
+//! A volume rendered directly ([`Render::Direct`](crate::assets::volume::Render))
+//! has every voxel whose sample has an opacity above 0 in the raster
+//! ([`crate::voxelize::direct`]), so walks stop there and skip the empty
+//! space around it; such a voxel is never a hit. Its sample (the volume's
+//! value at the voxel centre) is classified by the transfer function and
+//! composited front to back ([`composite::Composite`]:
+//! `C += (1 − A)·α·c`, `A += (1 − A)·α`) by every ray that visits it: eye,
+//! reflected and refracted rays. `α` is the transfer function's opacity
+//! corrected for the length `ℓ` of the ray the sample stands for,
+//! `1 − (1 − α)^(ℓ / spacing)` (the opacity is that of one sample spacing
+//! of the data): for six-connected and adaptive walks, which visit every
+//! voxel of the volume the line passes through, `ℓ` is the ray's chord
+//! through the voxel (so the lengths add up to the length crossed, on
+//! axis or diagonal steps alike); for 26-connected walks, one voxel per
+//! slice across the driving axis, the ray's length across a slice. A
+//! sample is shaded as a surface whose normal is the gray-level gradient
+//! (central differences of the neighbouring voxels' samples, the volume's
+//! material, lit by every light it faces, no shadows) where the gradient
+//! is strong ([`composite::STRONG_GRADIENT`]) and shows its transfer
+//! colour where the gray levels are flat, in between in proportion.
+//! Compositing stops when the opacity reaches
+//! [`composite::OPAQUE_ENOUGH`] (0.99; what lies behind would add at most
+//! 1 % of its colour, and no further ray is traced). Otherwise the
+//! surface the walk ends on is shaded as usual and seen through what was
+//! composited, `C + (1 − A)·colour`; a surface inside the volume ends the
+//! compositing at its depth (the voxel holding the hit contributes its
+//! chord up to the hit). In the exact mode, shadow rays take the
+//! transmittance `1 − α` of every voxel of such a volume they cross; in
+//! the verified and paper modes the precomputed light bits count its
+//! voxels as opaque. Everything is computed per ray in a fixed order, so
+//! images are byte-identical for every thread count.
+//!
 //! # Packets
 //! [`Tracer::trace_block`] traces eight primary rays (a 4×2 pixel block)
 //! in two stages: first every ray is walked to its first non-transparent
@@ -107,6 +140,7 @@
 //! 64 plane cells, small enough to stay in cache). [`RayStats::steps`]
 //! counts voxels visited, a jump as one.
 
+pub mod composite;
 pub mod shade;
 pub mod shading;
 pub mod verify;
@@ -119,6 +153,7 @@ use rrt_core::raster::{Extent, Raster};
 use rrt_core::store::RecordStore;
 use rrt_core::voxel::VoxelRecord;
 
+pub use self::composite::Composite;
 pub use self::verify::{Verdict, verify};
 pub use self::walk::FirstWalk;
 
@@ -257,6 +292,8 @@ pub struct RayStats {
     pub deferred: u64,
     /// Opaque cells without a record (a damaged raster), stepped over.
     pub missing: u64,
+    /// Samples of volumes rendered directly composited along rays.
+    pub samples: u64,
 }
 
 impl RayStats {
@@ -275,6 +312,7 @@ impl RayStats {
         self.shared_hits += o.shared_hits;
         self.false_hit_rays += o.false_hit_rays;
         self.missing += o.missing;
+        self.samples += o.samples;
     }
 
     /// All rays traced.
@@ -347,6 +385,8 @@ pub struct Tracer<'s> {
     materials: &'s [Material],
     lights: &'s [WorldLight],
     lights_fx: Vec<Option<[i64; 3]>>,
+    /// The volumes rendered directly, by object id.
+    direct: &'s [crate::voxelize::direct::DirectVolume],
     /// The records of exact objects hold the shadow classification, and
     /// the shadow segments stay close enough to the ones it covers
     /// ([`Tracer::exact_light`]) to use it.
@@ -419,6 +459,7 @@ impl<'s> Tracer<'s> {
             materials: &scene.materials,
             lights: &scene.lights,
             lights_fx,
+            direct: &scene.direct,
             classified: scene.exact
                 && scene.exact_records == ExactRecords::Classify
                 && surface_offset(&scene.frame) < scene.frame.voxel_size / 8.0,
@@ -452,13 +493,34 @@ impl<'s> Tracer<'s> {
             // t > tmin: no voxel is skipped by the acne rule on the way.
             _ => self.first_walk(ray),
         };
-        match self.resolve(ray, &mut walk, tmin, leave, stats) {
+        let mut acc = Composite::default();
+        let hit = self.resolve(ray, &mut walk, tmin, leave, &mut acc, stats);
+        self.behind(ray, hit, depth, &acc, stats)
+    }
+
+    /// The colour of a ray whose walk composited `acc` and ended on `hit`
+    /// (or left the raster): the hit shaded, or the background, seen
+    /// through what was composited (nothing more once compositing
+    /// stopped).
+    fn behind(
+        &self,
+        ray: &Ray,
+        hit: Option<SurfaceHit>,
+        depth: u32,
+        acc: &Composite,
+        stats: &mut RayStats,
+    ) -> DVec3 {
+        if acc.done() {
+            return acc.colour;
+        }
+        let c = match hit {
             None => self.background,
             Some(h) => {
                 stats.hits += 1;
                 self.shade(ray, &h, depth, stats)
             }
-        }
+        };
+        acc.over(c)
     }
 
     /// Traces up to eight primary rays (a 4×2 pixel block; `None` lanes lie
@@ -491,22 +553,21 @@ impl<'s> Tracer<'s> {
     /// Stage two of a primary ray: resolve its walk and shade the hit.
     fn primary(&self, r: &Ray, w: &mut FirstWalk, stats: &mut RayStats) -> DVec3 {
         stats.primary += 1;
-        match self.resolve(r, w, 0.0, None, stats) {
-            None => self.background,
-            Some(h) => {
-                stats.hits += 1;
-                self.shade(r, &h, 1, stats)
-            }
-        }
+        let mut acc = Composite::default();
+        let hit = self.resolve(r, w, 0.0, None, &mut acc, stats);
+        self.behind(r, hit, 1, &acc, stats)
     }
 
     /// The surface a primary ray (unit direction) hits, resolved as the
     /// renderer resolves it (the discrete hit, or under verification the
     /// nearest exact intersection), without shading; `None` when it leaves
-    /// the raster. Counts go to `stats` as for a traced ray.
+    /// the raster or the volumes rendered directly in front of the surface
+    /// are opaque enough to end it. Counts go to `stats` as for a traced
+    /// ray.
     pub fn hit(&self, ray: &Ray, stats: &mut RayStats) -> Option<RayHit> {
         let mut walk = self.first_walk(ray);
-        self.resolve(ray, &mut walk, 0.0, None, stats)
+        let mut acc = Composite::default();
+        self.resolve(ray, &mut walk, 0.0, None, &mut acc, stats)
             .map(|h| RayHit {
                 object: h.object,
                 t: h.t,

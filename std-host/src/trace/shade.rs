@@ -335,6 +335,7 @@ impl Tracer<'_> {
         let materials = self.materials;
         let objects = self.objects;
         let tmin = 0.0;
+        let o_r = self.frame.world_to_raster(segment.origin);
         let mut att = 1.0;
         let mut mail = Mailbox::default();
         // The surface left, where it cannot meet the ray again, is tested
@@ -359,6 +360,17 @@ impl Tracer<'_> {
                         return false;
                     };
                     for &id in store.objects(b) {
+                        if let Some(d) = self.direct_volume(id) {
+                            // A volume rendered directly lets its
+                            // transmittance through (its voxels are on the
+                            // line: index has coordinates).
+                            let v = extent.coord(index).unwrap_or([0; 3]);
+                            att *= self.transmittance_through(segment, o_r, v, d, tmax);
+                            if att <= 1.0 - super::composite::OPAQUE_ENOUGH {
+                                return true;
+                            }
+                            continue;
+                        }
                         let Some(obj) = usize::try_from(id).ok().and_then(|i| objects.get(i))
                         else {
                             continue;

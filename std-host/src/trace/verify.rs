@@ -246,6 +246,10 @@ impl Tracer<'_> {
             let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) else {
                 continue;
             };
+            // A volume rendered directly is composited, never hit.
+            if self.direct_volume(id).is_some() {
+                continue;
+            }
             let found = if obj.shape.is_exact() {
                 if mail.tested(id) {
                     continue;

@@ -14,7 +14,7 @@ use rrt_core::store::RecordStore;
 use rrt_core::voxel::VoxelRecord;
 
 use super::verify::{Candidate, Mailbox, REACH_MARGIN, exit_param, slab};
-use super::{BLOCK, RayStats, SurfaceHit, Tracer};
+use super::{BLOCK, Composite, RayStats, SurfaceHit, Tracer};
 use crate::frame::round_to_i64;
 use crate::world::Ray;
 
@@ -191,13 +191,14 @@ impl Tracer<'_> {
         walk: &mut FirstWalk,
         tmin: f64,
         leave: Option<&LeavingSurface>,
+        acc: &mut Composite,
         stats: &mut RayStats,
     ) -> Option<SurfaceHit> {
         let before = stats.false_hits;
         let hit = if self.opts.mode.verifies() {
-            self.resolve_verified(ray, walk, tmin, leave, stats)
+            self.resolve_verified(ray, walk, tmin, leave, acc, stats)
         } else {
-            self.resolve_walk(ray, walk, tmin, leave, stats)
+            self.resolve_walk(ray, walk, tmin, leave, acc, stats)
         };
         if stats.false_hits > before {
             stats.false_hit_rays += 1;
@@ -205,13 +206,16 @@ impl Tracer<'_> {
         hit
     }
 
-    /// The paper's raw mode: the first surface voxel is the hit.
+    /// The paper's raw mode: the first surface voxel is the hit; a voxel
+    /// a volume rendered directly owns is composited into `acc` and
+    /// passed (`None` once compositing stops).
     pub(super) fn resolve_walk(
         &self,
         ray: &Ray,
         walk: &mut FirstWalk,
         tmin: f64,
         leave: Option<&LeavingSurface>,
+        acc: &mut Composite,
         stats: &mut RayStats,
     ) -> Option<SurfaceHit> {
         stats.steps += walk.steps;
@@ -233,7 +237,17 @@ impl Tracer<'_> {
             };
             match &rec {
                 None => stats.missing += 1,
-                Some(rec) => return Some(self.discrete_hit(ray, o_r, h.voxel, rec, tmin)),
+                Some(rec) => match self.direct_of(rec) {
+                    Some(d) if self.store.owner(rec) == d.object => {
+                        if self.composite_voxel(ray, o_r, h.voxel, d, tmin, f64::INFINITY, acc) {
+                            stats.samples += 1;
+                            if acc.done() {
+                                return None;
+                            }
+                        }
+                    }
+                    _ => return Some(self.discrete_hit(ray, o_r, h.voxel, rec, tmin)),
+                },
             }
             // Resume after this voxel.
             let before = dray.steps();
@@ -265,13 +279,16 @@ impl Tracer<'_> {
     /// as its `t` is within the part of the ray the walk has reached (up to
     /// the continuous ray's exit from the current voxel, plus
     /// [`REACH_MARGIN`]); otherwise the walk goes on. A walk that leaves the
-    /// raster with a candidate takes it.
+    /// raster with a candidate takes it. The sample of a voxel of a volume
+    /// rendered directly is composited into `acc` up to the candidate
+    /// accepted in it, if any (`None` once compositing stops).
     pub(super) fn resolve_verified(
         &self,
         ray: &Ray,
         walk: &mut FirstWalk,
         tmin: f64,
         leave: Option<&LeavingSurface>,
+        acc: &mut Composite,
         stats: &mut RayStats,
     ) -> Option<SurfaceHit> {
         stats.steps += walk.steps;
@@ -294,9 +311,28 @@ impl Tracer<'_> {
                         ray, o_r, h.voxel, h.index, rec, tmin, leave, &mut mail, &mut best,
                     );
                     let reach = (exit_param(o_r, ray.dir, h.voxel) + REACH_MARGIN) * vs;
+                    let here = best.as_ref().filter(|b| b.t <= reach).map(|b| b.t);
+                    let direct = self.direct_of(rec);
+                    if let Some(d) = direct
+                        && self.composite_voxel(
+                            ray,
+                            o_r,
+                            h.voxel,
+                            d,
+                            tmin,
+                            here.unwrap_or(f64::INFINITY),
+                            acc,
+                        )
+                    {
+                        stats.samples += 1;
+                        if acc.done() {
+                            return None;
+                        }
+                    }
                     match &best {
                         Some(b) if b.t <= reach => return Some(self.accept(ray, b, stats)),
                         Some(_) => stats.deferred += 1,
+                        None if direct.is_some() => {}
                         None => stats.false_hits += 1,
                     }
                 }

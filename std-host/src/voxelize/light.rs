@@ -31,6 +31,9 @@ const LIGHT_RUN: usize = 1 << 14;
 /// entries, material table and lights.
 pub(super) struct LightScene {
     entries: Vec<Object>,
+    /// Per object id: a volume rendered directly, whose records need no
+    /// light (its samples are lit when composited).
+    unlit: Vec<bool>,
     materials: Box<Materials<MAX_MATERIALS>>,
     lights: Lights,
 }
@@ -60,6 +63,10 @@ impl LightScene {
                     shape: o.entry(),
                     material: materials.of(o.material()),
                 })
+                .collect(),
+            unlit: objects
+                .iter()
+                .map(|o| matches!(o, TableObject::Volume(v) if v.data.classifier.is_direct()))
                 .collect(),
             materials: materials.core(),
             lights: core_lights,
@@ -91,18 +98,39 @@ impl LightScene {
                 .enumerate()
                 .map(|(i, run)| {
                     let n = run.len() as u64;
-                    let r = illuminate_run(
-                        raster,
-                        store,
-                        i * LIGHT_RUN,
-                        run,
-                        &table,
-                        &self.materials,
-                        &self.lights,
-                        params,
-                    );
+                    let mut report = LightReport::default();
+                    // The records of volumes rendered directly are left
+                    // as they are: the rest in runs between them.
+                    let mut start = 0;
+                    while start < run.len() {
+                        let lit = |r: &VoxelRecord| {
+                            let id = usize::try_from(store.owner(r)).unwrap_or(usize::MAX);
+                            !self.unlit.get(id).copied().unwrap_or(false)
+                        };
+                        let rest = run.get(start..).unwrap_or(&[]);
+                        let skip = rest.iter().take_while(|r| !lit(r)).count();
+                        start += skip;
+                        let rest = run.get(start..).unwrap_or(&[]);
+                        let len = rest.iter().take_while(|r| lit(r)).count();
+                        if len == 0 {
+                            continue;
+                        }
+                        if let Some(sub) = run.get_mut(start..start + len) {
+                            report.add(&illuminate_run(
+                                raster,
+                                store,
+                                i * LIGHT_RUN + start,
+                                sub,
+                                &table,
+                                &self.materials,
+                                &self.lights,
+                                params,
+                            )?);
+                        }
+                        start += len;
+                    }
                     progress.inc(n);
-                    r
+                    Ok(report)
                 })
                 .collect()
         });

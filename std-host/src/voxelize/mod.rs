@@ -37,6 +37,7 @@
 //! file ([`crate::output::rasterfile`]) both start from it.
 
 pub mod csg;
+pub mod direct;
 pub mod light;
 pub mod materials;
 pub mod objects;
@@ -368,6 +369,7 @@ pub fn build(
             material: materials.of(o.material()),
         })
         .collect();
+    let direct = direct_volumes(&objects, &frame, scene, opts.fit.max_memory)?;
     let world_lights = scene
         .lights
         .iter()
@@ -401,7 +403,35 @@ pub fn build(
             lights: world_lights,
             background: scene.background,
             view: scene.view.clone(),
+            direct,
         },
         report,
     ))
+}
+
+/// The samples and transfer functions of the volumes rendered directly
+/// ([`direct::DirectVolume`]), in object-id order.
+fn direct_volumes(
+    objects: &[objects::TableObject<'_>],
+    frame: &crate::frame::RasterFrame,
+    scene: &Scene,
+    max_bytes: u64,
+) -> Result<Vec<direct::DirectVolume>, BuildError> {
+    let mut out = Vec::new();
+    for (id, o) in objects.iter().enumerate() {
+        let objects::TableObject::Volume(v) = o else {
+            continue;
+        };
+        if !v.data.classifier.is_direct() {
+            continue;
+        }
+        let base = scene.materials.get(v.material).map_or([255; 3], |m| {
+            [m.colour.x, m.colour.y, m.colour.z].map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
+        });
+        let id = u32::try_from(id).map_err(|_| BuildError::Raster("too many objects".into()))?;
+        let d = direct::DirectVolume::new(id, &v.data, frame, base, max_bytes)
+            .map_err(|e| BuildError::Raster(format!("{}: volume: {e}", v.loc)))?;
+        out.extend(d);
+    }
+    Ok(out)
 }

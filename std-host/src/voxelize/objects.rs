@@ -13,7 +13,7 @@ use rrt_core::object_table as table;
 use rrt_core::voxelize::Separation;
 
 use super::pass::Pass;
-use super::{BuildError, csg, volume, vox};
+use super::{BuildError, csg, direct, volume, vox};
 use crate::fit::{Fitted, FittedObject};
 use crate::frame::RasterFrame;
 use crate::scene::{Csg, Scene, VolumeObject, VoxObject};
@@ -95,6 +95,9 @@ impl TableObject<'_> {
     ) -> Result<(), BuildError> {
         match *self {
             Self::Primitive(o) => primitive(o, frame, separation, pass),
+            Self::Volume(v) if v.data.classifier.is_direct() => {
+                direct::voxelize_object(v, frame, pass)
+            }
             Self::Volume(v) => volume::voxelize_object(v, frame, separation, None, pass),
             Self::Vox(v) => vox::voxelize_object(v, frame, pass),
             Self::Csg(c) => csg::voxelize_object(c, frame, separation, pass),

@@ -15,6 +15,7 @@ use rrt_core::store::{RecordStore, StoreError, write_rank_hints};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
+use super::direct::DirectVolume;
 use super::plane::Plane;
 use crate::frame::RasterFrame;
 use crate::scene::{Material, View, light_intensity};
@@ -63,6 +64,10 @@ pub struct VoxelScene {
     pub background: DVec3,
     /// The scene's view (the renderer may override it).
     pub view: View,
+    /// The volumes rendered directly, in object-id order: their samples
+    /// at the voxel centres and transfer functions (not saved: a saved
+    /// raster refuses them).
+    pub direct: Vec<DirectVolume>,
 }
 
 impl VoxelScene {
@@ -106,8 +111,8 @@ impl VoxelScene {
         light_intensity(self.lights.len())
     }
 
-    /// Bytes held by the plane, its line level, directory, records and
-    /// object lists.
+    /// Bytes held by the plane, its line level, directory, records,
+    /// object lists and the samples of volumes rendered directly.
     #[must_use]
     pub fn memory(&self) -> u64 {
         let dir = self.directory.len().saturating_mul(size_of::<u32>());
@@ -121,7 +126,13 @@ impl VoxelScene {
             .saturating_add(self.lines.len())
             .saturating_add(dir)
             .saturating_add(rec)
-            .saturating_add(self.lists.len().saturating_mul(size_of::<u32>()));
+            .saturating_add(self.lists.len().saturating_mul(size_of::<u32>()))
+            .saturating_add(
+                self.direct
+                    .iter()
+                    .map(|d| d.values.len().saturating_mul(size_of::<f32>()))
+                    .fold(0usize, usize::saturating_add),
+            );
         u64::try_from(bytes).unwrap_or(u64::MAX)
     }
 }

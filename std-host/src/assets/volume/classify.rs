@@ -28,6 +28,31 @@
 //! Colour ramps interpolate each 8-bit channel linearly and round to
 //! nearest; without one, a voxel gets the object's base colour.
 //!
+//! # Direct volume rendering
+//! A classifier with [`Render::Direct`] is not cut at all: its opacity
+//! ramp and colour ramp are the **transfer function** of direct volume
+//! rendering ([`Classifier::direct`]). A sample of value `v` has opacity
+//! [`Classifier::sample_opacity`]`(v)` (the ramp's, 0 below `iso`): the
+//! opacity of a slab of the material **one data sample spacing thick**
+//! (the placed volume's smallest sample spacing in the world). A ray that
+//! crosses a length `ℓ` of it takes the opacity `1 − (1 − α)^(ℓ / spacing)`,
+//! so the picture does not depend on the raster's resolution. Colours are
+//! the colour ramp's (or the object's material colour). Every voxel of
+//! opacity above 0 goes in the raster; the tracer composites the samples
+//! of the voxels a ray visits ([`crate::trace`], *Direct volume
+//! rendering*).
+//!
+//! ```
+//! use rrt_host::assets::volume::{Classifier, ColorRamp, Ramp, Render};
+//! // Air (below 40) clear, soft tissue faint, bone nearly opaque.
+//! let tf = Classifier::direct(Ramp::new(vec![(40.0, 0.0), (60.0, 0.05), (150.0, 0.05), (200.0, 0.9)]).unwrap())
+//!     .with_color(ColorRamp::new(vec![(40.0, [200, 90, 70]), (200.0, [255, 255, 240])]).unwrap());
+//! assert_eq!(tf.render, Render::Direct);
+//! assert_eq!(tf.sample_opacity(10.0), 0.0);
+//! assert_eq!(tf.sample_opacity(100.0), 0.05);
+//! assert_eq!(tf.color(200.0, [0; 3]), [255, 255, 240]);
+//! ```
+//!
 //! # Normals
 //! The core's volume voxelizer computes the normal of each boundary voxel
 //! from the gray-level gradient of its integer grid with the
@@ -174,7 +199,35 @@ impl ColorRamp {
     }
 }
 
-/// The classification of a volume (module docs).
+/// How a volume is rendered (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Render {
+    /// The iso-surface: the boundary of the non-transparent voxels
+    /// ([`Classifier::is_opaque`]), hit where a ray enters it.
+    #[default]
+    Iso,
+    /// Direct volume rendering: the samples of every voxel a ray passes
+    /// composited front to back through the transfer function (the
+    /// opacity and colour ramps, with partial opacity).
+    Direct,
+}
+
+impl Render {
+    /// The name in a scene file (`render = "iso"` or `"direct"`).
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Iso => "iso",
+            Self::Direct => "direct",
+        }
+    }
+}
+
+/// The classification of a volume (module docs): for an iso-surface the
+/// iso-value and the ramps that cut it; for direct volume rendering the
+/// transfer function (the opacity and colour ramps, points of
+/// `(value, opacity)` and `(value, colour)`), with `iso` a floor below
+/// which samples are clear.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Classifier {
     /// Samples at or above this value may be non-transparent.
@@ -183,6 +236,8 @@ pub struct Classifier {
     pub opacity: Option<Ramp>,
     /// Optional colour ramp.
     pub color: Option<ColorRamp>,
+    /// Iso-surface or direct volume rendering.
+    pub render: Render,
 }
 
 impl Classifier {
@@ -193,6 +248,46 @@ impl Classifier {
             iso,
             opacity: None,
             color: None,
+            render: Render::Iso,
+        }
+    }
+
+    /// Direct volume rendering with the opacity ramp `opacity` as the
+    /// transfer function's opacity (no floor: `iso` is `f64::MIN`) and the
+    /// base colour (add a colour ramp with [`Classifier::with_color`]).
+    #[must_use]
+    pub fn direct(opacity: Ramp) -> Self {
+        Self {
+            iso: f64::MIN,
+            opacity: Some(opacity),
+            color: None,
+            render: Render::Direct,
+        }
+    }
+
+    /// With the rendering `render`.
+    #[must_use]
+    pub const fn with_render(mut self, render: Render) -> Self {
+        self.render = render;
+        self
+    }
+
+    /// Whether the volume is rendered directly ([`Render::Direct`]).
+    #[must_use]
+    pub fn is_direct(&self) -> bool {
+        self.render == Render::Direct
+    }
+
+    /// The transfer function's opacity of a sample of value `v` (direct
+    /// volume rendering): 0 below `iso` or for NaN, else the opacity
+    /// ramp's (1 without one). The opacity of a slab one data sample
+    /// spacing thick.
+    #[must_use]
+    pub fn sample_opacity(&self, v: f64) -> f64 {
+        if v >= self.iso {
+            self.opacity_at(v)
+        } else {
+            0.0
         }
     }
 

@@ -46,7 +46,7 @@ pub mod nrrd;
 pub mod raw;
 pub mod resample;
 
-pub use classify::{Classifier, ColorRamp, Ramp};
+pub use classify::{Classifier, ColorRamp, Ramp, Render};
 pub use resample::{PlacedVolume, Placement, SAMPLE_MAX};
 
 /// Default limit on the bytes of samples one volume may take (4 GiB).

@@ -133,13 +133,24 @@ impl Builder<'_> {
         } else if let Some(t) = &d.torus {
             Solid::Torus(self.torus(t, &s, &format!("{key}.torus"))?)
         } else if let Some(v) = &d.volume {
-            Solid::Volume(self.volumes.get(v.get_ref()).cloned().ok_or_else(|| {
+            let vol = self.volumes.get(v.get_ref()).cloned().ok_or_else(|| {
                 self.err(
                     v.span(),
                     &format!("{key}.volume"),
                     format!("no [volume.{}] in this scene", v.get_ref()),
                 )
-            })?)
+            })?;
+            if vol.classifier.is_direct() {
+                return Err(self.err(
+                    v.span(),
+                    &format!("{key}.volume"),
+                    format!(
+                        "[volume.{}] is rendered directly (render = \"direct\"); a CSG leaf takes an iso-surface volume (render = \"iso\")",
+                        v.get_ref()
+                    ),
+                ));
+            }
+            Solid::Volume(vol)
         } else {
             return Err(self.err(s, &key, "no shape"));
         };

@@ -15,7 +15,7 @@
 //! | `bezier = { file, steps }` | the bicubic patches of a `.bpt` file, each tessellated into `steps × steps` quads with the patch's exact normals (NFF `pp`) |
 //! | `mesh = { file, smooth }` | an OBJ triangle mesh (`tobj`); `smooth` interpolates the file's (or averaged) vertex normals |
 //! | `nff = "file.nff"` | every object, light and material of an NFF file (its view is ignored) |
-//! | `volume = "NAME"` | a volume of `[volume.NAME]`: its iso-surface, gray-level normals |
+//! | `volume = "NAME"` | a volume of `[volume.NAME]`: its iso-surface with gray-level normals, or direct volume rendering (`render` below) |
 //! | `vox = { file, position, cell }` | a MagicaVoxel model |
 //! | `csg = { difference = ["a", { union = ["b", "c"] }] }` | a CSG tree over `[solid.NAME]`s |
 //!
@@ -30,6 +30,17 @@
 //! other operand has no volume (the paper's box cut out of the head): the
 //! volume's voxels inside (or outside) the other operand count as
 //! transparent before its boundary is found.
+//!
+//! A `[volume.NAME]` takes `iso`, `opacity = [[value, alpha], …]` and
+//! `colours = [[value, r, g, b], …]` (values strictly increasing, alpha
+//! and channels in 0–1) and `render = "iso" | "direct"`. `"iso"` draws
+//! the iso-surface, the opacity ramp cutting it at ½; `"direct"` composites
+//! the samples with the ramps as the transfer function
+//! ([`crate::assets::volume::classify`], *Direct volume rendering*) and
+//! needs `opacity`. Without `render`, a volume is rendered directly when an
+//! opacity point lies strictly between 0 and 1 (a partial opacity only
+//! direct rendering can show) and as an iso-surface otherwise. A volume
+//! rendered directly cannot be a CSG leaf.
 //!
 //! # Errors
 //! Unknown keys (`deny_unknown_fields`), wrong types, missing keys, bad

@@ -173,6 +173,10 @@ pub(super) struct VolumeDef {
     pub(super) opacity: Option<Vec<[f64; 2]>>,
     #[serde(default)]
     pub(super) colours: Option<Vec<[f64; 4]>>,
+    /// `"iso"` or `"direct"`; the default is `"direct"` when an opacity
+    /// point lies strictly between 0 and 1, else `"iso"`.
+    #[serde(default)]
+    pub(super) render: Option<String>,
     #[serde(default)]
     pub(super) fit: Option<BoxDef>,
     #[serde(default)]

@@ -13,7 +13,7 @@ use super::schema::VolumeDef;
 use crate::assets::volume::computed::{self, Metaball, Metaballs};
 use crate::assets::volume::raw::{self, RawSpec};
 use crate::assets::volume::{
-    self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, SampleType, Volume,
+    self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, Render, SampleType, Volume,
 };
 use crate::scene::error::SceneError;
 use crate::scene::objects::SceneVolume;
@@ -199,7 +199,34 @@ impl Builder<'_> {
         classifier
             .validate()
             .map_err(|e| self.err(s.clone(), &key("iso"), e.to_string()))?;
-        Ok(classifier)
+        // Direct volume rendering where the opacity ramp has partial
+        // opacities (a point strictly between 0 and 1), unless `render`
+        // says otherwise: a ramp of only 0 and 1 is a cut of the
+        // iso-surface, as it always was.
+        let partial = d
+            .opacity
+            .as_ref()
+            .is_some_and(|o| o.iter().any(|p| p[1] > 0.0 && p[1] < 1.0));
+        let render = match d.render.as_deref() {
+            None if partial => Render::Direct,
+            None | Some("iso") => Render::Iso,
+            Some("direct") => Render::Direct,
+            Some(other) => {
+                return Err(self.err(
+                    s,
+                    &key("render"),
+                    format!("expected \"iso\" or \"direct\", found \"{other}\""),
+                ));
+            }
+        };
+        if render == Render::Direct && d.opacity.is_none() {
+            return Err(self.err(
+                s,
+                &key("render"),
+                "direct volume rendering needs a transfer function: give opacity = [[value, alpha], …]",
+            ));
+        }
+        Ok(classifier.with_render(render))
     }
 
     /// Where the volume goes: fitted into a box, or translated and scaled.

@@ -1,0 +1,277 @@
+//! The raster side of direct volume rendering: a volume classified by a
+//! transfer function ([`Render::Direct`](crate::assets::volume::Render))
+//! puts every raster voxel whose sample has an opacity above 0 in the
+//! raster, so that the discrete walk visits them (and skips the empty
+//! space around them, which the distance field and the line level
+//! describe), and keeps its samples at the voxel centres for the tracer
+//! ([`DirectVolume`]).
+//!
+//! A voxel's sample is the placed volume's trilinear value at the voxel's
+//! centre, rounded to `f32` ([`voxel_sample`]); the voxelization and the
+//! tracer read the same numbers, so the voxels in the raster are exactly
+//! those of opacity above 0. Their records carry the object (and, where
+//! geometry shares the voxel, are listed with it; the geometry owns the
+//! voxel: the volume offers its voxels at the largest distance).
+//!
+//! ```
+//! use glam::DVec3;
+//! use rrt_core::raster::Extent;
+//! use std::sync::Arc;
+//! use rrt_host::assets::volume::{Classifier, Grid, Placement, Ramp, Samples, Volume};
+//! use rrt_host::frame::RasterFrame;
+//! use rrt_host::scene::SceneVolume;
+//! use rrt_host::voxelize::direct::DirectVolume;
+//! // 4×4×4 samples of 0 and 100, one world unit apart.
+//! let s = (0..64).map(|i| if i % 4 < 2 { 0 } else { 100 }).collect();
+//! let v = Volume::new([4; 3], Grid::unit(), Samples::U8(s)).unwrap();
+//! let tf = Classifier::direct(Ramp::new(vec![(0.0, 0.0), (100.0, 0.25)]).unwrap());
+//! let volume = SceneVolume { volume: Arc::new(v), placement: Placement::IDENTITY, classifier: tf };
+//! let frame = RasterFrame { extent: Extent::cube(8).unwrap(), origin: DVec3::splat(-2.5), voxel_size: 1.0 };
+//! let d = DirectVolume::new(0, &volume, &frame, [255; 3], 1 << 20).unwrap().unwrap();
+//! assert_eq!(d.spacing, 1.0);
+//! assert_eq!(d.value([2, 2, 2]), Some(0.0));
+//! assert_eq!(d.value([5, 2, 2]), Some(100.0));
+//! assert_eq!(d.count_visible(), 2 * 4 * 4);
+//! ```
+
+use glam::DVec3;
+use rayon::prelude::*;
+use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
+
+use super::BuildError;
+use super::pass::Pass;
+use super::volume::VolumeColors;
+use crate::assets::volume::{
+    Classifier, DimsFmt, PlacedVolume, SampleType, VolumeError, sample_count,
+};
+use crate::frame::RasterFrame;
+use crate::scene::{SceneVolume, VolumeObject};
+
+/// The sample of raster voxel `v` of a placed volume: its trilinear value
+/// at the voxel's centre, rounded to `f32`; NaN outside the volume (clear
+/// under every transfer function).
+#[must_use]
+pub fn voxel_sample(placed: &PlacedVolume<'_>, frame: &RasterFrame, v: [u32; 3]) -> f32 {
+    let c = DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])) + 0.5;
+    // The rounding to f32 is the stored value's.
+    placed
+        .sample_world(frame.raster_to_world(c))
+        .map_or(f32::NAN, |x| x as f32)
+}
+
+/// A volume rendered directly, as the tracer reads it: the samples at
+/// the centres of the raster voxels its cells cover, and its transfer
+/// function.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DirectVolume {
+    /// Its id in the object table.
+    pub object: u32,
+    /// The first raster voxel of the box of samples.
+    pub first: [u32; 3],
+    /// Samples per axis.
+    pub dims: [u32; 3],
+    /// The samples ([`voxel_sample`]), x fastest.
+    pub values: Vec<f32>,
+    /// The transfer function (opacity and colour ramps, floor `iso`).
+    pub classifier: Classifier,
+    /// The colour of samples without a colour ramp (the material's).
+    pub base: [u8; 3],
+    /// The world length the ramp's opacities are for: the placed
+    /// volume's smallest sample spacing.
+    pub spacing: f64,
+}
+
+impl DirectVolume {
+    /// The samples of `volume` (placed, under its transfer function) over
+    /// the raster `frame`, for object `object`; `None` when the volume
+    /// misses the raster.
+    ///
+    /// # Errors
+    /// [`VolumeError::TooLarge`] when the samples would take more than
+    /// `max_bytes` (4 bytes per voxel of the volume's box), checked before
+    /// allocating; [`VolumeError::Invalid`] for a classifier that is not
+    /// valid or a degenerate placement.
+    pub fn new(
+        object: u32,
+        volume: &SceneVolume,
+        frame: &RasterFrame,
+        base: [u8; 3],
+        max_bytes: u64,
+    ) -> Result<Option<Self>, VolumeError> {
+        let classifier = &volume.classifier;
+        let placed = volume.placed();
+        let spacing = volume.sample_spacing();
+        classifier.validate()?;
+        if !(spacing.is_finite() && spacing > 0.0) {
+            return Err(VolumeError::Invalid {
+                what: "direct volume rendering".into(),
+                msg: format!("sample spacing {spacing} in the world"),
+            });
+        }
+        let Some((first, dims)) = placed.raster_box(frame) else {
+            return Ok(None);
+        };
+        let voxels = sample_count(dims);
+        let bytes = voxels.saturating_mul(4);
+        if bytes > max_bytes {
+            return Err(VolumeError::TooLarge {
+                path: "direct volume samples".into(),
+                at: String::new(),
+                dims: DimsFmt(dims),
+                ty: SampleType::F32,
+                bytes,
+                limit: max_bytes,
+            });
+        }
+        let count = usize::try_from(voxels).map_err(|_| VolumeError::Invalid {
+            what: "direct volume samples".into(),
+            msg: "too many voxels for this machine".into(),
+        })?;
+        let mut values = vec![0f32; count];
+        let row = dims[0].max(1) as usize;
+        let layer = row * dims[1].max(1) as usize;
+        values
+            .par_chunks_mut(layer)
+            .enumerate()
+            .for_each(|(k, plane)| {
+                for (j, r) in plane.chunks_mut(row).enumerate() {
+                    for (i, out) in r.iter_mut().enumerate() {
+                        // Inside the box: below 2^16 per axis.
+                        let v = [
+                            first[0] + i as u32,
+                            first[1] + j as u32,
+                            first[2] + k as u32,
+                        ];
+                        *out = voxel_sample(&placed, frame, v);
+                    }
+                }
+            });
+        Ok(Some(Self {
+            object,
+            first,
+            dims,
+            values,
+            classifier: classifier.clone(),
+            base,
+            spacing,
+        }))
+    }
+
+    /// The sample of raster voxel `v` (`None` outside the box; NaN where
+    /// the volume has no value).
+    #[must_use]
+    pub fn value(&self, v: [u32; 3]) -> Option<f32> {
+        let mut l = [0u64; 3];
+        for axis in 0..3 {
+            let d = v[axis].checked_sub(self.first[axis])?;
+            if d >= self.dims[axis] {
+                return None;
+            }
+            l[axis] = u64::from(d);
+        }
+        let [nx, ny, _] = self.dims.map(u64::from);
+        let i = l[0] + nx * (l[1] + ny * l[2]);
+        self.values.get(usize::try_from(i).ok()?).copied()
+    }
+
+    /// The transfer function's opacity of raster voxel `v` (0 outside).
+    #[must_use]
+    pub fn opacity(&self, v: [u32; 3]) -> f64 {
+        self.value(v)
+            .map_or(0.0, |x| self.classifier.sample_opacity(f64::from(x)))
+    }
+
+    /// The gray-level gradient at raster voxel `v` by central differences
+    /// of the neighbouring voxels' samples (a neighbour outside the box or
+    /// without a value counts as `v`'s own sample), in gray levels per
+    /// raster voxel.
+    #[must_use]
+    pub fn gradient(&self, v: [u32; 3]) -> DVec3 {
+        let own = self.value(v).filter(|x| !x.is_nan()).unwrap_or(0.0);
+        let at = |axis: usize, d: i32| {
+            let mut w = v;
+            w[axis] = match v[axis].checked_add_signed(d) {
+                Some(x) => x,
+                None => return own,
+            };
+            self.value(w).filter(|x| !x.is_nan()).unwrap_or(own)
+        };
+        let g = |axis| 0.5 * (f64::from(at(axis, 1)) - f64::from(at(axis, -1)));
+        DVec3::new(g(0), g(1), g(2))
+    }
+
+    /// Number of voxels of opacity above 0 (the voxels it puts in the
+    /// raster).
+    #[must_use]
+    pub fn count_visible(&self) -> u64 {
+        self.values
+            .iter()
+            .filter(|&&x| self.classifier.sample_opacity(f64::from(x)) > 0.0)
+            .count() as u64
+    }
+}
+
+/// Offers every voxel of opacity above 0 of a directly rendered volume to
+/// `sink`, over the layers it keeps, in z, y, x order, at the largest
+/// distance (so that geometry sharing a voxel owns it).
+fn offer_visible<S: VoxelSink + ?Sized>(
+    placed: &PlacedVolume<'_>,
+    frame: &RasterFrame,
+    classifier: &Classifier,
+    sink: &mut S,
+) {
+    let Some((first, n)) = placed.raster_box(frame) else {
+        return;
+    };
+    let layers = sink.layers();
+    let z0 = first[2].max(layers.start);
+    let z1 = (first[2] + n[2]).min(layers.end);
+    let surfel = Surfel {
+        normal: [0, 0, NORMAL_ONE],
+        distance: u32::MAX,
+    };
+    for z in z0..z1 {
+        for y in first[1]..first[1] + n[1] {
+            for x in first[0]..first[0] + n[0] {
+                let v = [x, y, z];
+                let s = voxel_sample(placed, frame, v);
+                if classifier.sample_opacity(f64::from(s)) > 0.0 {
+                    sink.offer(v, surfel);
+                }
+            }
+        }
+    }
+}
+
+/// Voxelizes a directly rendered volume object into `pass`: every voxel
+/// of opacity above 0, coloured by the transfer function (or the
+/// material's texture).
+///
+/// # Errors
+/// The store's.
+pub(super) fn voxelize_object(
+    v: &VolumeObject,
+    frame: &RasterFrame,
+    pass: Pass<'_, '_, '_, '_>,
+) -> Result<(), BuildError> {
+    let placed = v.data.placed();
+    let classifier = &v.data.classifier;
+    match pass {
+        Pass::Count(c) => offer_visible(&placed, frame, classifier, c),
+        Pass::Fill {
+            filler,
+            attrs,
+            texture,
+            ..
+        } => {
+            filler.begin_object(attrs)?;
+            if let Some(t) = texture {
+                offer_visible(&placed, frame, classifier, &mut filler.textured(t));
+            } else {
+                let colors = VolumeColors::new(placed, *frame, classifier);
+                offer_visible(&placed, frame, classifier, &mut filler.textured(&colors));
+            }
+        }
+    }
+    Ok(())
+}
