@@ -333,6 +333,14 @@ fn orient(p: [i128; 2], q: [i128; 2], r: [i128; 2]) -> i128 {
         .saturating_sub(u[1].saturating_mul(w[0]))
 }
 
+/// `n` shifted right until every component is below `2^31` (the same
+/// direction).
+fn below_2_31(n: [i128; 3]) -> [i128; 3] {
+    let m = n.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    let shift = (128u32.saturating_sub(m.leading_zeros())).saturating_sub(31);
+    n.map(|c| c >> shift)
+}
+
 /// One separating axis: the probe at centre `c` meets the triangle only if
 /// `lo <= alpha·c <= hi`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -349,8 +357,6 @@ pub(crate) struct Tri {
     e: [[i128; 3]; 3],
     /// `(v1 − v0) × (v2 − v0)`, nonzero.
     n: [i128; 3],
-    /// `n` shifted below 2^31 (same direction).
-    n_small: [i128; 3],
     /// Unit face normal.
     unit: [i32; 3],
     normals: Option<[UnitVector; 3]>,
@@ -379,9 +385,7 @@ impl Tri {
         if n == [0; 3] {
             return Err(VoxelizeError::Degenerate);
         }
-        let m = n.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
-        let shift = (128u32.saturating_sub(m.leading_zeros())).saturating_sub(31);
-        let n_small = n.map(|c| c >> shift);
+        let n_small = below_2_31(n);
         // (p − c) × (q − c) · n = (p × q) · n + c · (n × (q − p)): the
         // numerator of vertex i, with p, q the other two vertices in order.
         let mut bary = [(0, [0; 3]); 3];
@@ -398,7 +402,6 @@ impl Tri {
             v,
             e,
             n,
-            n_small,
             unit: unit(n).ok_or(VoxelizeError::Degenerate)?,
             normals,
             bary,
@@ -680,7 +683,7 @@ impl Tri {
 
     /// The barycentric numerators of the projection of point `c` onto the
     /// plane: `(v_j − c) × (v_k − c) · n` for vertex `i` and the other two
-    /// vertices `j, k` in order, scaled by `|n|` shifted below `2^31`. For a
+    /// vertices `j, k` in order, scaled by `n` shifted below `2^31`. For a
     /// voxel centre of any raster (below `2^32` per axis) and vertices
     /// within `COORD_LIMIT` no term saturates, so the linear form is exact.
     fn barycentric(&self, c: [i128; 3]) -> [i128; 3] {
@@ -885,7 +888,7 @@ mod tests {
                 let direct = [0, 1, 2].map(|i| {
                     let p = sub(v[NEXT[i]], c);
                     let q = sub(v[NEXT[NEXT[i]]], c);
-                    checked_dot(checked_cross(p, q).unwrap(), t.n_small).unwrap()
+                    checked_dot(checked_cross(p, q).unwrap(), below_2_31(t.n)).unwrap()
                 });
                 assert_eq!(t.barycentric(c), direct, "{v:?} {c:?}");
                 compared += 1;
