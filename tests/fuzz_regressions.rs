@@ -74,3 +74,8 @@ fn nrrd_inputs_replay() {
 fn scene_toml_inputs_replay() {
     replay_checked("scene_toml", rrt_host::check::toml_input);
 }
+
+#[test]
+fn raster_file_inputs_replay() {
+    replay_checked("raster_file", rrt_host::check::raster_file_input);
+}
