@@ -71,6 +71,11 @@ fn nrrd_inputs_replay() {
 }
 
 #[test]
+fn camera_path_inputs_replay() {
+    replay_checked("camera_path", rrt_host::check::path_input);
+}
+
+#[test]
 fn scene_toml_inputs_replay() {
     replay_checked("scene_toml", rrt_host::check::toml_input);
 }

@@ -10,8 +10,9 @@ use rrt_core::Connectivity;
 use rrt_host::output::encoding::{Codes, Encoding, codes};
 use rrt_host::output::png::png_bytes;
 use rrt_host::output::rasterfile;
+use rrt_host::render::band::Band;
 use rrt_host::render::camera::Camera;
-use rrt_host::render::{Image, RenderOptions, render};
+use rrt_host::render::{Image, RenderOptions, render, render_rows};
 use rrt_host::scene::Scene;
 use rrt_host::trace::{Mode, RayStats, TraceOptions, Tracer};
 use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
@@ -169,6 +170,65 @@ fn png_is_identical_for_every_thread_count() {
 /// `rrt voxelize` then `rrt render FILE.rrt` writes the same PNG as
 /// `rrt render SCENE` with the same raster; view overrides apply to a saved
 /// raster; `rrt info` reports it.
+/// A band's pixels are the same rows of the whole image, bit for bit,
+/// whatever the split (bands cutting the 8-row tiles and the 2-row ray
+/// blocks), with packets or scalar walks, with and without supersampling.
+#[test]
+fn bands_are_the_rows_of_the_whole_image() {
+    let scene = Scene::load(balls2()).unwrap();
+    let paper = voxelize(&scene, 64, Connectivity::Adaptive);
+    let exact = voxelize_exact(&scene, 64);
+    let (w, h) = (37, 23);
+    let mut checked = 0;
+    for (mode, vs) in [(Mode::Paper, &paper), (Mode::Exact, &exact)] {
+        for (packets, k) in [(true, 1), (false, 2)] {
+            let trace = TraceOptions {
+                mode,
+                packets,
+                ..TraceOptions::default()
+            };
+            let (whole, _) = draw(vs, w, h, trace, k, 2);
+            let tracer = Tracer::new(vs, trace).unwrap();
+            let cam = Camera::new(&vs.view, w, h).unwrap();
+            let opts = RenderOptions {
+                supersample: k,
+                threads: 2,
+            };
+            for n in [2, 3, 5, 7, 23] {
+                for i in 0..n {
+                    let rows = Band::new(i, n, h).unwrap().rows(h);
+                    let (band, ..) =
+                        render_rows(&tracer, &cam, &opts, rows.clone(), &ProgressBar::hidden())
+                            .unwrap();
+                    let (a, b) = (3 * (w * rows.start) as usize, 3 * (w * rows.end) as usize);
+                    assert_eq!(band.height, rows.end - rows.start);
+                    assert_eq!(band.rgb, whole.rgb[a..b], "{mode:?} band {i}/{n}");
+                    let same_bits = band
+                        .linear
+                        .iter()
+                        .zip(&whole.linear[a..b])
+                        .all(|(x, y)| x.to_bits() == y.to_bits());
+                    assert!(same_bits, "{mode:?} band {i}/{n} linear");
+                    checked += 1;
+                }
+            }
+        }
+    }
+    println!("{checked} bands checked against their whole images");
+    let tracer = Tracer::new(&exact, TraceOptions::default()).unwrap();
+    let cam = Camera::new(&exact.view, w, h).unwrap();
+    for bad in [0..0, 5..5, 20..24] {
+        let e = render_rows(
+            &tracer,
+            &cam,
+            &RenderOptions::default(),
+            bad.clone(),
+            &ProgressBar::hidden(),
+        );
+        assert!(e.is_err(), "{bad:?}");
+    }
+}
+
 #[test]
 fn saved_raster_renders_like_the_scene() {
     let dir = temp_dir("roundtrip");

@@ -5,6 +5,7 @@
 //! * [`nff_input`] and [`toml_input`]: the scene parsers and the fit;
 //! * [`nrrd_input`]: the NRRD reader and a volume's raster block;
 //! * [`raster_file_input`]: the saved-raster loader, and rendering what it loads;
+//! * [`path_input`]: the camera path reader;
 //! * [`check_scene`]: the guarantees of a parsed [`Scene`](crate::scene::Scene).
 
 use glam::DVec3;
@@ -80,6 +81,35 @@ pub fn nff_input(data: &[u8]) -> Result<(), String> {
         if fitted.lights.len() != scene.lights.len() {
             return Err("fit lost lights".into());
         }
+    }
+    Ok(())
+}
+
+/// Feeds arbitrary bytes (as the file `fuzz.path`) to the camera path
+/// reader and checks: an error names the file; every view read makes a
+/// camera (so the renderer never refuses a view the reader accepted) and
+/// keeps its line's location.
+///
+/// # Errors
+/// The first broken invariant.
+pub fn path_input(data: &[u8]) -> Result<(), String> {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return Ok(());
+    };
+    let Some(views) = read_or_refused("fuzz.path", crate::scene::path::parse("fuzz.path", text))?
+    else {
+        return Ok(());
+    };
+    let lines = u32::try_from(text.lines().count()).unwrap_or(u32::MAX);
+    for v in &views {
+        Camera::look_at(v.from, v.at, v.up, v.angle, 8, 8)
+            .map_err(|e| format!("the reader accepted a view the camera refuses: {e} ({v:?})"))?;
+        if !(1..=lines).contains(&v.loc.line) || v.loc.column != 1 {
+            return Err(format!("view located outside its line: {v:?}"));
+        }
+    }
+    if !views.windows(2).all(|w| w[0].loc.line < w[1].loc.line) {
+        return Err("views out of line order".into());
     }
     Ok(())
 }

@@ -2,10 +2,12 @@
 //! arguments and prints errors; each subcommand lives in its own module here.
 
 pub mod common;
+pub mod frames;
 pub mod info;
 pub mod num;
 pub mod ray;
 pub mod render;
+pub mod stitch;
 pub mod voxelize;
 
 use std::io::Write;
@@ -28,6 +30,10 @@ pub enum Command {
     /// PPM, OpenEXR or PFM by the output's extension (no scene: the
     /// built-in 91-sphereflake to rrt.png).
     Render(render::RenderArgs),
+    /// Join the bands written by `rrt render --tile I/N`, in order, into
+    /// the whole image, byte for byte the file one render writes; refuses
+    /// files that are not the bands of one image, each once, in order.
+    Stitch(stitch::StitchArgs),
     /// Voxelize an NFF or TOML scene once and save the raster, with light
     /// visibility and precomputed illumination, for `rrt render`.
     Voxelize(voxelize::VoxelizeArgs),
@@ -83,6 +89,9 @@ pub enum CliError {
     /// A saved raster.
     #[error(transparent)]
     RasterFile(#[from] crate::output::rasterfile::RasterFileError),
+    /// Joining bands.
+    #[error(transparent)]
+    Stitch(#[from] crate::output::stitch::StitchError),
 }
 
 /// Runs a parsed command line, writing reports to `out`.
@@ -93,6 +102,7 @@ pub fn run(cli: &Cli, out: &mut impl Write) -> Result<(), CliError> {
     match &cli.command {
         Command::Ray(args) => ray::run(args, out),
         Command::Render(args) => render::run(args, out),
+        Command::Stitch(args) => stitch::run(args, out),
         Command::Voxelize(args) => voxelize::run(args, out),
         Command::Info(args) => info::run(args, out),
     }

@@ -8,9 +8,12 @@ use super::common::{
     ImageNeed, Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, parse_depth, parse_threads,
     progress, secs,
 };
+use super::frames::{Frames, Names, TileArg, parse_frame_count, parse_tile};
+use crate::output::band::BandTag;
 use crate::output::image::{Encoding, ImageOutput};
 use crate::render::camera::Camera;
-use crate::render::{RenderOptions, check_sizes, render};
+use crate::render::{RenderOptions, check_sizes, render_rows};
+use crate::scene::View;
 use crate::trace::{TraceOptions, Tracer};
 
 /// Arguments of `rrt render`.
@@ -21,7 +24,10 @@ pub struct RenderArgs {
     pub scene: Option<PathBuf>,
     /// The image to write; its extension chooses the format: .png (8-bit
     /// sRGB by default), .ppm (binary), .exr or .pfm (32-bit float,
-    /// linear), or - for PNG on standard output.
+    /// linear), or - for PNG on standard output. With --orbit or --path,
+    /// a file name pattern: %d, or %0Nd (N from 1 to 20), for the frame
+    /// number zero-padded to N digits (%% is a %), required when several
+    /// frames are written.
     #[arg(short, long, value_name = "OUT", default_value = "rrt.png")]
     pub output: PathBuf,
     /// Bits per channel of .png and .ppm output: 8 or 16.
@@ -62,16 +68,41 @@ pub struct RenderArgs {
     /// View overrides.
     #[command(flatten)]
     pub view: ViewArgs,
+    /// Render only band I of N horizontal bands of equal height (to a
+    /// row), I from 0 (the top band) to N − 1, N from 1 to the image's
+    /// height: the band's rows, byte for byte as in the whole image, in
+    /// a file that says which band it is (PNG, PPM, OpenEXR; PFM bands
+    /// cannot say); `rrt stitch` joins the bands.
+    #[arg(long, value_name = "I/N", value_parser = parse_tile)]
+    pub tile: Option<TileArg>,
+    /// An animation of N frames, 1 to 2^64 − 1, from one voxelization:
+    /// frame k has the eye turned by 360°·k/N about the up axis through
+    /// `at` (frame 0 is the view itself). -o is then a file name pattern
+    /// with the frame number: %d, or %0Nd zero-padded to N digits (%% is
+    /// a %).
+    #[arg(long, value_name = "N", value_parser = parse_frame_count, conflicts_with = "path")]
+    pub orbit: Option<u64>,
+    /// An animation along a camera path: one view per line of FILE, `from
+    /// (x y z) at (x y z) up (x y z) angle`, whitespace-separated, #
+    /// comments and blank lines allowed; frame k is the k-th view (from
+    /// 0), with the scene's resolution. -o as for --orbit.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["from", "at", "up", "angle"])]
+    pub path: Option<PathBuf>,
+    /// Render only frame K of the animation, K from 0 to its frame count
+    /// − 1 (frames rendered apart are byte-identical to one process's).
+    #[arg(long, value_name = "K")]
+    pub frame: Option<u64>,
     /// No progress bars and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
 }
 
-/// Runs `rrt render`, writing the summary line to `out`.
+/// Runs `rrt render`, writing one summary line per image to `out`.
 ///
 /// # Errors
-/// [`CliError`]: bad sizes, an unwritable output, the scene's, builder's,
-/// tracer's or encoder's error.
+/// [`CliError`]: bad sizes, bands, frames or file name patterns, a bad
+/// camera path, an unwritable output, the scene's, builder's, tracer's or
+/// encoder's error.
 pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     // Sizes given on the command line are checked before any work.
     check_sizes(
@@ -79,22 +110,45 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         args.height.unwrap_or(1),
         args.supersample,
     )?;
-    let output = ImageOutput::create(
-        &args.output,
-        Encoding {
-            bits: args.bits,
-            linear: args.linear,
-        },
-    )?;
-    // The view with the overrides, the image size and the camera, checked
-    // before voxelizing and again for the render.
-    let camera_of = |scene_view: &crate::scene::View| -> Result<(Camera, u32, u32), CliError> {
-        let view = args.view.apply(scene_view);
-        let [rw, rh] = view.resolution;
-        let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
-        check_sizes(w, h, args.supersample)?;
-        Ok((Camera::new(&view, w, h)?, w, h))
+    let frames = match (args.orbit, &args.path) {
+        (Some(n), _) => Frames::Orbit(n),
+        (None, Some(p)) => Frames::Path(crate::scene::path::load(p, &p.display().to_string())?),
+        (None, None) if args.frame.is_some() => {
+            return Err(CliError::Arg {
+                arg: "--frame",
+                message: "a frame of an animation: give --orbit N or --path FILE".to_string(),
+            });
+        }
+        (None, None) => Frames::Still,
     };
+    let chosen = frames.chosen(args.frame)?;
+    let names = Names::new(&args.output, frames.animated(), chosen.end - chosen.start)?;
+    if let (Some(t), Some(h)) = (args.tile, args.height) {
+        t.band(h)?;
+    }
+    let encoding = Encoding {
+        bits: args.bits,
+        linear: args.linear,
+    };
+    // The first image's output is opened before any work (an unwritable
+    // path or an unknown format is reported at once), the others as their
+    // turn comes.
+    let mut first_output = Some(ImageOutput::create(&names.path(chosen.start), encoding)?);
+    // Frame k's view, image size and camera, checked before voxelizing
+    // (the first frame) and again for each render.
+    let camera_of =
+        |scene_view: &crate::scene::View, k: u64| -> Result<(Camera, View, u32, u32), CliError> {
+            let view = frames.view(k, &args.view.apply(scene_view));
+            let [rw, rh] = view.resolution;
+            let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
+            check_sizes(w, h, args.supersample)?;
+            if let Some(t) = args.tile {
+                t.band(h)?;
+            }
+            Ok((Camera::new(&view, w, h)?, view, w, h))
+        };
+    // The raster is fitted to the base view (the scene's with the
+    // overrides), whichever frames are rendered.
     let loaded = load_or_build(
         args.scene.as_ref(),
         &args.raster,
@@ -107,12 +161,11 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         },
         args.threads,
         !args.quiet,
-        &|v| camera_of(v).map(|_| ()),
+        &|v| camera_of(v, chosen.start).map(|_| ()),
     )?;
     let scene = match &loaded {
         Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
     };
-    let (camera, w, h) = camera_of(&scene.view)?;
     let tracer = Tracer::new(
         scene,
         TraceOptions {
@@ -123,60 +176,140 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             ..TraceOptions::default()
         },
     )?;
-    let bar = progress(!args.quiet);
-    let rendered = render(
-        &tracer,
-        &camera,
-        &RenderOptions {
-            supersample: args.supersample,
-            threads: args.threads,
-        },
-        &bar,
-    );
-    bar.finish_and_clear();
-    let (image, stats, time) = rendered?;
-    let to_stdout = output.is_stdout();
-    output.write(&image, out)?;
-    if !args.quiet {
-        // With the image on standard output, the summary goes to stderr.
-        let mut stderr = std::io::stderr();
-        let out: &mut dyn Write = if to_stdout { &mut stderr } else { out };
-        let d = scene.extent().dims();
-        let prep = match &loaded {
-            Loaded::Built { report, parse, .. } => format!(
-                "parse {}, voxelize {}, light visibility {}",
-                secs(*parse),
-                secs(report.voxelize),
-                secs(report.lights)
-            ),
-            Loaded::Saved { load, .. } => format!("load {}", secs(*load)),
+    let mut prep = Some(match &loaded {
+        Loaded::Built { report, parse, .. } => format!(
+            "parse {}, voxelize {}, light visibility {}",
+            secs(*parse),
+            secs(report.voxelize),
+            secs(report.lights)
+        ),
+        Loaded::Saved { load, .. } => format!("load {}", secs(*load)),
+    });
+    for k in chosen {
+        let (camera, view, w, h) = camera_of(&scene.view, k)?;
+        let output = match first_output.take() {
+            Some(o) => o,
+            None => ImageOutput::create(&names.path(k), encoding)?,
         };
-        let rays = stats.rays().max(1);
-        writeln!(
-            out,
-            "{}: {w}×{h}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit, {:.1} steps/shadow ray); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays)",
-            args.output.display(),
-            d[0],
-            d[1],
-            d[2],
-            crate::trace::Mode::from(args.raster.mode).name(),
-            rrt_core::Connectivity::from(args.raster.connectivity).name(),
-            args.depth,
-            secs(time),
-            stats.primary,
-            stats.reflected,
-            stats.refracted,
-            stats.shadow,
-            stats.classified,
-            stats.shadow_steps as f64 / stats.shadow.max(1) as f64,
-            stats.steps as f64 / rays as f64,
-            stats.hits,
-            stats.shared_hits,
-            stats.false_hits,
-            100.0 * stats.false_hit_rays as f64
-                / (stats.primary + stats.reflected + stats.refracted).max(1) as f64,
-        )?;
+        let band = args.tile.map(|t| t.band(h)).transpose()?;
+        let rows = band.map_or(0..h, |b| b.rows(h));
+        let bar = progress(!args.quiet);
+        let rendered = render_rows(
+            &tracer,
+            &camera,
+            &RenderOptions {
+                supersample: args.supersample,
+                threads: args.threads,
+            },
+            rows.clone(),
+            &bar,
+        );
+        bar.finish_and_clear();
+        let (image, stats, time) = rendered?;
+        let tag = band.map(|band| {
+            BandTag {
+                band,
+                width: w,
+                height: h,
+                kind: output.kind(),
+                render: render_key(args, &view, scene),
+            }
+            .to_string()
+        });
+        let to_stdout = output.is_stdout();
+        let path = output.path().to_path_buf();
+        output.write_band(&image, tag.as_deref(), out)?;
+        if !args.quiet {
+            // With the image on standard output, the summary goes to stderr.
+            let mut stderr = std::io::stderr();
+            let out: &mut dyn Write = if to_stdout { &mut stderr } else { out };
+            let size = match band {
+                Some(b) => format!(
+                    "{w}×{h} band {}/{} (rows {}..{})",
+                    b.index, b.count, rows.start, rows.end
+                ),
+                None => format!("{w}×{h}"),
+            };
+            let frame = if frames.animated() {
+                format!("frame {k} of {}, ", frames.count())
+            } else {
+                String::new()
+            };
+            let prep = prep.take().unwrap_or_else(|| "raster reused".to_string());
+            summary(
+                out,
+                args,
+                scene,
+                &path,
+                &format!("{frame}{size}"),
+                &prep,
+                &stats,
+                time,
+            )?;
+        }
     }
+    Ok(())
+}
+
+/// What every band of one image shares, for its [`BandTag`]: the view,
+/// the sampling, the ray tree, the mode and the raster.
+fn render_key(args: &RenderArgs, view: &View, scene: &crate::voxelize::VoxelScene) -> String {
+    let v = |p: glam::DVec3| format!("{},{},{}", p.x, p.y, p.z);
+    let d = scene.extent().dims();
+    format!(
+        "view from {} at {} up {} angle {}; supersample {}; depth {}; {} mode, {}; raster {}x{}x{}",
+        v(view.from),
+        v(view.at),
+        v(view.up),
+        view.angle,
+        args.supersample,
+        args.depth,
+        crate::trace::Mode::from(args.raster.mode).name(),
+        rrt_core::Connectivity::from(args.raster.connectivity).name(),
+        d[0],
+        d[1],
+        d[2]
+    )
+}
+
+/// Writes one image's summary line.
+#[allow(clippy::too_many_arguments)]
+fn summary(
+    out: &mut dyn Write,
+    args: &RenderArgs,
+    scene: &crate::voxelize::VoxelScene,
+    path: &std::path::Path,
+    size: &str,
+    prep: &str,
+    stats: &crate::trace::RayStats,
+    time: std::time::Duration,
+) -> Result<(), CliError> {
+    let d = scene.extent().dims();
+    let rays = stats.rays().max(1);
+    writeln!(
+        out,
+        "{}: {size}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit, {:.1} steps/shadow ray); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays)",
+        path.display(),
+        d[0],
+        d[1],
+        d[2],
+        crate::trace::Mode::from(args.raster.mode).name(),
+        rrt_core::Connectivity::from(args.raster.connectivity).name(),
+        args.depth,
+        secs(time),
+        stats.primary,
+        stats.reflected,
+        stats.refracted,
+        stats.shadow,
+        stats.classified,
+        stats.shadow_steps as f64 / stats.shadow.max(1) as f64,
+        stats.steps as f64 / rays as f64,
+        stats.hits,
+        stats.shared_hits,
+        stats.false_hits,
+        100.0 * stats.false_hit_rays as f64
+            / (stats.primary + stats.reflected + stats.refracted).max(1) as f64,
+    )?;
     Ok(())
 }
 

@@ -2,6 +2,9 @@
 //! (the exact IEC 61966-2-1 transfer function) or linear, 8 or 16 bits,
 //! clamped to `[0, 1]` and rounded to nearest.
 
+use std::borrow::Cow;
+use std::fmt;
+
 use crate::render::Image;
 
 /// How integer formats encode the values.
@@ -103,6 +106,95 @@ impl Codes {
     }
 }
 
+/// What an image file's samples are: integer codes in an [`Encoding`]
+/// (PNG, PPM) or 32-bit floats, linear and unclamped (OpenEXR, PFM).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampleKind {
+    /// Integer codes.
+    Codes(Encoding),
+    /// 32-bit floats.
+    Float,
+}
+
+impl fmt::Display for SampleKind {
+    /// `8-bit sRGB`, `16-bit linear`, `32-bit float`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Codes(e) => write!(
+                f,
+                "{}-bit {}",
+                e.bits,
+                if e.linear { "linear" } else { "sRGB" }
+            ),
+            Self::Float => f.write_str("32-bit float"),
+        }
+    }
+}
+
+impl SampleKind {
+    /// The kind [`SampleKind`]'s `Display` names, or `None`.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        let codes = |bits, linear| Some(Self::Codes(Encoding { bits, linear }));
+        match s {
+            "8-bit sRGB" => codes(8, false),
+            "8-bit linear" => codes(8, true),
+            "16-bit sRGB" => codes(16, false),
+            "16-bit linear" => codes(16, true),
+            "32-bit float" => Some(Self::Float),
+            _ => None,
+        }
+    }
+}
+
+/// An image's samples as a file stores them, row by row (3 per pixel).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Samples<'a> {
+    /// Integer codes ([`codes`]).
+    Codes(Codes),
+    /// Linear, unclamped floats ([`Image::linear`]).
+    Float(Cow<'a, [f32]>),
+}
+
+impl Samples<'_> {
+    /// The image's samples of `kind`.
+    #[must_use]
+    pub fn of(image: &Image, kind: SampleKind) -> Samples<'_> {
+        match kind {
+            SampleKind::Codes(enc) => Samples::Codes(codes(image, enc)),
+            SampleKind::Float => Samples::Float(Cow::Borrowed(&image.linear)),
+        }
+    }
+
+    /// How many samples (three per pixel).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Codes(Codes::Eight(v)) => v.len(),
+            Self::Codes(Codes::Sixteen(v)) => v.len(),
+            Self::Float(v) => v.len(),
+        }
+    }
+
+    /// Whether there are none.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Appends `more`'s samples (of the same kind; `false`, and nothing
+    /// appended, otherwise).
+    pub fn append(&mut self, more: Samples<'_>) -> bool {
+        match (self, more) {
+            (Self::Codes(Codes::Eight(a)), Samples::Codes(Codes::Eight(b))) => a.extend(b),
+            (Self::Codes(Codes::Sixteen(a)), Samples::Codes(Codes::Sixteen(b))) => a.extend(b),
+            (Self::Float(a), Samples::Float(b)) => a.to_mut().extend_from_slice(&b),
+            _ => return false,
+        }
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -116,6 +208,16 @@ mod tests {
         assert_eq!(quantize(f32::NAN, false, 255), 0);
         assert_eq!(quantize(7.0, false, u16::MAX), u16::MAX);
         let mut last = 0;
+        for k in [
+            "8-bit sRGB",
+            "8-bit linear",
+            "16-bit sRGB",
+            "16-bit linear",
+            "32-bit float",
+        ] {
+            assert_eq!(SampleKind::parse(k).unwrap().to_string(), k);
+        }
+        assert_eq!(SampleKind::parse("12-bit"), None);
         for i in 0..=4096 {
             let c = quantize(i as f32 / 4096.0, false, u16::MAX);
             assert!(c >= last);

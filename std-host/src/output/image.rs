@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 
 use super::atomic::AtomicFile;
 pub use super::encoding::Encoding;
+use super::encoding::{Codes, SampleKind, Samples};
 use crate::render::Image;
 
 /// Why the image could not be written.
@@ -214,6 +215,16 @@ impl ImageOutput {
         self.format
     }
 
+    /// What the file's samples are.
+    #[must_use]
+    pub fn kind(&self) -> SampleKind {
+        if self.format.is_float() {
+            SampleKind::Float
+        } else {
+            SampleKind::Codes(self.encoding)
+        }
+    }
+
     /// Encodes `image` and moves it to the output path, or writes it to
     /// `stdout` for `-`.
     ///
@@ -221,6 +232,64 @@ impl ImageOutput {
     /// [`OutputError`] for an encoder or file-system failure; a file
     /// target is then untouched.
     pub fn write(self, image: &Image, stdout: &mut impl Write) -> Result<(), OutputError> {
+        self.write_band(image, None, stdout)
+    }
+
+    /// [`ImageOutput::write`], for a band of an image (`rrt render
+    /// --tile`): `band` ([`super::band::BandTag`]'s text) goes where the
+    /// format keeps text (a PNG `tEXt` chunk, a PPM header comment, an
+    /// OpenEXR attribute; PFM has no place for it).
+    ///
+    /// # Errors
+    /// As [`ImageOutput::write`].
+    pub fn write_band(
+        self,
+        image: &Image,
+        band: Option<&str>,
+        stdout: &mut impl Write,
+    ) -> Result<(), OutputError> {
+        let samples = Samples::of(image, self.kind());
+        self.write_samples(image.width, image.height, &samples, band, stdout)
+    }
+
+    /// Writes `width × height` pixels of `samples`, which must be of
+    /// [`ImageOutput::kind`]: the bytes [`ImageOutput::write_band`]
+    /// writes for an image with these samples.
+    ///
+    /// # Errors
+    /// As [`ImageOutput::write`]; [`OutputError::Options`] for samples of
+    /// another kind or number.
+    pub fn write_samples(
+        self,
+        width: u32,
+        height: u32,
+        samples: &Samples<'_>,
+        band: Option<&str>,
+        stdout: &mut impl Write,
+    ) -> Result<(), OutputError> {
+        let fits = match (self.kind(), samples) {
+            (SampleKind::Float, Samples::Float(_)) => true,
+            (SampleKind::Codes(e), Samples::Codes(Codes::Eight(_))) => e.bits == 8,
+            (SampleKind::Codes(e), Samples::Codes(Codes::Sixteen(_))) => e.bits == 16,
+            _ => false,
+        };
+        let count = 3 * u64::from(width) * u64::from(height);
+        if !fits || u64::try_from(samples.len()) != Ok(count) {
+            let kind = self.kind();
+            return Err(OutputError::Options {
+                path: self.path,
+                message: format!(
+                    "{} samples of another kind or number than {width}×{height} pixels of {kind}",
+                    samples.len(),
+                ),
+            });
+        }
+        let image = Encoded {
+            width,
+            height,
+            samples,
+            band,
+        };
         let path = self.path;
         let io = |source| OutputError::Io {
             path: path.clone(),
@@ -228,12 +297,12 @@ impl ImageOutput {
         };
         match self.target {
             Target::Stdout => {
-                encode(self.format, self.encoding, image, &mut *stdout, &path)?;
+                encode(self.format, self.encoding, &image, &mut *stdout, &path)?;
                 stdout.flush().map_err(io)
             }
             Target::File(mut file) => {
                 let mut w = BufWriter::with_capacity(1 << 20, file.file());
-                encode(self.format, self.encoding, image, &mut w, &path)?;
+                encode(self.format, self.encoding, &image, &mut w, &path)?;
                 w.flush().map_err(io)?;
                 drop(w);
                 file.commit().map_err(io)
@@ -242,11 +311,20 @@ impl ImageOutput {
     }
 }
 
+/// What [`encode`] writes: pixels of samples of the output's kind, and
+/// the band they are.
+struct Encoded<'a, 's> {
+    width: u32,
+    height: u32,
+    samples: &'a Samples<'s>,
+    band: Option<&'a str>,
+}
+
 /// Encodes `image` in `format` into `w`.
 fn encode(
     format: Format,
     enc: Encoding,
-    image: &Image,
+    image: &Encoded<'_, '_>,
     w: &mut impl Write,
     path: &Path,
 ) -> Result<(), OutputError> {
@@ -259,11 +337,22 @@ fn encode(
         path: path.to_path_buf(),
         source,
     };
-    match format {
-        Format::Png => super::png::write(image, enc, w).map_err(|e| failed(e.into())),
-        Format::Ppm => super::ppm::write_ppm(image, enc, w).map_err(io),
-        Format::Pfm => super::ppm::write_pfm(image, w).map_err(io),
-        Format::Exr => super::exr::write(image, w).map_err(|e| failed(e.into())),
+    let (width, height, band) = (image.width, image.height, image.band);
+    match (format, image.samples) {
+        (Format::Png, Samples::Codes(c)) => {
+            super::png::write_codes(width, height, c, enc, band, w).map_err(|e| failed(e.into()))
+        }
+        (Format::Ppm, Samples::Codes(c)) => {
+            super::ppm::write_ppm_codes(width, height, c, band, w).map_err(io)
+        }
+        (Format::Pfm, Samples::Float(v)) => {
+            super::ppm::write_pfm_floats(width, height, v, w).map_err(io)
+        }
+        (Format::Exr, Samples::Float(v)) => {
+            super::exr::write_floats(width, height, v, band, w).map_err(|e| failed(e.into()))
+        }
+        // `write_samples` checked the kind.
+        _ => Err(failed("samples of another kind than the format's".into())),
     }
 }
 

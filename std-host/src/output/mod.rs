@@ -7,9 +7,11 @@
 //! interruption, so the old output survives anything but success.
 
 pub mod atomic;
+pub mod band;
 pub mod encoding;
 pub mod exr;
 pub mod image;
 pub mod png;
 pub mod ppm;
 pub mod rasterfile;
+pub mod stitch;

@@ -15,7 +15,15 @@
 //! its samples are summed in a fixed order; tiles are written back by
 //! index. The image is therefore byte-identical for every thread count.
 //! The ray counts are integer sums, identical as well.
+//!
+//! **Bands.** [`render_rows`] renders only some rows of the image (a
+//! [`band::Band`]): the tiles and 4×2 blocks are those of the whole image
+//! (its grid, clipped to the rows), the camera is the whole image's, and
+//! a pixel's colour depends only on its own rays (a packet's lanes agree
+//! bit for bit with scalar rays), so a band's pixels are byte-identical to
+//! the same rows of the whole image.
 
+pub mod band;
 pub mod camera;
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -141,10 +149,39 @@ pub fn render(
     opts: &RenderOptions,
     progress: &ProgressBar,
 ) -> Result<(Image, RayStats, Duration), RenderError> {
+    render_rows(tracer, camera, opts, 0..camera.height, progress)
+}
+
+/// Renders rows `rows` of the camera's image (top row 0) with `tracer`:
+/// an image of the camera's width and `rows.len()` rows, byte-identical
+/// to those rows of [`render`]'s image (module docs). `progress` counts
+/// tiles.
+///
+/// # Errors
+/// [`RenderError`]: sizes out of range, rows empty or outside the image,
+/// no threads.
+pub fn render_rows(
+    tracer: &Tracer<'_>,
+    camera: &Camera,
+    opts: &RenderOptions,
+    rows: std::ops::Range<u32>,
+    progress: &ProgressBar,
+) -> Result<(Image, RayStats, Duration), RenderError> {
     let (w, h, k) = (camera.width, camera.height, opts.supersample);
     check_sizes(w, h, k)?;
+    if rows.is_empty() || rows.end > h {
+        return Err(RenderError::Size {
+            what: "rows",
+            message: format!(
+                "expected a non-empty range of the image's rows 0..{h}, found {}..{}",
+                rows.start, rows.end
+            ),
+        });
+    }
+    // The whole image's tile grid, its rows of tiles that meet `rows`.
     let tiles_x = w.div_ceil(TILE_W);
-    let tiles_y = h.div_ceil(TILE_H);
+    let first_ty = rows.start / TILE_H;
+    let tiles_y = rows.end.div_ceil(TILE_H) - first_ty;
     let tiles = u64::from(tiles_x) * u64::from(tiles_y);
     crate::progress::phase(progress, "rendering", crate::progress::Unit::Tiles, tiles);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -166,21 +203,29 @@ pub fn render(
                 break mine;
             }
             let tx = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0);
-            let ty = u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
-            mine.push((t, render_tile(tracer, camera, k, tx * TILE_W, ty * TILE_H)));
+            let ty = first_ty + u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
+            let tile = Tile {
+                x0: tx * TILE_W,
+                y0: ty * TILE_H,
+                rows: rows.clone(),
+            };
+            mine.push((t, render_tile(tracer, camera, k, &tile)));
             progress.inc(1);
         }
     });
     let elapsed = t0.elapsed();
     let mut done: Vec<(u64, TileResult)> = per_thread.into_iter().flatten().collect();
     done.sort_unstable_by_key(|&(t, _)| t);
-    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
-    let mut linear = vec![0f32; 3 * w as usize * h as usize];
+    let bh = rows.end - rows.start;
+    let mut rgb = vec![0u8; 3 * w as usize * bh as usize];
+    let mut linear = vec![0f32; 3 * w as usize * bh as usize];
     let mut stats = RayStats::default();
     for (t, (pixels, s)) in &done {
         stats.add(s);
         let x0 = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0) * TILE_W;
-        let y0 = u32::try_from(t / u64::from(tiles_x)).unwrap_or(0) * TILE_H;
+        let ty = first_ty + u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
+        // The tile's first row within the band.
+        let y0 = (ty * TILE_H).max(rows.start) - rows.start;
         let tw = TILE_W.min(w - x0);
         for (j, row) in pixels.chunks(tw as usize).enumerate() {
             let y = y0 as usize + j;
@@ -194,7 +239,7 @@ pub fn render(
     Ok((
         Image {
             width: w,
-            height: h,
+            height: bh,
             rgb,
             linear,
         },
@@ -206,18 +251,32 @@ pub fn render(
 /// One tile's pixels, row by row, and its ray counts.
 type TileResult = (Vec<([u8; 3], [f32; 3])>, RayStats);
 
-/// Renders the tile whose top left pixel is `(x0, y0)`.
-fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, x0: u32, y0: u32) -> TileResult {
+/// A tile of the whole image's grid, clipped to the rows rendered.
+struct Tile {
+    /// The tile's top left pixel in the whole image.
+    x0: u32,
+    y0: u32,
+    /// The rows rendered.
+    rows: std::ops::Range<u32>,
+}
+
+/// Renders the tile's pixels in its rows: the blocks of the whole
+/// image's tile (from its top left pixel), lanes outside the rows empty.
+fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, tile: &Tile) -> TileResult {
+    let x0 = tile.x0;
     let x1 = (x0 + TILE_W).min(camera.width);
-    let y1 = (y0 + TILE_H).min(camera.height);
+    let y1 = (tile.y0 + TILE_H).min(camera.height).min(tile.rows.end);
+    let y0 = tile.y0.max(tile.rows.start);
     let tw = (x1 - x0) as usize;
     let mut sums = vec![DVec3::ZERO; tw * (y1 - y0) as usize];
     let mut stats = RayStats::default();
-    for by in (y0..y1).step_by(BLOCK_H as usize) {
+    // The blocks of the whole tile's grid that meet the rows.
+    let first_by = tile.y0 + (y0 - tile.y0) / BLOCK_H * BLOCK_H;
+    for by in (first_by..y1).step_by(BLOCK_H as usize) {
         for bx in (x0..x1).step_by(BLOCK_W as usize) {
             let lane_pixel = |lane: u32| {
                 let (x, y) = (bx + lane % BLOCK_W, by + lane / BLOCK_W);
-                (x < x1 && y < y1).then_some((x, y))
+                (x < x1 && (y0..y1).contains(&y)).then_some((x, y))
             };
             for j in 0..k {
                 for i in 0..k {

@@ -191,6 +191,14 @@ pub enum SceneError {
         /// What is wrong.
         msg: String,
     },
+    /// A camera path without views.
+    #[error(
+        "{file}: no views: a camera path has one view per line, from (3 numbers) at (3) up (3) angle"
+    )]
+    NoViews {
+        /// The file.
+        file: Arc<str>,
+    },
     /// No object.
     #[error("{file}: no objects: the scene has no s, c, p or pp")]
     NoObjects {

@@ -30,6 +30,7 @@ pub(crate) mod loc;
 pub mod nff;
 pub mod obj;
 pub mod objects;
+pub mod path;
 pub(crate) mod text;
 pub mod toml;
 
@@ -71,6 +72,35 @@ pub struct View {
     pub resolution: [u32; 2],
     /// Where the `v` is.
     pub loc: SourceLoc,
+}
+
+/// What makes `from`, `at` and `up` no view (the parsers' check, which
+/// every view [`crate::render::camera::Camera`] accepts passes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ViewDefect {
+    /// `at` equals `from`.
+    NoDirection,
+    /// `up` is zero or parallel to `at − from`.
+    NoUp,
+}
+
+impl ViewDefect {
+    /// The defect of `from`, `at`, `up`, if any.
+    pub(crate) fn of(from: DVec3, at: DVec3, up: DVec3) -> Option<Self> {
+        if at == from {
+            return Some(Self::NoDirection);
+        }
+        let forward = (at - from).normalize_or_zero();
+        (forward.cross(up.normalize_or_zero()).length_squared() < 1e-24).then_some(Self::NoUp)
+    }
+
+    /// What is wrong, for a message about `at` or `up`.
+    pub(crate) fn problem(self) -> &'static str {
+        match self {
+            Self::NoDirection => "equals `from`: the view has no direction",
+            Self::NoUp => "zero or parallel to the view direction (at − from): the image has no up",
+        }
+    }
 }
 
 impl View {

@@ -65,7 +65,7 @@ use indicatif::ProgressBar;
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
 use super::text::byte_loc;
-use super::{Light, Material, Object, Polygon, Scene, View};
+use super::{Light, Material, Object, Polygon, Scene, View, ViewDefect};
 use crate::shape::{Cone, Sphere};
 
 /// Largest image width or height a `resolution` line may ask for.
@@ -546,7 +546,7 @@ impl<'a> Parser<'a> {
             return Err(SceneError::Invalid {
                 loc: SourceLoc::new(Arc::clone(&self.file), at_line, 1),
                 field: "view at",
-                problem: "equals `from`: the view has no direction",
+                problem: ViewDefect::NoDirection.problem(),
             });
         }
 
@@ -554,12 +554,11 @@ impl<'a> Parser<'a> {
         let up_line = self.line_no;
         let up = self.vec3("view up")?;
         self.expect_eol("view up")?;
-        let forward = (at - from).normalize_or_zero();
-        if forward.cross(up.normalize_or_zero()).length_squared() < 1e-24 {
+        if let Some(defect) = ViewDefect::of(from, at, up) {
             return Err(SceneError::Invalid {
                 loc: SourceLoc::new(Arc::clone(&self.file), up_line, 1),
                 field: "view up",
-                problem: "zero or parallel to the view direction (at − from): the image has no up",
+                problem: defect.problem(),
             });
         }
 
