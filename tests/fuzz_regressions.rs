@@ -79,3 +79,8 @@ fn camera_path_inputs_replay() {
 fn scene_toml_inputs_replay() {
     replay_checked("scene_toml", rrt_host::check::toml_input);
 }
+
+#[test]
+fn raster_file_inputs_replay() {
+    replay_checked("raster_file", rrt_host::check::raster_file_input);
+}

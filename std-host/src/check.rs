@@ -4,6 +4,7 @@
 //!
 //! * [`nff_input`] and [`toml_input`]: the scene parsers and the fit;
 //! * [`nrrd_input`]: the NRRD reader and a volume's raster block;
+//! * [`raster_file_input`]: the saved-raster loader, and rendering what it loads;
 //! * [`path_input`]: the camera path reader;
 //! * [`check_scene`]: the guarantees of a parsed [`Scene`](crate::scene::Scene).
 
@@ -230,6 +231,126 @@ pub fn nrrd_input(data: &[u8]) -> Result<(), String> {
                 block.threshold
             ));
         }
+    }
+    Ok(())
+}
+
+/// A small scene with every kind of NFF object, two lights and a
+/// translucent material: the valid rasters [`raster_file_input`] mutates.
+const RASTER_FUZZ_SCENE: &str = "v\nfrom 0 -5 2\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0.1\nresolution 8 8\n\
+    b 0.1 0.2 0.3\nl 3 -4 6\nl -3 -2 4 0.5 0.5 1\n\
+    f 0.9 0.4 0.2 0.8 0.2 20 0 1\ns 0 0 0.7 0.7\ns 0.9 0.2 0.3 0.3\n\
+    f 0.2 0.8 0.4 0.5 0.3 10 0.5 1.3\nc -1 0 0 0.3 -1 0 1 0.1\n\
+    f 0.8 0.8 0.8 0.9 0 1 0 1\np 4\n-2 -2 0\n2 -2 0\n2 2 0\n-2 2 0\n\
+    pp 3\n0 1 0.2 0 0 1\n1 1 0.2 0 0.6 0.8\n0 1.5 1 0 -0.6 0.8\n";
+
+/// The saved bytes of [`RASTER_FUZZ_SCENE`] on a 12-voxel raster: exact
+/// (version 2) and the paper's (version 1); made once.
+fn raster_fuzz_bases() -> Result<&'static [Vec<u8>; 2], String> {
+    use crate::output::rasterfile::save_bytes;
+    use crate::scene::Scene;
+    use crate::voxelize::{BuildOptions, build};
+    static BASES: std::sync::OnceLock<Result<[Vec<u8>; 2], String>> = std::sync::OnceLock::new();
+    BASES
+        .get_or_init(|| {
+            let scene = Scene::parse("fuzz-base.nff", RASTER_FUZZ_SCENE.as_bytes())
+                .map_err(|e| e.to_string())?;
+            let quiet = indicatif::ProgressBar::hidden();
+            let mut bases = [Vec::new(), Vec::new()];
+            for (b, opts) in bases
+                .iter_mut()
+                .zip([BuildOptions::new(12), BuildOptions::paper(12)])
+            {
+                let opts = BuildOptions { threads: 1, ..opts };
+                let (voxels, _) = build(&scene, &opts, &quiet).map_err(|e| e.to_string())?;
+                *b = save_bytes(&voxels, std::path::Path::new("fuzz-base.rrt"))
+                    .map_err(|e| e.to_string())?;
+            }
+            Ok(bases)
+        })
+        .as_ref()
+        .map_err(Clone::clone)
+}
+
+/// Fuzz input as a raster file named `fuzz.rrt`. The first byte chooses
+/// what the rest is: (0) the file's bytes; (1, 2) changes to a valid
+/// exact (1) or paper (2) raster, five bytes each (a little-endian `u32`
+/// offset into the file, a byte to xor there), after which the checksums
+/// are recomputed ([`reseal`](crate::output::rasterfile::reseal)) so that
+/// the loader's checks behind them are reached; (3) the same changes to the
+/// exact raster without recomputing them. Checks: an error names the
+/// file; a corrupted file (3) is refused unless what it loads is what was
+/// saved (changes in padding only); a loaded raster saves to bytes that
+/// load again and save the same, and renders a small image in its mode
+/// without panicking and without NaN pixels. A panic or a hang inside is a bug the caller sees as
+/// such.
+///
+/// # Errors
+/// The first broken invariant.
+pub fn raster_file_input(data: &[u8]) -> Result<(), String> {
+    use crate::output::rasterfile::{load_bytes, reseal, save_bytes};
+    use crate::render::{RenderOptions, render};
+    use crate::trace::{Mode, TraceOptions, Tracer};
+    let Some((&mode, rest)) = data.split_first() else {
+        return Ok(());
+    };
+    let bases = raster_fuzz_bases()?;
+    let bytes = match mode % 4 {
+        0 => rest.to_vec(),
+        m => {
+            let mut b = bases[usize::from(m == 2)].clone();
+            for change in rest.chunks_exact(5) {
+                let at = u32::from_le_bytes([change[0], change[1], change[2], change[3]]);
+                let at = usize::try_from(at).unwrap_or(0) % b.len().max(1);
+                if let Some(x) = b.get_mut(at) {
+                    *x ^= change[4];
+                }
+            }
+            if m != 3 {
+                reseal(&mut b);
+            }
+            b
+        }
+    };
+    let name = std::path::Path::new("fuzz.rrt");
+    let Some(scene) = read_or_refused("fuzz.rrt", load_bytes(name, &bytes))? else {
+        return Ok(());
+    };
+    let saved =
+        save_bytes(&scene, name).map_err(|e| format!("a loaded raster does not save: {e}"))?;
+    if mode % 4 == 3 && saved != bases[0] {
+        return Err("a file with a changed checksummed byte was loaded".into());
+    }
+    let again = load_bytes(name, &saved).map_err(|e| format!("saved raster does not load: {e}"))?;
+    if save_bytes(&again, name).ok().as_ref() != Some(&saved) {
+        return Err("a loaded raster saves differently the second time".into());
+    }
+    let opts = TraceOptions {
+        mode: if scene.exact {
+            Mode::Exact
+        } else {
+            Mode::Paper
+        },
+        depth: 2,
+        ..TraceOptions::default()
+    };
+    let Ok(tracer) = Tracer::new(&scene, opts) else {
+        return Ok(());
+    };
+    let Ok(camera) = Camera::new(&scene.view, 6, 5) else {
+        return Ok(());
+    };
+    let quiet = indicatif::ProgressBar::hidden();
+    let threads = RenderOptions {
+        supersample: 1,
+        threads: 1,
+    };
+    let (image, _, _) = render(&tracer, &camera, &threads, &quiet)
+        .map_err(|e| format!("a loaded raster does not render: {e}"))?;
+    // Lights may be as bright as a scene makes them (an f32 pixel may
+    // overflow to infinity), but never undefined.
+    if image.linear.iter().any(|v| v.is_nan()) {
+        return Err("a loaded raster renders NaN pixels".into());
     }
     Ok(())
 }

@@ -327,12 +327,18 @@ fn shade_record<const N: usize>(
     // Sum of I·L_rgb·(N·L) over visible front-side lights, 2^-32 units.
     let mut acc = [u128::from(lights.ambient) << SCALAR_BITS; 3];
     for (i, light) in lights.as_slice().iter().enumerate() {
+        if exact && params.exact_records == ExactRecords::Skip {
+            // Decided at render time by an exact shadow ray: no direction,
+            // no ray, nothing lit here.
+            rec.set_light(i, LightVisibility::Translucent);
+            report.translucent = report.translucent.saturating_add(1);
+            continue;
+        }
         let to_light = sub(light.position, c0);
         let l = normalize(to_light);
         let ndl = l.map_or(0, |l| dot_unit(normal, l));
         let front = ndl > 0;
         let vis = match (exact, params.exact_records) {
-            (true, ExactRecords::Skip) => LightVisibility::Translucent,
             (true, _) => {
                 report.rays = report.rays.saturating_add(1);
                 classify(raster, view, v, own, c0, light.position)?

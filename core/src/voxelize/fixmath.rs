@@ -245,6 +245,14 @@ pub(crate) fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
         .fold(0i128, |s, (x, y)| s.saturating_add(x.saturating_mul(y)))
 }
 
+/// `a · b`, or `None` when a product or a sum overflows.
+#[inline]
+pub(crate) fn checked_dot(a: [i128; 3], b: [i128; 3]) -> Option<i128> {
+    a.iter()
+        .zip(b)
+        .try_fold(0i128, |s, (x, y)| s.checked_add(x.checked_mul(y)?))
+}
+
 /// `a × b`, saturating.
 #[inline]
 pub(crate) fn cross(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {

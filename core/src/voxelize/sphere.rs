@@ -110,6 +110,9 @@ fn shell<S: VoxelSink + ?Sized>(
 ) -> Result<u64, VoxelizeError> {
     let b = Ball::new(sphere, window(extent, sink.layers()))?;
     let mut n = Counter::default();
+    if b.outside_window() {
+        return Ok(0);
+    }
     match separation {
         Separation::TwentySix => b.twenty_six(sink, &mut n, fill),
         Separation::Six => {
@@ -199,6 +202,18 @@ impl Ball {
             r,
             r2: r.saturating_mul(r),
             win,
+        })
+    }
+
+    /// Whether no cell of the window meets the closed ball: then no rule
+    /// offers anything (every voxel offered overlaps the ball's box).
+    fn outside_window(&self) -> bool {
+        (0..3).any(|k| {
+            let (lo, hi) = cells_overlapping(
+                self.c[k].saturating_sub(self.r),
+                self.c[k].saturating_add(self.r),
+            );
+            clip(lo, hi, self.win[k]).is_none()
         })
     }
 

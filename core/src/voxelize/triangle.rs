@@ -70,8 +70,8 @@
 
 use super::error::VoxelizeError;
 use super::fixmath::{
-    Counter, H, IncDiv, V, ceil_div, centre, check_point, checked_cross, clip, dist_u32, dot,
-    floor_div, isqrt, low, sub, unit, window,
+    Counter, H, IncDiv, V, ceil_div, centre, check_point, checked_cross, checked_dot, clip,
+    dist_u32, dot, floor_div, isqrt, low, sub, unit, window,
 };
 use super::sphere::{pick, place};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
@@ -333,6 +333,14 @@ fn orient(p: [i128; 2], q: [i128; 2], r: [i128; 2]) -> i128 {
         .saturating_sub(u[1].saturating_mul(w[0]))
 }
 
+/// `n` shifted right until every component is below `2^31` (the same
+/// direction).
+fn below_2_31(n: [i128; 3]) -> [i128; 3] {
+    let m = n.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    let shift = (128u32.saturating_sub(m.leading_zeros())).saturating_sub(31);
+    n.map(|c| c >> shift)
+}
+
 /// One separating axis: the probe at centre `c` meets the triangle only if
 /// `lo <= alpha·c <= hi`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -349,11 +357,12 @@ pub(crate) struct Tri {
     e: [[i128; 3]; 3],
     /// `(v1 − v0) × (v2 − v0)`, nonzero.
     n: [i128; 3],
-    /// `n` shifted below 2^31 (same direction).
-    n_small: [i128; 3],
     /// Unit face normal.
     unit: [i32; 3],
     normals: Option<[UnitVector; 3]>,
+    /// The barycentric numerators of a point's projection as linear
+    /// functions `k + g·c` ([`Tri::barycentric`]).
+    bary: [(i128, [i128; 3]); 3],
 }
 
 impl Tri {
@@ -376,15 +385,26 @@ impl Tri {
         if n == [0; 3] {
             return Err(VoxelizeError::Degenerate);
         }
-        let m = n.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
-        let shift = (128u32.saturating_sub(m.leading_zeros())).saturating_sub(31);
+        let n_small = below_2_31(n);
+        // (p − c) × (q − c) · n = (p × q) · n + c · (n × (q − p)): the
+        // numerator of vertex i, with p, q the other two vertices in order.
+        let mut bary = [(0, [0; 3]); 3];
+        for (i, b) in bary.iter_mut().enumerate() {
+            let (p, q) = (v[NEXT[i]], v[NEXT[NEXT[i]]]);
+            let k = checked_cross(p, q).and_then(|x| checked_dot(x, n_small));
+            let g = checked_cross(n_small, sub(q, p));
+            let (Some(k), Some(g)) = (k, g) else {
+                return Err(VoxelizeError::Arithmetic);
+            };
+            *b = (k, g);
+        }
         Ok(Self {
             v,
             e,
             n,
-            n_small: n.map(|c| c >> shift),
             unit: unit(n).ok_or(VoxelizeError::Degenerate)?,
             normals,
+            bary,
         })
     }
 
@@ -608,12 +628,7 @@ impl Tri {
     /// Nearest point data for voxel `v`: distance and normal.
     pub(crate) fn surfel(&self, v: [u32; 3]) -> Surfel {
         let c = v.map(centre);
-        // Barycentric numerators of c's projection onto the plane.
-        let a = [0, 1, 2].map(|i| {
-            let p = sub(self.v[NEXT[i]], c);
-            let q = sub(self.v[NEXT[NEXT[i]]], c);
-            checked_cross(p, q).map_or(0, |x| dot(x, self.n_small))
-        });
+        let a = self.barycentric(c);
         if a.iter().all(|x| *x >= 0) {
             // Inside: the plane distance along the unit normal.
             let u = self.unit.map(i128::from);
@@ -664,6 +679,15 @@ impl Tri {
             normal: self.interpolate(w).unwrap_or(self.unit),
             distance: dist_u32(isqrt(d2)),
         }
+    }
+
+    /// The barycentric numerators of the projection of point `c` onto the
+    /// plane: `(v_j − c) × (v_k − c) · n` for vertex `i` and the other two
+    /// vertices `j, k` in order, scaled by `n` shifted below `2^31`. For a
+    /// voxel centre of any raster (below `2^32` per axis) and vertices
+    /// within `COORD_LIMIT` no term saturates, so the linear form is exact.
+    fn barycentric(&self, c: [i128; 3]) -> [i128; 3] {
+        self.bary.map(|(k, g)| k.saturating_add(dot(g, c)))
     }
 
     /// Normal interpolated with non-negative weights `w` (any common scale).
@@ -840,6 +864,37 @@ mod tests {
             mesh(&verts, None, &[[0, 1, 9]], Separation::Six, e, &mut c),
             Err(VoxelizeError::IndexOutOfRange { triangle: 0 })
         );
+    }
+
+    #[test]
+    fn barycentric_is_the_cross_product() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut compared = 0;
+        for _ in 0..2000 {
+            let mut coord = |scale: u64| {
+                let r = rng.next_u64();
+                let m = (r >> 1) % scale;
+                if r & 1 == 0 { m as i128 } else { -(m as i128) }
+            };
+            let big = if compared % 2 == 0 { 1 << 20 } else { 1 << 40 };
+            let v: [[i128; 3]; 3] = core::array::from_fn(|_| core::array::from_fn(|_| coord(big)));
+            let Ok(t) = Tri::from_points(v, None) else {
+                continue;
+            };
+            for _ in 0..8 {
+                let c: [i128; 3] = core::array::from_fn(|_| {
+                    centre(u32::try_from(coord(1 << 16).unsigned_abs()).unwrap())
+                });
+                let direct = [0, 1, 2].map(|i| {
+                    let p = sub(v[NEXT[i]], c);
+                    let q = sub(v[NEXT[NEXT[i]]], c);
+                    checked_dot(checked_cross(p, q).unwrap(), below_2_31(t.n)).unwrap()
+                });
+                assert_eq!(t.barycentric(c), direct, "{v:?} {c:?}");
+                compared += 1;
+            }
+        }
+        assert!(compared > 10_000, "{compared}");
     }
 
     #[test]

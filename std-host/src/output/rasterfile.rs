@@ -48,6 +48,8 @@
 //! that break an invariant (dimensions, the record store's directory and
 //! sort order, object and material indices, non-finite numbers). Sizes are
 //! checked against the file's length before anything is allocated.
+//! [`load_bytes`] does the same for the bytes of a file in memory, and
+//! [`save_bytes`] gives the bytes [`save`] writes.
 //!
 //! The file is read, not memory-mapped: the checksums read every byte
 //! anyway, and a plane read into anonymous memory gets huge pages
@@ -390,29 +392,61 @@ pub fn save_to(
     mut out: AtomicFile,
     progress: &ProgressBar,
 ) -> Result<u64, RasterFileError> {
-    let path = &out.target().to_path_buf();
-    if let Some(d) = scene.direct.first() {
-        return Err(RasterFileError::Unsupported {
-            path: path.clone(),
+    let path = out.target().to_path_buf();
+    refuse_direct(scene, &path)?;
+    let io = |source| RasterFileError::Io {
+        path: path.clone(),
+        what: "cannot write",
+        source,
+    };
+    let len = write_raster(scene, out.file(), progress).map_err(io)?;
+    out.commit().map_err(io)?;
+    Ok(len)
+}
+
+/// The bytes [`save`] writes for `scene` (named `path` in errors).
+///
+/// # Errors
+/// [`RasterFileError::Unsupported`] for what a raster file cannot hold.
+pub fn save_bytes(scene: &VoxelScene, path: &Path) -> Result<Vec<u8>, RasterFileError> {
+    refuse_direct(scene, path)?;
+    let mut out = std::io::Cursor::new(Vec::new());
+    write_raster(scene, &mut out, &ProgressBar::hidden()).map_err(|source| {
+        RasterFileError::Io {
+            path: path.to_path_buf(),
+            what: "cannot write",
+            source,
+        }
+    })?;
+    Ok(out.into_inner())
+}
+
+/// Refuses a scene with volumes rendered directly: a raster file holds no
+/// samples or transfer functions.
+fn refuse_direct(scene: &VoxelScene, path: &Path) -> Result<(), RasterFileError> {
+    match scene.direct.first() {
+        Some(d) => Err(RasterFileError::Unsupported {
+            path: path.to_path_buf(),
             what: format!(
                 "a volume rendered directly (object {}: its samples and transfer function)",
                 d.object
             ),
-        });
+        }),
+        None => Ok(()),
     }
-    let io = |what| {
-        move |source| RasterFileError::Io {
-            path: path.to_path_buf(),
-            what,
-            source,
-        }
-    };
-    let file = out.file();
+}
+
+/// Writes `scene` into `file` from its start (module docs for the layout);
+/// returns the length written.
+fn write_raster<F: Write + Seek>(
+    scene: &VoxelScene,
+    file: &mut F,
+    progress: &ProgressBar,
+) -> std::io::Result<u64> {
     let mut w = BufWriter::with_capacity(1 << 20, &mut *file);
     let version = if scene.exact { 2 } else { 1 };
     let (sections, header_len) = layout(version);
-    w.write_all(&vec![0u8; header_len as usize])
-        .map_err(io("cannot write"))?;
+    w.write_all(&vec![0u8; header_len as usize])?;
     // Every section's bytes, as the writer below counts them.
     progress.set_length(
         META_LEN
@@ -434,50 +468,43 @@ pub fn save_to(
             len: 0,
             progress,
         };
-        let r: std::io::Result<()> = match kind {
-            1 => c.put(&meta_bytes(scene)),
-            2 => c.put(&scene.plane),
+        match kind {
+            1 => c.put(&meta_bytes(scene))?,
+            2 => c.put(&scene.plane)?,
             3 => {
                 let mut b =
                     Vec::with_capacity(scene.directory.len() * DIRECTORY_ENTRY_LEN as usize);
                 for d in &scene.directory {
                     b.extend_from_slice(&d.to_le_bytes());
                 }
-                c.put(&b)
+                c.put(&b)?;
             }
             4 => {
                 let mut b = Vec::with_capacity(1 << 20);
-                let mut r = Ok(());
                 for chunk in scene.records.chunks(1 << 15) {
                     b.clear();
                     for rec in chunk {
                         record_bytes(rec, &mut b);
                     }
-                    r = c.put(&b);
-                    if r.is_err() {
-                        break;
-                    }
+                    c.put(&b)?;
                 }
-                r
             }
-            5 => c.put(&objects_bytes(scene)),
-            6 => c.put(&materials_bytes(scene)),
-            7 => c.put(&lights_bytes(scene)),
+            5 => c.put(&objects_bytes(scene))?,
+            6 => c.put(&materials_bytes(scene))?,
+            7 => c.put(&lights_bytes(scene))?,
             _ => {
                 let b: Vec<u8> = scene.lists.iter().flat_map(|v| v.to_le_bytes()).collect();
-                c.put(&b)
+                c.put(&b)?;
             }
-        };
-        r.map_err(io("cannot write"))?;
+        }
         let (len, crc) = (c.len, c.crc.finalize());
         table.push((kind, crc, offset, len));
         offset += len;
         let pad = offset.next_multiple_of(SECTION_ALIGN) - offset;
-        w.write_all(&vec![0u8; pad as usize])
-            .map_err(io("cannot write"))?;
+        w.write_all(&vec![0u8; pad as usize])?;
         offset += pad;
     }
-    w.flush().map_err(io("cannot write"))?;
+    w.flush()?;
     drop(w);
     let mut h = Vec::with_capacity(header_len as usize);
     h.extend_from_slice(&MAGIC);
@@ -492,10 +519,50 @@ pub fn save_to(
     let hcrc = crc32fast::hash(&h);
     h.extend_from_slice(&hcrc.to_le_bytes());
     h.resize(header_len as usize, 0);
-    file.seek(SeekFrom::Start(0)).map_err(io("cannot write"))?;
-    file.write_all(&h).map_err(io("cannot write"))?;
-    out.commit().map_err(io("cannot write"))?;
+    file.seek(SeekFrom::Start(0))?;
+    file.write_all(&h)?;
     Ok(offset)
+}
+
+/// Recomputes, in the bytes of a raster file, every checksum its section
+/// table can reach (the sections inside the bytes, then the header's), so
+/// that changed contents reach the loader's checks behind the checksums.
+/// Bytes that are not a raster file's header are left as they are.
+#[cfg(any(test, feature = "check"))]
+pub fn reseal(bytes: &mut [u8]) {
+    if bytes.len() < 16 || bytes[..8] != MAGIC {
+        return;
+    }
+    let version = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+    if !(1..=VERSION).contains(&version) {
+        return;
+    }
+    let (n, header_len) = layout(version);
+    if (bytes.len() as u64) < header_len {
+        return;
+    }
+    let le64 = |b: &[u8], at: usize| {
+        let mut x = [0u8; 8];
+        x.copy_from_slice(&b[at..at + 8]);
+        u64::from_le_bytes(x)
+    };
+    for k in 0..n {
+        let at = 16 + 24 * k;
+        let (off, len) = (le64(bytes, at + 8), le64(bytes, at + 16));
+        let Some(range) = usize::try_from(off)
+            .ok()
+            .zip(usize::try_from(len).ok())
+            .and_then(|(o, l)| Some(o..o.checked_add(l)?))
+            .filter(|r| r.end <= bytes.len())
+        else {
+            continue;
+        };
+        let crc = crc32fast::hash(&bytes[range]);
+        bytes[at + 4..at + 8].copy_from_slice(&crc.to_le_bytes());
+    }
+    let at = 16 + 24 * n;
+    let crc = crc32fast::hash(&bytes[..at]);
+    bytes[at..at + 4].copy_from_slice(&crc.to_le_bytes());
 }
 
 /// Whether the file at `path` starts with the raster magic.
@@ -548,16 +615,12 @@ struct Header {
     sections: [(u32, u64, u64); SECTIONS],
 }
 
-fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> {
+fn read_header<R: Read>(
+    file: &mut R,
+    file_len: u64,
+    path: &Path,
+) -> Result<Header, RasterFileError> {
     let p = || path.to_path_buf();
-    let file_len = file
-        .metadata()
-        .map_err(|source| RasterFileError::Io {
-            path: p(),
-            what: "cannot read",
-            source,
-        })?
-        .len();
     let mut h = [0u8; HEADER2_LEN as usize];
     let got = read_up_to(file, &mut h).map_err(|source| RasterFileError::Io {
         path: p(),
@@ -663,7 +726,7 @@ fn read_header(file: &mut File, path: &Path) -> Result<Header, RasterFileError> 
     })
 }
 
-fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
+fn read_up_to<R: Read>(file: &mut R, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut got = 0;
     while got < buf.len() {
         match file.read(&mut buf[got..]) {
@@ -678,8 +741,8 @@ fn read_up_to(file: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
 
 /// Reads section `k` into `buf` (whose length is the section's) and checks
 /// its checksum; `progress` counts the bytes read.
-fn read_section(
-    file: &mut File,
+fn read_section<R: Read + Seek>(
+    file: &mut R,
     path: &Path,
     h: &Header,
     k: usize,
@@ -723,7 +786,11 @@ struct Meta {
     lights: u32,
 }
 
-fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFileError> {
+fn read_meta<R: Read + Seek>(
+    file: &mut R,
+    path: &Path,
+    h: &Header,
+) -> Result<Meta, RasterFileError> {
     let invalid = |what: String| RasterFileError::Invalid {
         path: path.to_path_buf(),
         what,
@@ -786,9 +853,11 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
         lights: c.u32(),
     };
     Extent::new(dims[0], dims[1], dims[2]).map_err(|e| invalid(e.to_string()))?;
-    if !(origin.is_finite() && voxel_size > 0.0 && voxel_size.is_finite() && background.is_finite())
-    {
-        return Err(invalid("world frame or background is not finite".into()));
+    if !(origin.is_finite() && voxel_size > 0.0 && voxel_size.is_finite()) {
+        return Err(invalid("world frame is not finite".into()));
+    }
+    if !unit_colour(background) {
+        return Err(invalid("background colour channels not in [0, 1]".into()));
     }
     if !(from.is_finite() && at.is_finite() && up.is_finite() && angle.is_finite()) {
         return Err(invalid("view is not finite".into()));
@@ -808,13 +877,22 @@ fn read_meta(file: &mut File, path: &Path, h: &Header) -> Result<Meta, RasterFil
     Ok(m)
 }
 
-/// Opens `path` for reading.
-fn open(path: &Path) -> Result<File, RasterFileError> {
-    File::open(path).map_err(|source| RasterFileError::Io {
+/// Opens `path` for reading, with its length.
+fn open(path: &Path) -> Result<(File, u64), RasterFileError> {
+    let file = File::open(path).map_err(|source| RasterFileError::Io {
         path: path.to_path_buf(),
         what: "cannot open",
         source,
-    })
+    })?;
+    let len = file
+        .metadata()
+        .map_err(|source| RasterFileError::Io {
+            path: path.to_path_buf(),
+            what: "cannot read",
+            source,
+        })?
+        .len();
+    Ok((file, len))
 }
 
 /// The header and meta section of a raster file.
@@ -822,8 +900,8 @@ fn open(path: &Path) -> Result<File, RasterFileError> {
 /// # Errors
 /// As [`load`], for the header and meta section.
 pub fn info(path: &Path) -> Result<Info, RasterFileError> {
-    let mut file = open(path)?;
-    let h = read_header(&mut file, path)?;
+    let (mut file, len) = open(path)?;
+    let h = read_header(&mut file, len, path)?;
     let m = read_meta(&mut file, path, &h)?;
     Ok(Info {
         version: h.version,
@@ -861,8 +939,8 @@ pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError
         what: "cannot read",
         source,
     };
-    let mut file = open(path)?;
-    let h = read_header(&mut file, path)?;
+    let (mut file, len) = open(path)?;
+    let h = read_header(&mut file, len, path)?;
     progress.set_length(h.file_len);
     progress.set_position(0);
     let (n, header_len) = layout(h.version);
@@ -926,12 +1004,36 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
 /// # Errors
 /// As [`load`].
 pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, RasterFileError> {
+    let (file, len) = open(path)?;
+    load_from(file, len, path, progress)
+}
+
+/// [`load`] from the bytes of a raster file in memory, named `path` in
+/// errors.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<VoxelScene, RasterFileError> {
+    load_from(
+        std::io::Cursor::new(bytes),
+        bytes.len() as u64,
+        path,
+        &ProgressBar::hidden(),
+    )
+}
+
+/// [`load_with`] from `file` of `len` bytes, named `path` in errors.
+fn load_from<R: Read + Seek>(
+    mut file: R,
+    len: u64,
+    path: &Path,
+    progress: &ProgressBar,
+) -> Result<VoxelScene, RasterFileError> {
     let invalid = |what: String| RasterFileError::Invalid {
         path: path.to_path_buf(),
         what,
     };
-    let mut file = open(path)?;
-    let h = read_header(&mut file, path)?;
+    let h = read_header(&mut file, len, path)?;
     let m = read_meta(&mut file, path, &h)?;
     progress.set_length(h.file_len);
     progress.set_position(0);
@@ -962,7 +1064,7 @@ pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, Rast
         )));
     }
     let lists_len = expect(7, lists_bytes)?;
-    let section = |file: &mut File, k: usize, len: usize| -> Result<Vec<u8>, RasterFileError> {
+    let section = |file: &mut R, k: usize, len: usize| -> Result<Vec<u8>, RasterFileError> {
         let mut b = vec![0u8; len];
         read_section(file, path, &h, k, &mut b, progress)?;
         Ok(b)
@@ -1044,11 +1146,15 @@ fn materials_from(b: &[u8]) -> Result<Vec<Material>, String> {
         loc: None,
     });
     for (i, mt) in materials.iter().enumerate() {
-        let ok = mt.colour.is_finite()
+        // What the scene readers accept: colour channels and the
+        // transmittance in [0, 1], the rest finite and ≥ 0, an index of
+        // refraction > 0 where light is transmitted.
+        let ok = unit_colour(mt.colour)
             && [mt.kd, mt.ks, mt.shine, mt.transmittance, mt.ior]
                 .iter()
                 .all(|v| v.is_finite() && *v >= 0.0)
-            && mt.transmittance <= 1.0;
+            && mt.transmittance <= 1.0
+            && (mt.transmittance == 0.0 || mt.ior > 0.0);
         if !ok {
             return Err(format!("material {i} has a value out of range"));
         }
@@ -1080,23 +1186,28 @@ fn objects_from(b: &[u8], materials: usize) -> Result<Vec<WorldObject>, String> 
     Ok(objects)
 }
 
-/// The lights section, every number finite.
+/// Whether every channel of `c` lies in `[0, 1]` (so is finite).
+fn unit_colour(c: DVec3) -> bool {
+    c.cmpge(DVec3::ZERO).all() && c.cmple(DVec3::ONE).all()
+}
+
+/// The lights section: positions finite, colour channels finite and ≥ 0
+/// (as the scene readers accept).
 fn lights_from(b: &[u8]) -> Result<Vec<WorldLight>, String> {
     let lights = Cursor::entries(b, LIGHT_LEN, |c| WorldLight {
         position: c.vec(),
         colour: c.vec(),
     });
-    if lights
-        .iter()
-        .any(|l| !(l.position.is_finite() && l.colour.is_finite()))
-    {
-        return Err("a light is not finite".into());
+    if lights.iter().any(|l| {
+        !(l.position.is_finite() && l.colour.is_finite() && l.colour.cmpge(DVec3::ZERO).all())
+    }) {
+        return Err("a light is not finite, or has a negative colour channel".into());
     }
     Ok(lights)
 }
 
-fn read_records(
-    file: &mut File,
+fn read_records<R: Read + Seek>(
+    file: &mut R,
     path: &Path,
     h: &Header,
     len: usize,
