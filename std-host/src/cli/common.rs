@@ -409,10 +409,33 @@ pub fn load_or_build(
             return Err(e);
         }
     };
-    if let Err(e) = check_view(&scene.view).and_then(|()| check_bounds(&scene, raster)) {
-        bar.finish_and_clear();
-        return Err(e);
-    }
+    let built = check_view(&scene.view)
+        .and_then(|()| build_scene(&scene, raster, purpose, image, threads, &bar));
+    bar.finish_and_clear();
+    let (vs, report) = built?;
+    Ok(Loaded::Built {
+        scene: vs,
+        report,
+        parse,
+    })
+}
+
+/// Voxelizes a scene already in memory as `rrt render` and `rrt
+/// voxelize` voxelize a scene file: `raster`'s options for `purpose`,
+/// the raster fitted to `image` unless `--raster` is given, on `threads`
+/// threads (0: one per core), with `bar` for the phases.
+///
+/// # Errors
+/// `--bounds` that hold none of the scene's geometry; the builder's error.
+pub fn build_scene(
+    scene: &Scene,
+    raster: &RasterArgs,
+    purpose: Purpose,
+    image: &ImageNeed<'_>,
+    threads: usize,
+    bar: &ProgressBar,
+) -> Result<(VoxelScene, BuildReport), CliError> {
+    check_bounds(scene, raster)?;
     let view = image.view.apply(&scene.view);
     let need = RasterNeed {
         view: &view,
@@ -423,16 +446,9 @@ pub fn load_or_build(
         samples: image.samples,
         discrete: raster.discrete(),
     };
-    let mut opts = raster.build_options(purpose, default_raster(&scene, &need));
+    let mut opts = raster.build_options(purpose, default_raster(scene, &need));
     opts.threads = threads;
-    let built = build(&scene, &opts, &bar);
-    bar.finish_and_clear();
-    let (vs, report) = built?;
-    Ok(Loaded::Built {
-        scene: vs,
-        report,
-        parse,
-    })
+    Ok(build(scene, &opts, bar)?)
 }
 
 /// Refuses `--bounds` that do not meet the box around the scene's
