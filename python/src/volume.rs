@@ -30,8 +30,9 @@ const DEFAULT_SIDE: u32 = 256;
 const DEFAULT_ANGLE: f64 = 30.0;
 /// The default background.
 const DEFAULT_BACKGROUND: [f64; 3] = [0.08, 0.08, 0.1];
-/// The default transfer function's colours, from the lowest to the
-/// highest sample (a blue, white, red diverging map), channels in `[0, 1]`.
+/// The default transfer function's colours (a blue, white, red diverging
+/// map, channels in `[0, 1]`) at 20%, 50% and 80% of the data's range:
+/// across its opacity ramp.
 const DEFAULT_COLOURS: [[f64; 3]; 3] = [[0.23, 0.30, 0.75], [0.87, 0.87, 0.87], [0.71, 0.02, 0.15]];
 
 /// The samples of a C-contiguous 3D array, indexed `[z, y, x]` (x
@@ -156,7 +157,7 @@ fn classifier(
         let colours: Vec<[f64; 4]> = DEFAULT_COLOURS
             .iter()
             .enumerate()
-            .map(|(i, c)| [at(i as f64 / 2.0), c[0], c[1], c[2]])
+            .map(|(i, c)| [at(0.2 + 0.3 * i as f64), c[0], c[1], c[2]])
             .collect();
         return Classifier::from_points(None, Some(&opacity), Some(&colours))
             .map_err(|e| bad(e.to_string()));
@@ -353,8 +354,9 @@ pub fn volume(
 /// * `transfer`: a dict with the TOML volume keys: `iso` (a value),
 ///   `opacity` (`[[value, alpha], ...]`) and `colours` (`[[value, r, g,
 ///   b], ...]`, channels in [0, 1]); values increase along each ramp.
-///   Default: opaque from the middle of the data's range up, coloured
-///   blue, white, red from the lowest to the highest sample.
+///   Default: an opacity ramp from 0 at 20% to 1 at 80% of the data's
+///   range (opaque from the middle up while opacity is a cut at ½),
+///   coloured blue, white, red across it.
 /// * `camera`: an `rrt.View`; default: the whole volume from the front,
 ///   right and above, z up. `frame=(k, n)`: frame `k` of its orbit.
 #[pyfunction]
