@@ -65,7 +65,7 @@ def main():
     fps = {1: [], 2: []}
     for _ in range(max(1, a.rounds // 2)):
         for threads in (1, 2):
-            t, _ = timed(lambda: [raster.render(frame=(k, n), threads=threads) for k in range(n)])
+            t, _ = timed(lambda: [raster.render(frame=(k, n), width=256, height=256, threads=threads) for k in range(n)])
             fps[threads].append(n / t)
     print(f"orbit of {n} frames from a saved raster (balls2, 256²), frames per second:")
     for threads in (1, 2):
