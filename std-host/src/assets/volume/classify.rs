@@ -279,7 +279,7 @@ impl Classifier {
     /// ```
     /// use rrt_host::assets::volume::Classifier;
     /// let c = Classifier::from_points(None, Some(&[[0.2, 0.0], [0.8, 1.0]]), Some(&[[0.0, 1.0, 0.0, 0.0]]))?;
-    /// assert!(c.is_opaque(0.5) && !c.is_opaque(0.4));
+    /// assert!(c.is_opaque(0.6) && !c.is_opaque(0.4));
     /// assert_eq!(c.color(0.5, [0; 3]), [255, 0, 0]);
     /// let e = Classifier::from_points(Some(1.0), Some(&[[0.5, 0.0], [0.5, 1.0]]), None).unwrap_err();
     /// assert_eq!(e.to_string(), "opacity[1][0]: expected values that increase along the ramp");
