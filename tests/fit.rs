@@ -207,3 +207,37 @@ fn spd_scenes_fit_with_memory_estimates() {
         "{msg}"
     );
 }
+
+/// A scene of volumes alone gets the raster of a pixel's footprint (not
+/// the largest default, which the surface primitives' ray budget would
+/// allow for a scene without any).
+#[test]
+fn a_volume_alone_gets_the_pixel_footprint_raster() {
+    use rrt_host::fit::{MAX_DEFAULT_RASTER, MIN_DEFAULT_RASTER, RasterNeed, default_raster};
+    let dir = rrt_tests::fresh_dir("fit", "volume_alone");
+    let path = dir.join("blob.toml");
+    std::fs::write(
+        &path,
+        "[camera]\nfrom = [0, -6, 2]\nat = [0, 0, 0]\nangle = 40\nresolution = [64, 48]\n\
+         [volume.v]\nmetaballs = { dims = [32, 32, 32], min = [-1, -1, -1], max = [1, 1, 1], balls = [[0, 0, 0, 0.8, 1]] }\n\
+         iso = 0.5\n[material.m]\ncolour = [1, 1, 1]\n[[object]]\nmaterial = \"m\"\nvolume = \"v\"\n",
+    )
+    .unwrap();
+    let scene = Scene::load(&path).unwrap();
+    let size = |w: u32, h: u32| {
+        default_raster(
+            &scene,
+            &RasterNeed {
+                view: &scene.view,
+                image: [w, h],
+                samples: 1,
+                discrete: false,
+            },
+        )
+    };
+    assert_eq!(size(64, 48), MIN_DEFAULT_RASTER);
+    // Larger images, finer voxels, up to the largest default.
+    let (a, b) = (size(512, 384), size(2048, 1536));
+    assert!(MIN_DEFAULT_RASTER < a && a < b, "{a} {b}");
+    assert!(b <= MAX_DEFAULT_RASTER);
+}

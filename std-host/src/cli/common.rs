@@ -409,26 +409,46 @@ pub fn load_or_build(
             return Err(e);
         }
     };
-    let check_save = || {
-        // A saved raster cannot hold a volume rendered directly: said
-        // before voxelizing.
-        match scene.volumes.iter().find(|v| v.data.classifier.is_direct()) {
-            Some(v) if purpose == Purpose::Save => Err(CliError::Arg {
-                arg: "SCENE",
-                message: format!(
-                    "{}: a volume rendered directly (render = \"direct\") cannot be saved in a raster file; render the scene itself, or give the volume render = \"iso\"",
-                    v.loc
-                ),
-            }),
-            _ => Ok(()),
-        }
-    };
-    if let Err(e) = check_view(&scene.view)
-        .and_then(|()| check_bounds(&scene, raster))
-        .and_then(|()| check_save())
+    let built = check_view(&scene.view)
+        .and_then(|()| build_scene(&scene, raster, purpose, image, threads, &bar));
+    bar.finish_and_clear();
+    let (vs, report) = built?;
+    Ok(Loaded::Built {
+        scene: vs,
+        report,
+        parse,
+    })
+}
+
+/// Voxelizes a scene already in memory as `rrt render` and `rrt
+/// voxelize` voxelize a scene file: `raster`'s options for `purpose`,
+/// the raster fitted to `image` unless `--raster` is given, on `threads`
+/// threads (0: one per core), with `bar` for the phases.
+///
+/// # Errors
+/// `--bounds` that hold none of the scene's geometry; a volume rendered
+/// directly in a raster to be saved; the builder's error.
+pub fn build_scene(
+    scene: &Scene,
+    raster: &RasterArgs,
+    purpose: Purpose,
+    image: &ImageNeed<'_>,
+    threads: usize,
+    bar: &ProgressBar,
+) -> Result<(VoxelScene, BuildReport), CliError> {
+    check_bounds(scene, raster)?;
+    // A saved raster cannot hold a volume rendered directly: said before
+    // voxelizing.
+    if purpose == Purpose::Save
+        && let Some(v) = scene.volumes.iter().find(|v| v.data.classifier.is_direct())
     {
-        bar.finish_and_clear();
-        return Err(e);
+        return Err(CliError::Arg {
+            arg: "SCENE",
+            message: format!(
+                "{}: a volume rendered directly (render = \"direct\") cannot be saved in a raster file; render the scene itself, or give the volume render = \"iso\"",
+                v.loc
+            ),
+        });
     }
     let view = image.view.apply(&scene.view);
     let need = RasterNeed {
@@ -440,16 +460,9 @@ pub fn load_or_build(
         samples: image.samples,
         discrete: raster.discrete(),
     };
-    let mut opts = raster.build_options(purpose, default_raster(&scene, &need));
+    let mut opts = raster.build_options(purpose, default_raster(scene, &need));
     opts.threads = threads;
-    let built = build(&scene, &opts, &bar);
-    bar.finish_and_clear();
-    let (vs, report) = built?;
-    Ok(Loaded::Built {
-        scene: vs,
-        report,
-        parse,
-    })
+    Ok(build(scene, &opts, bar)?)
 }
 
 /// Refuses `--bounds` that do not meet the box around the scene's

@@ -105,7 +105,9 @@ pub struct RasterNeed<'v> {
 /// the size is the largest whose estimated surface voxels
 /// ([`SurfaceMeasure::voxels`]) do not exceed the rays per image (more
 /// voxels cost more to build than they save), but at least the size at
-/// which voxels do not crowd ([`CROWDING`]). Where voxels are the picture (the paper's mode;
+/// which voxels do not crowd ([`CROWDING`]); a scene without surface
+/// primitives (volumes, `.vox` models, CSG only) starts
+/// from [`MIN_DEFAULT_RASTER`]. Where voxels are the picture (the paper's mode;
 /// volumes, `.vox` models and CSG results, which have no exact geometry),
 /// a voxel is in addition no larger than a pixel's footprint at the
 /// scene's nearest point to the eye. With volumes rendered directly, a
@@ -124,8 +126,13 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
     let rays = w * h * f64::from(need.samples).powi(2);
     let (lo, hi) = (MIN_DEFAULT_RASTER, MAX_DEFAULT_RASTER);
     // The largest size within the ray budget, and the smallest that does
-    // not crowd (both monotone in the size: bisect).
-    let within = last_true(lo, hi, |r| voxels_at(r) <= rays.max(1.0));
+    // not crowd (both monotone in the size: bisect). Without surface
+    // primitives there is nothing for the raster to accelerate.
+    let within = if surface.objects == 0 {
+        lo
+    } else {
+        last_true(lo, hi, |r| voxels_at(r) <= rays.max(1.0))
+    };
     let crowd = 8.0 * CROWDING * surface.objects as f64;
     let uncrowded = if voxels_at(lo) < crowd {
         last_true(lo, hi, |r| voxels_at(r) < crowd).saturating_add(1)

@@ -349,6 +349,141 @@ impl Classifier {
     }
 }
 
+/// A transfer function's control point or key that is refused by
+/// [`Classifier::from_points`]: the key it is at (`iso`, `opacity[2]`,
+/// `colours[1][0]`, arrays counting from 0) and what is wrong.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{key}: {message}")]
+pub struct TransferError {
+    /// Where: `iso`, `opacity`, `colours`, or one point (`opacity[i]`)
+    /// or its value (`opacity[i][0]`).
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl Classifier {
+    /// The classification a transfer function's points describe, as a
+    /// volume's `iso`, `opacity` and `colours` keys in a TOML scene give
+    /// them: `opacity` points `[value, alpha]` with alpha in `[0, 1]`,
+    /// `colours` points `[value, r, g, b]` with channels in `[0, 1]`
+    /// (rounded to 8 bits), values finite and strictly increasing along
+    /// each ramp. Without `iso` the opacity ramp alone decides; one of the
+    /// two is required. `render` (the `render` key) is `"iso"` or
+    /// `"direct"` ([`Render`]); without it, a volume whose opacity ramp has
+    /// a point strictly between 0 and 1 is rendered directly and any other
+    /// as its iso-surface. Direct rendering needs an opacity ramp.
+    ///
+    /// ```
+    /// use rrt_host::assets::volume::Classifier;
+    /// let c = Classifier::from_points(None, Some(&[[0.2, 0.0], [0.8, 1.0]]), Some(&[[0.0, 1.0, 0.0, 0.0]]), None)?;
+    /// assert!(c.is_opaque(0.6) && !c.is_opaque(0.4) && !c.is_direct());
+    /// assert_eq!(c.color(0.5, [0; 3]), [255, 0, 0]);
+    /// let soft = Classifier::from_points(None, Some(&[[0.2, 0.0], [0.8, 0.3]]), None, None)?;
+    /// assert!(soft.is_direct());
+    /// let e = Classifier::from_points(Some(1.0), Some(&[[0.5, 0.0], [0.5, 1.0]]), None, None).unwrap_err();
+    /// assert_eq!(e.to_string(), "opacity[1][0]: expected values that increase along the ramp");
+    /// # Ok::<(), rrt_host::assets::volume::classify::TransferError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`TransferError`] naming the first bad key or point.
+    pub fn from_points(
+        iso: Option<f64>,
+        opacity: Option<&[[f64; 2]]>,
+        colours: Option<&[[f64; 4]]>,
+        render: Option<&str>,
+    ) -> Result<Self, TransferError> {
+        let err = |key: String, message: &str| TransferError {
+            key,
+            message: message.into(),
+        };
+        // Point by point: each point's form, then its value against the
+        // previous point's.
+        let check = |ramp: &str, values: &[f64], ok: &dyn Fn(usize) -> bool, form: &str| {
+            for (i, v) in values.iter().enumerate() {
+                if !ok(i) {
+                    return Err(err(format!("{ramp}[{i}]"), form));
+                }
+                if i > 0 && !(*v > values[i - 1]) {
+                    return Err(err(
+                        format!("{ramp}[{i}][0]"),
+                        "expected values that increase along the ramp",
+                    ));
+                }
+            }
+            Ok(())
+        };
+        // With an opacity ramp and no iso-value, the ramp alone decides.
+        let mut classifier = match (iso, opacity) {
+            (Some(iso), _) => Self::iso(iso),
+            (None, Some(_)) => Self::iso(f64::MIN),
+            (None, None) => {
+                return Err(err(
+                    "iso".into(),
+                    "missing: give an iso-value, an opacity ramp, or both",
+                ));
+            }
+        };
+        if let Some(o) = opacity {
+            let values: Vec<f64> = o.iter().map(|p| p[0]).collect();
+            check(
+                "opacity",
+                &values,
+                &|i| o[i][0].is_finite() && (0.0..=1.0).contains(&o[i][1]),
+                "expected [value, alpha] with alpha in [0, 1]",
+            )?;
+            let ramp = Ramp::new(o.iter().map(|p| (p[0], p[1])).collect())
+                .map_err(|e| err("opacity".into(), &e.to_string()))?;
+            classifier = classifier.with_opacity(ramp);
+        }
+        if let Some(c) = colours {
+            let values: Vec<f64> = c.iter().map(|p| p[0]).collect();
+            check(
+                "colours",
+                &values,
+                &|i| {
+                    c[i].iter().all(|x| x.is_finite())
+                        && c[i][1..].iter().all(|x| (0.0..=1.0).contains(x))
+                },
+                "expected [value, r, g, b] with channels in [0, 1]",
+            )?;
+            // In [0, 255] after the check above.
+            let ch = |x: f64| (x * 255.0).round() as u8;
+            let ramp = ColorRamp::new(
+                c.iter()
+                    .map(|p| (p[0], [ch(p[1]), ch(p[2]), ch(p[3])]))
+                    .collect(),
+            )
+            .map_err(|e| err("colours".into(), &e.to_string()))?;
+            classifier = classifier.with_color(ramp);
+        }
+        classifier
+            .validate()
+            .map_err(|e| err("iso".into(), &e.to_string()))?;
+        // A ramp of only 0 and 1 is a cut of the iso-surface.
+        let partial = opacity.is_some_and(|o| o.iter().any(|p| p[1] > 0.0 && p[1] < 1.0));
+        let render = match render {
+            None if partial => Render::Direct,
+            None | Some("iso") => Render::Iso,
+            Some("direct") => Render::Direct,
+            Some(other) => {
+                return Err(err(
+                    "render".into(),
+                    &format!("expected \"iso\" or \"direct\", found \"{other}\""),
+                ));
+            }
+        };
+        if render == Render::Direct && opacity.is_none() {
+            return Err(err(
+                "render".into(),
+                "direct volume rendering needs a transfer function: give opacity = [[value, alpha], …]",
+            ));
+        }
+        Ok(classifier.with_render(render))
+    }
+}
+
 /// Sum of the Zucker–Hummel weights on one face of the 3×3×3 cube
 /// (`1 + 4/√2 + 4/√3`): a linear field of slope `g` gives a face
 /// difference of `2·g·ZH_FACE`.

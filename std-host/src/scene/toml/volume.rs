@@ -12,9 +12,7 @@ use super::build::Builder;
 use super::schema::VolumeDef;
 use crate::assets::volume::computed::{self, Metaball, Metaballs};
 use crate::assets::volume::raw::{self, RawSpec};
-use crate::assets::volume::{
-    self, Classifier, ColorRamp, Endian, Grid, Placement, Ramp, Render, SampleType, Volume,
-};
+use crate::assets::volume::{self, Classifier, Endian, Grid, Placement, SampleType, Volume};
 use crate::scene::error::SceneError;
 use crate::scene::objects::SceneVolume;
 
@@ -135,98 +133,13 @@ impl Builder<'_> {
         s: &Range<usize>,
         key: &dyn Fn(&str) -> String,
     ) -> Result<Classifier, SceneError> {
-        let s = s.clone();
-        // With an opacity ramp and no iso-value, the ramp alone decides.
-        let iso = match (d.iso, &d.opacity) {
-            (Some(iso), _) => iso,
-            (None, Some(_)) => f64::MIN,
-            (None, None) => {
-                return Err(self.err(
-                    s,
-                    &key("iso"),
-                    "missing: give an iso-value, an opacity ramp, or both",
-                ));
-            }
-        };
-        let mut classifier = Classifier::iso(iso);
-        if let Some(o) = &d.opacity {
-            for (i, p) in o.iter().enumerate() {
-                if !(p[0].is_finite() && (0.0..=1.0).contains(&p[1])) {
-                    return Err(self.err(
-                        s,
-                        &key(&format!("opacity[{i}]")),
-                        "expected [value, alpha] with alpha in [0, 1]",
-                    ));
-                }
-                if i > 0 && !(p[0] > o[i - 1][0]) {
-                    return Err(self.err(
-                        s,
-                        &key(&format!("opacity[{i}][0]")),
-                        "expected values that increase along the ramp",
-                    ));
-                }
-            }
-            let ramp = Ramp::new(o.iter().map(|p| (p[0], p[1])).collect())
-                .map_err(|e| self.err(s.clone(), &key("opacity"), e.to_string()))?;
-            classifier = classifier.with_opacity(ramp);
-        }
-        if let Some(c) = &d.colours {
-            let mut pts = Vec::with_capacity(c.len().min(4096));
-            for (i, p) in c.iter().enumerate() {
-                if !p.iter().all(|x| x.is_finite())
-                    || p[1..].iter().any(|&x| !(0.0..=1.0).contains(&x))
-                {
-                    return Err(self.err(
-                        s,
-                        &key(&format!("colours[{i}]")),
-                        "expected [value, r, g, b] with channels in [0, 1]",
-                    ));
-                }
-                if i > 0 && !(p[0] > c[i - 1][0]) {
-                    return Err(self.err(
-                        s,
-                        &key(&format!("colours[{i}][0]")),
-                        "expected values that increase along the ramp",
-                    ));
-                }
-                let ch = |x: f64| (x * 255.0).round() as u8;
-                pts.push((p[0], [ch(p[1]), ch(p[2]), ch(p[3])]));
-            }
-            let ramp = ColorRamp::new(pts)
-                .map_err(|e| self.err(s.clone(), &key("colours"), e.to_string()))?;
-            classifier = classifier.with_color(ramp);
-        }
-        classifier
-            .validate()
-            .map_err(|e| self.err(s.clone(), &key("iso"), e.to_string()))?;
-        // Direct volume rendering where the opacity ramp has partial
-        // opacities (a point strictly between 0 and 1), unless `render`
-        // says otherwise: a ramp of only 0 and 1 is a cut of the
-        // iso-surface, as it always was.
-        let partial = d
-            .opacity
-            .as_ref()
-            .is_some_and(|o| o.iter().any(|p| p[1] > 0.0 && p[1] < 1.0));
-        let render = match d.render.as_deref() {
-            None if partial => Render::Direct,
-            None | Some("iso") => Render::Iso,
-            Some("direct") => Render::Direct,
-            Some(other) => {
-                return Err(self.err(
-                    s,
-                    &key("render"),
-                    format!("expected \"iso\" or \"direct\", found \"{other}\""),
-                ));
-            }
-        };
-        if render == Render::Direct && d.opacity.is_none() {
-            return Err(self.err(
-                s,
-                &key("render"),
-                "direct volume rendering needs a transfer function: give opacity = [[value, alpha], …]",
-            ));
-        }
-        Ok(classifier.with_render(render))
+        Classifier::from_points(
+            d.iso,
+            d.opacity.as_deref(),
+            d.colours.as_deref(),
+            d.render.as_deref(),
+        )
+        .map_err(|e| self.err(s.clone(), &key(&e.key), e.message))
     }
 
     /// Where the volume goes: fitted into a box, or translated and scaled.
