@@ -375,6 +375,7 @@ impl<'p, 'd> Sizing<'p, 'd> {
             slab: self.slab,
             last_object: None,
             in_order: true,
+            encoded: None,
         })
     }
 }
@@ -431,6 +432,9 @@ pub struct Filler<'p, 'd, 'r> {
     /// object can only be in a voxel's chain as the chain's head node, the
     /// last one added to it (see [`Filler::listed`]).
     in_order: bool,
+    /// The last normal encoded and its encoding: the voxels of a planar
+    /// surface are offered with one normal, encoded once.
+    encoded: Option<([i32; 3], [i16; 2])>,
 }
 
 /// While the fill pass runs, a record's `lights` and first two `illum`
@@ -584,14 +588,23 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
             return;
         }
         let key = make_key(v, surfel.distance);
-        let make = |attrs: ObjectAttrs| {
+        let encoded = &mut self.encoded;
+        let mut make = |attrs: ObjectAttrs| {
+            let normal = match *encoded {
+                Some((n, e)) if n == surfel.normal => e,
+                _ => {
+                    let e = encode_normal(surfel.normal);
+                    *encoded = Some((surfel.normal, e));
+                    e
+                }
+            };
             let color = match texture {
                 Some(t) => t.color(centre(global), surfel.normal, attrs.color),
                 None => attrs.color,
             };
             VoxelRecord {
                 object: attrs.object,
-                normal: encode_normal(surfel.normal),
+                normal,
                 color,
                 illum: [0; 3],
                 lights: 0,
