@@ -189,3 +189,40 @@ fn classified_shadows_render_as_exact_shadow_rays() {
         assert_eq!(sa.classified + sa.shadow, sb.shadow, "seed {seed}");
     }
 }
+
+#[test]
+fn the_last_blocker_changes_no_image() {
+    for seed in 30..36u64 {
+        // Dense scenes, so that neighbouring shadow rays share blockers.
+        let nff = random_scene(seed, 80, 0.08);
+        let vs = exact(&nff, 40, ExactRecords::Skip);
+        let draw = |last_blocker: bool| {
+            let opts = TraceOptions {
+                last_blocker,
+                ..TraceOptions::default()
+            };
+            let tracer = Tracer::new(&vs, opts).unwrap();
+            let cam = Camera::new(&vs.view, 64, 64).unwrap();
+            render(
+                &tracer,
+                &cam,
+                &RenderOptions::default(),
+                &ProgressBar::hidden(),
+            )
+            .unwrap()
+        };
+        let (a, sa, _) = draw(true);
+        let (b, sb, _) = draw(false);
+        assert_eq!(a.rgb, b.rgb, "seed {seed}");
+        assert_eq!(a.linear, b.linear, "seed {seed}");
+        assert!(
+            sa.last_blocker > 0 && sb.last_blocker == 0,
+            "seed {seed}: {sa:?}"
+        );
+        assert_eq!(sa.shadow, sb.shadow, "seed {seed}");
+        assert!(
+            sa.shadow_steps < sb.shadow_steps,
+            "seed {seed}: {sa:?} {sb:?}"
+        );
+    }
+}

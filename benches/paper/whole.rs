@@ -322,6 +322,10 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             secs(median(&ts[1][2])),
             f(median(&ts[1][0]) / median(&ts[1][2]), 2),
             f(100.0 * shadow / (shadow + lit), 1),
+            f(
+                100.0 * saved_last.count("blocked by the last blocker") / shadow.max(1.0),
+                1,
+            ),
             f(saved_last.count("steps/shadow ray"), 1),
             f(100.0 * saved_last.count("false hits") / rays.max(1.0), 0),
             f(
@@ -409,8 +413,10 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
         "The same renders from the raster `rrt voxelize SCENE` saved (the default raster, with \
          the shadow classification), interleaved with Embree's whole process from the scene \
          file. **Uncertain**: the share of the shadow queries of verified hits that the \
-         classification did not prove lit, which fired an exact shadow ray; **steps per shadow \
-         ray**: the voxels each of those rays visited (an empty-space jump counts as one). \
+         classification did not prove lit, which fired an exact shadow ray; **blocked by the \
+         last blocker**: the share of those the object that last blocked a shadow ray towards \
+         the same light in the tile was found to block, without a walk; **steps per shadow \
+         ray**: the voxels each walked one visited (an empty-space jump counts as one). \
          **False hits**: discrete hits verification rejected, per traced ray (eye, reflected, \
          refracted). **Shared-voxel hits**: the share of verified hits found in a voxel that \
          several objects share (through its object list).",
@@ -427,6 +433,7 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             "Embree s, 2 threads",
             "rrt / Embree",
             "uncertain %",
+            "blocked by the last blocker %",
             "steps per shadow ray",
             "false hits per 100 rays",
             "shared-voxel hits %",

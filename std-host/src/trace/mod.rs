@@ -242,6 +242,11 @@ pub struct TraceOptions {
     /// space, and the scalar walk, the faster of the two where it was
     /// measured, is the default.
     pub packets: bool,
+    /// Before an exact shadow ray walks, try the object that last blocked
+    /// a shadow ray towards the same light in the tile
+    /// ([`RayStats::blockers`]). On by default; the image is the same
+    /// without it (every shadow ray then walks).
+    pub last_blocker: bool,
 }
 
 impl Default for TraceOptions {
@@ -252,6 +257,7 @@ impl Default for TraceOptions {
             depth: 3,
             light: LightParams::default(),
             packets: false,
+            last_blocker: true,
         }
     }
 }
@@ -294,7 +300,19 @@ pub struct RayStats {
     pub missing: u64,
     /// Samples of volumes rendered directly composited along rays.
     pub samples: u64,
+    /// Of `shadow`, the rays found blocked by the object that last blocked
+    /// a shadow ray towards the same light in this tile, without a walk.
+    pub last_blocker: u64,
+    /// Per light (the first [`BLOCKER_LIGHTS`]), the opaque object with
+    /// exact geometry that last blocked a render-time shadow ray of this
+    /// tile: tried first by the next one (an intersection with it is a
+    /// shadow whatever else lies between). Not a count: [`RayStats::add`]
+    /// leaves it, and no answer depends on it.
+    pub blockers: [Option<u32>; BLOCKER_LIGHTS],
 }
+
+/// Lights whose last blocker a tile keeps ([`RayStats::blockers`]).
+pub const BLOCKER_LIGHTS: usize = 8;
 
 impl RayStats {
     /// Adds `o` to `self`.
@@ -313,6 +331,7 @@ impl RayStats {
         self.false_hit_rays += o.false_hit_rays;
         self.missing += o.missing;
         self.samples += o.samples;
+        self.last_blocker += o.last_blocker;
     }
 
     /// All rays traced.

@@ -313,7 +313,11 @@ impl Tracer<'_> {
     /// continuous segment `t ∈ (0, tmax)`. Any intersection with an opaque
     /// object is a shadow (any hit ends the walk); a translucent object
     /// attenuates once. An object without exact geometry counts at its
-    /// voxels, unless the acne rule ignores them.
+    /// voxels, unless the acne rule ignores them. Before walking, the
+    /// object that last blocked a shadow ray towards the light in this
+    /// tile ([`RayStats::blockers`]) is intersected: neighbouring hits
+    /// mostly share their blocker, and meeting it inside the raster is the
+    /// walk's answer too.
     pub(super) fn exact_shadow(
         &self,
         h: &SurfaceHit,
@@ -329,6 +333,15 @@ impl Tracer<'_> {
         let Some(mut dray) = ray else {
             return 1.0;
         };
+        let skip = (!self.meets_itself(h, n)).then_some(h.object);
+        if self.opts.last_blocker
+            && let Some(Some(id)) = stats.blockers.get(k).copied()
+            && Some(id) != skip
+            && self.blocks_inside(id, segment, tmax)
+        {
+            stats.last_blocker += 1;
+            return 0.0;
+        }
         let rule = self.leaving(h, n);
         let store = self.store;
         let extent = self.extent;
@@ -340,9 +353,10 @@ impl Tracer<'_> {
         let mut mail = Mailbox::default();
         // The surface left, where it cannot meet the ray again, is tested
         // already.
-        if !self.meets_itself(h, n) {
-            mail.tested(h.object);
+        if let Some(id) = skip {
+            mail.tested(id);
         }
+        let mut blocker = None;
         // Translucent objects already counted (each attenuates once).
         let mut seen: Vec<u32> = Vec::new();
         let mut missing = 0u64;
@@ -387,6 +401,7 @@ impl Tracer<'_> {
                             .get(usize::from(obj.material))
                             .map_or(0.0, |m| m.transmittance);
                         if t <= 0.0 {
+                            blocker = obj.shape.is_exact().then_some(id);
                             return true;
                         }
                         if !seen.contains(&id) {
@@ -401,6 +416,28 @@ impl Tracer<'_> {
         stats.steps += u64::from(dray.steps());
         stats.shadow_steps += u64::from(dray.steps());
         stats.missing += missing;
+        if let (Some(id), Some(slot)) = (blocker, stats.blockers.get_mut(k)) {
+            *slot = Some(id);
+        }
         if end == WalkEnd::Hit { 0.0 } else { att }
+    }
+
+    /// Whether object `id`, opaque with exact geometry, meets `segment`
+    /// for `t ∈ (0, tmax)` first at a point inside the raster box: then
+    /// the exact shadow ray's walk, which visits every voxel of the
+    /// segment inside the raster, meets it too, and the light is blocked.
+    fn blocks_inside(&self, id: u32, segment: &Ray, tmax: f64) -> bool {
+        let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) else {
+            return false;
+        };
+        if !obj.shape.is_exact() || self.transmittance(obj.material) > 0.0 {
+            return false;
+        }
+        let Some(hit) = obj.shape.intersect(segment, 0.0, tmax) else {
+            return false;
+        };
+        let r = self.frame.world_to_raster(segment.at(hit.t));
+        let dims = self.extent.dims();
+        (0..3).all(|a| r[a] > 0.0 && r[a] < f64::from(dims[a]))
     }
 }
