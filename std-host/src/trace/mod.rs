@@ -24,7 +24,9 @@
 //! exactly: where the voxel holding the shadow ray's start is proven lit by
 //! the shadow classification ([`rrt_core::light`], *Shadow
 //! classification*), only the voxel's own objects are intersected;
-//! otherwise an exact shadow ray walks adaptively with empty-space skipping
+//! otherwise the object that last blocked a shadow ray towards the light
+//! in the tile is tried (met inside the raster, it is the walk's answer
+//! too), and else an exact shadow ray walks adaptively with empty-space skipping
 //! (exact: every opaque voxel the segment's line passes through is
 //! visited) and counts only objects of those voxels' lists that the
 //! continuous segment really intersects (voxels of objects without exact
