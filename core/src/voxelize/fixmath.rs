@@ -240,6 +240,15 @@ pub(crate) fn add(a: [i128; 3], b: [i128; 3]) -> [i128; 3] {
 /// `a·b`, saturating (summed in axis order).
 #[inline]
 pub(crate) fn dot(a: [i128; 3], b: [i128; 3]) -> i128 {
+    // Below 2^62 per factor, each product is below 2^124 and the sum below
+    // 2^126: exact, nothing to saturate, and no overflow checks to pay.
+    const SMALL: u128 = 1 << 62;
+    if a.iter().chain(b.iter()).all(|v| v.unsigned_abs() < SMALL) {
+        return a[0]
+            .wrapping_mul(b[0])
+            .wrapping_add(a[1].wrapping_mul(b[1]))
+            .wrapping_add(a[2].wrapping_mul(b[2]));
+    }
     a.iter()
         .zip(b)
         .fold(0i128, |s, (x, y)| s.saturating_add(x.saturating_mul(y)))
