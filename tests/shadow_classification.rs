@@ -10,9 +10,9 @@ use indicatif::ProgressBar;
 use rrt_core::light::ExactRecords;
 use rrt_core::voxel::LightVisibility;
 use rrt_host::render::camera::Camera;
-use rrt_host::render::{RenderOptions, render};
+use rrt_host::render::{Image, RenderOptions, render};
 use rrt_host::scene::Scene;
-use rrt_host::trace::{TraceOptions, Tracer};
+use rrt_host::trace::{RayStats, TraceOptions, Tracer};
 use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
 use rrt_host::world::Ray;
 use rrt_tests::Rng;
@@ -161,25 +161,28 @@ fn lit_voxels_have_only_their_own_objects_between_them_and_each_light() {
     assert!(lit > 2_000, "{lit} lit (voxel, light) pairs");
 }
 
+/// The scene's view rendered `size`² with `opts`: the image and counts.
+fn draw(vs: &VoxelScene, opts: TraceOptions, size: u32) -> (Image, RayStats) {
+    let tracer = Tracer::new(vs, opts).unwrap();
+    let cam = Camera::new(&vs.view, size, size).unwrap();
+    let (image, stats, _) = render(
+        &tracer,
+        &cam,
+        &RenderOptions::default(),
+        &ProgressBar::hidden(),
+    )
+    .unwrap();
+    (image, stats)
+}
+
 #[test]
 fn classified_shadows_render_as_exact_shadow_rays() {
     for seed in 20..26u64 {
         let nff = random_scene(seed, 40, 0.05);
         let vs = exact(&nff, 40, ExactRecords::Classify);
         let rays_only = exact(&nff, 40, ExactRecords::Skip);
-        let draw = |s: &VoxelScene| {
-            let tracer = Tracer::new(s, TraceOptions::default()).unwrap();
-            let cam = Camera::new(&s.view, 48, 48).unwrap();
-            render(
-                &tracer,
-                &cam,
-                &RenderOptions::default(),
-                &ProgressBar::hidden(),
-            )
-            .unwrap()
-        };
-        let (a, sa, _) = draw(&vs);
-        let (b, sb, _) = draw(&rays_only);
+        let (a, sa) = draw(&vs, TraceOptions::default(), 48);
+        let (b, sb) = draw(&rays_only, TraceOptions::default(), 48);
         assert_eq!(a.rgb, b.rgb, "seed {seed}");
         assert_eq!(a.linear, b.linear, "seed {seed}");
         assert!(
@@ -196,23 +199,12 @@ fn the_last_blocker_changes_no_image() {
         // Dense scenes, so that neighbouring shadow rays share blockers.
         let nff = random_scene(seed, 80, 0.08);
         let vs = exact(&nff, 40, ExactRecords::Skip);
-        let draw = |last_blocker: bool| {
-            let opts = TraceOptions {
-                last_blocker,
-                ..TraceOptions::default()
-            };
-            let tracer = Tracer::new(&vs, opts).unwrap();
-            let cam = Camera::new(&vs.view, 64, 64).unwrap();
-            render(
-                &tracer,
-                &cam,
-                &RenderOptions::default(),
-                &ProgressBar::hidden(),
-            )
-            .unwrap()
+        let with = |last_blocker| TraceOptions {
+            last_blocker,
+            ..TraceOptions::default()
         };
-        let (a, sa, _) = draw(true);
-        let (b, sb, _) = draw(false);
+        let (a, sa) = draw(&vs, with(true), 64);
+        let (b, sb) = draw(&vs, with(false), 64);
         assert_eq!(a.rgb, b.rgb, "seed {seed}");
         assert_eq!(a.linear, b.linear, "seed {seed}");
         assert!(
