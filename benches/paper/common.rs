@@ -222,6 +222,7 @@ pub(crate) fn render_scene(
         &RenderOptions {
             supersample,
             threads,
+            alpha: false,
         },
         &ProgressBar::hidden(),
     )?;
