@@ -231,13 +231,19 @@ pub(crate) fn python(ctx: &mut Ctx) -> Res<()> {
         reading,
         "A fresh Python process that imports rrt and renders takes {} ms, {} ms more than the `rrt` \
          process: the interpreter's start-up and the imports. The orbit renders {} frames per second on \
-         one thread and {} on two ({}×; the machine's two cores are shared with other jobs, so two \
-         threads cannot give more than 2×). ",
+         one thread and {} on two ({}×{}). ",
         ms(process),
         ms(process - cli),
         f(fps1, 1),
         f(fps2, 1),
-        f(fps2 / fps1, 2)
+        f(fps2 / fps1, 2),
+        if fps2 / fps1 < 1.3 {
+            "; the second thread gained little or nothing in this run: the machine's two cores are \
+             shared with other jobs (the load averages at the top of this file), and two threads can \
+             only help while a core is idle"
+        } else {
+            "; the machine's two cores bound it at 2×"
+        }
     );
     match ray {
         Some((r, s, _, workers)) if r > s => {
