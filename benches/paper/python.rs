@@ -2,8 +2,9 @@
 //! overhead, an orbit's frames per second from a saved raster on one and
 //! two threads, and the Ray example's frames against one process, as
 //! `python/measure.py --json` measures them in the environment `tests/run`
-//! makes (`target/python-venv`, or `$RRT_VENV`), with the package and the
-//! `rrt` binary built from this checkout as this bench is built.
+//! makes (`target/python-venv` in the workspace, or `$RRT_VENV`), with the
+//! package and the `rrt` binary built from this checkout as this bench is
+//! built. Not measured in quick runs.
 
 use serde_json::Value;
 
@@ -47,9 +48,13 @@ fn tail(stderr: &[u8]) -> String {
 
 pub(crate) fn python(ctx: &mut Ctx) -> Res<()> {
     ctx.md.h2("Python");
+    if ctx.cfg.quick {
+        return skipped(
+            ctx,
+            "not measured in quick runs (the package's release build alone takes minutes); `--section python` measures it.",
+        );
+    }
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let target =
-        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
     let venv =
         std::env::var_os("RRT_VENV").map_or_else(|| root.join("target/python-venv"), PathBuf::from);
     let py = venv.join("bin/python");
@@ -63,15 +68,10 @@ pub(crate) fn python(ctx: &mut Ctx) -> Res<()> {
         );
     }
     // The command line the figures compare with, built as this bench is
-    // (the same RUSTFLAGS).
-    ctx.log("Python: building the release rrt binary");
-    let built = Command::new("cargo")
-        .current_dir(&root)
-        .args(["build", "--release", "-q", "-p", "rrt-host", "--bin", "rrt"])
-        .status()?;
-    if !built.success() {
-        return Err("cargo build --release -p rrt-host --bin rrt failed".into());
-    }
+    // (the same profile and flags).
+    let Some(rrt) = rrt_binary(ctx)? else {
+        return Err("no rrt binary beside the bench's".into());
+    };
     // The package from this checkout (maturin from the environment; cargo
     // reuses python/target).
     ctx.log(&format!(
@@ -118,7 +118,7 @@ pub(crate) fn python(ctx: &mut Ctx) -> Res<()> {
         .current_dir(&root)
         .arg("python/measure.py")
         .args(["--json", "--rounds", &rounds.to_string()])
-        .env("RRT_CLI", target.join("release/rrt"))
+        .env("RRT_CLI", &rrt)
         .output()?;
     if !measured.status.success() {
         return Err(format!("python/measure.py failed: {}", tail(&measured.stderr)).into());
@@ -196,7 +196,7 @@ pub(crate) fn python(ctx: &mut Ctx) -> Res<()> {
     }
     ctx.md.para(&format!(
         "`python/measure.py --json --rounds {rounds}` in `{}` (the package installed from this checkout \
-         with `pip install ./python`, the `rrt` binary it compares with from `cargo build --release`): \
+         with `pip install ./python`, the `rrt` binary it compares with built as this bench is): \
          one render of `scenes/one-sphere.toml` at 256² three ways, interleaved, medians of {rounds}; \
          an orbit of {frames:.0} frames at 256² from a saved raster of the built-in 91-sphereflake \
          (raster {raster}), `Raster.render(frame=(k, {frames:.0}))`, medians of {} rounds on 1 and 2 \
