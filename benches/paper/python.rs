@@ -212,9 +212,10 @@ pub(crate) fn python(ctx: &mut Ctx) -> Res<()> {
     if overhead <= 0.0 {
         let _ = write!(
             reading,
-            "Calling rrt from Python costs nothing measurable: `rrt.render` returns the array {} ms \
-             sooner than the command line writes its PNG, as it starts no process and encodes no file \
-             (the parse, voxelization and render are the same code). ",
+            "`rrt.render` called in a running interpreter returned its array {} ms sooner than the \
+             `rrt` process wrote its PNG: the call starts no process and encodes no file (the parse, \
+             voxelization and render are the same code), so its own overhead is below what this run \
+             resolves. ",
             ms(-overhead)
         );
     } else {
