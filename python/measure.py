@@ -12,9 +12,17 @@ environment tests/run makes, with a release `rrt` built):
 3. The same 16 frames as Ray tasks on a local cluster of two workers,
    against the single process (2 threads).
 
-Medians of interleaved rounds; prints a table."""
+Medians of interleaved rounds; prints a table, or with --json one JSON
+object (times in seconds) for the paper bench's Python section:
+
+    {"rounds", "frames",
+     "render": {"cli", "call", "process"},
+     "orbit": {"raster", "side", "fps": {"1", "2"}},
+     "ray": null (ray not installed) or
+            {"workers", "ray", "process", "startup", "identical"}}"""
 
 import argparse
+import json
 import os
 import pathlib
 import statistics
@@ -41,7 +49,10 @@ def main():
     p = argparse.ArgumentParser()
     p.add_argument("--rounds", type=int, default=7)
     p.add_argument("--frames", type=int, default=16)
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
     a = p.parse_args()
+    say = (lambda *_: None) if a.json else print
+    out = {"rounds": a.rounds, "frames": a.frames}
     cli = pathlib.Path(os.environ.get("RRT_CLI", REPO / "target" / "release" / "rrt"))
     tmp = pathlib.Path(tempfile.mkdtemp())
     png = tmp / "one.png"
@@ -53,10 +64,11 @@ def main():
         times["call"].append(timed(lambda: rrt.render(SCENE))[0])
         times["py"].append(timed(lambda: subprocess.run(py_process, check=True))[0])
     med = {k: statistics.median(v) for k, v in times.items()}
-    print(f"one render, one-sphere.toml 256², medians of {a.rounds}:")
-    print(f"  rrt render (process)                 {med['cli'] * 1000:8.1f} ms")
-    print(f"  rrt.render (call in an interpreter)  {med['call'] * 1000:8.1f} ms")
-    print(f"  python -c 'import rrt; rrt.render'   {med['py'] * 1000:8.1f} ms")
+    out["render"] = {"cli": med["cli"], "call": med["call"], "process": med["py"]}
+    say(f"one render, one-sphere.toml 256², medians of {a.rounds}:")
+    say(f"  rrt render (process)                 {med['cli'] * 1000:8.1f} ms")
+    say(f"  rrt.render (call in an interpreter)  {med['call'] * 1000:8.1f} ms")
+    say(f"  python -c 'import rrt; rrt.render'   {med['py'] * 1000:8.1f} ms")
 
     raster_path = tmp / "balls2.rrt"
     rrt.voxelize(None, raster_path)
@@ -67,14 +79,22 @@ def main():
         for threads in (1, 2):
             t, _ = timed(lambda: [raster.render(frame=(k, n), width=256, height=256, threads=threads) for k in range(n)])
             fps[threads].append(n / t)
-    print(f"orbit of {n} frames from a saved raster (balls2, 256²), frames per second:")
+    out["orbit"] = {
+        "raster": list(raster.dims),
+        "side": 256,
+        "fps": {str(t): statistics.median(fps[t]) for t in (1, 2)},
+    }
+    say(f"orbit of {n} frames from a saved raster (balls2, 256²), frames per second:")
     for threads in (1, 2):
-        print(f"  {threads} thread{'s' if threads > 1 else ' '}  {statistics.median(fps[threads]):6.2f} fps")
+        say(f"  {threads} thread{'s' if threads > 1 else ' '}  {statistics.median(fps[threads]):6.2f} fps")
 
+    out["ray"] = None
     try:
         import ray
     except ImportError:
-        print("ray is not installed: no Ray figures")
+        say("ray is not installed: no Ray figures")
+        if a.json:
+            print(json.dumps(out))
         return
     sys.path.insert(0, str(REPO / "python" / "examples"))
     import ray_orbit
@@ -90,8 +110,11 @@ def main():
         assert all(np.array_equal(x, y) for x, y in zip(frames, local)), "Ray frames differ"
     ray.shutdown()
     r, s = statistics.median(ray_times), statistics.median(local_times)
-    print(f"{n} frames 256² on Ray (2 workers, 1 thread each) against one process (2 threads):")
-    print(f"  Ray {r:.2f} s, one process {s:.2f} s, ratio {r / s:.2f} (Ray start-up {t_init:.1f} s, not counted); frames byte-identical")
+    out["ray"] = {"workers": 2, "ray": r, "process": s, "startup": t_init, "identical": True}
+    say(f"{n} frames 256² on Ray (2 workers, 1 thread each) against one process (2 threads):")
+    say(f"  Ray {r:.2f} s, one process {s:.2f} s, ratio {r / s:.2f} (Ray start-up {t_init:.1f} s, not counted); frames byte-identical")
+    if a.json:
+        print(json.dumps(out))
 
 
 if __name__ == "__main__":

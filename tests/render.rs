@@ -62,6 +62,7 @@ fn draw(
     let opts = RenderOptions {
         supersample: k,
         threads,
+        alpha: false,
     };
     let (img, stats, _) = render(&tracer, &cam, &opts, &ProgressBar::hidden()).unwrap();
     (img, stats)
@@ -164,6 +165,77 @@ fn png_is_identical_for_every_thread_count() {
         assert!(s.steps < s1.steps);
         assert_eq!(s1.primary, 70 * 45 * u64::from(k * k));
         assert!(s1.hits > 0 && s1.reflected > 0);
+    }
+}
+
+/// With alpha asked for, the colours are the same bytes; the coverage is 1
+/// where rays end on a sphere (matte or mirror) and 0 where they see the
+/// background (a pixel's share of its rays with supersampling), the
+/// straight colour is the colour where the coverage is 1 or 0 and over
+/// the background gives it elsewhere; all of it the same bits on 1, 2 and
+/// 3 threads.
+#[test]
+fn alpha_is_the_coverage_for_every_thread_count() {
+    // A matte sphere and a mirror sphere, background all around.
+    let nff = temp_dir("alpha").join("two.nff");
+    std::fs::write(
+        &nff,
+        "b 0.1 0.3 0.7\nv\nfrom 0 -6 1\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\nresolution 70 45\n\
+         l 3 -4 5\nf 1 0.5 0.2 0.8 0.2 20 0 1\ns -0.9 0 0 0.8\nf 0.9 0.9 0.9 0.1 0.9 50 0 1\ns 0.9 0 0 0.8\n",
+    )
+    .unwrap();
+    let scene = Scene::load(&nff).unwrap();
+    let exact = voxelize_exact(&scene, 96);
+    let bg = exact.background.as_vec3().to_array();
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let tracer = Tracer::new(&exact, TraceOptions::default()).unwrap();
+    let cam = Camera::new(&exact.view, 70, 45).unwrap();
+    for k in [1, 2] {
+        let (plain, _) = draw(&exact, 70, 45, TraceOptions::default(), k, 1);
+        assert!(plain.alpha.is_none());
+        let with = |threads| {
+            let opts = RenderOptions {
+                supersample: k,
+                threads,
+                alpha: true,
+            };
+            render(&tracer, &cam, &opts, &ProgressBar::hidden())
+                .unwrap()
+                .0
+        };
+        let one = with(1);
+        assert_eq!(one.rgb, plain.rgb);
+        assert_eq!(bits(&one.linear), bits(&plain.linear));
+        let a = one.alpha.as_ref().unwrap();
+        assert_eq!(a.coverage.len(), 70 * 45);
+        for threads in [2, 3] {
+            let other = with(threads);
+            let b = other.alpha.as_ref().unwrap();
+            assert_eq!(bits(&b.coverage), bits(&a.coverage), "{threads} threads");
+            assert_eq!(bits(&b.straight), bits(&a.straight), "{threads} threads");
+        }
+        let count = |f: &dyn Fn(f32) -> bool| a.coverage.iter().filter(|&&c| f(c)).count();
+        let (full, empty) = (count(&|c| c == 1.0), count(&|c| c == 0.0));
+        let partial = a.coverage.len() - full - empty;
+        assert!(full > 0 && empty > 0, "{full} {empty}");
+        if k == 1 {
+            assert_eq!(partial, 0);
+        } else {
+            assert!(partial > 0);
+            assert!(count(&|c| ![0.0, 0.25, 0.5, 0.75, 1.0].contains(&c)) == 0);
+        }
+        for (p, &c) in a.coverage.iter().enumerate() {
+            let (s, l) = (&a.straight[3 * p..3 * p + 3], &one.linear[3 * p..3 * p + 3]);
+            if c == 0.0 {
+                assert_eq!(l, bg, "{p}");
+            }
+            if c == 0.0 || c == 1.0 {
+                assert_eq!(bits(s), bits(l), "{p}");
+            }
+            for ((s, l), b) in s.iter().zip(l).zip(bg) {
+                assert!((s * c + b * (1.0 - c) - l).abs() < 1e-5, "{p}");
+            }
+        }
     }
 }
 
@@ -274,6 +346,7 @@ fn bands_are_the_rows_of_the_whole_image() {
             let opts = RenderOptions {
                 supersample: k,
                 threads: 2,
+                alpha: false,
             };
             for n in [2, 3, 5, 7, 23] {
                 for i in 0..n {

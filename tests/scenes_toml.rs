@@ -418,6 +418,7 @@ volume = "blob"
             &RenderOptions {
                 supersample: 1,
                 threads: 1,
+                alpha: false,
             },
             &ProgressBar::hidden(),
         )

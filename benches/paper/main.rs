@@ -23,6 +23,7 @@ mod dvr;
 mod embree;
 mod head;
 mod plot;
+mod python;
 mod skipping;
 mod table1;
 mod table2;
@@ -65,7 +66,7 @@ struct Args {
     #[arg(long, default_value_t = 1992)]
     seed: u64,
     /// Run only this section (repeatable): table1, table2, connectivity,
-    /// verification, skipping, embree, dvr, whole [default: all].
+    /// verification, skipping, embree, dvr, python, whole [default: all].
     #[arg(long = "section", value_name = "NAME")]
     sections: Vec<String>,
 }
@@ -119,7 +120,7 @@ fn run() -> Res<()> {
     let mut body = Md::default();
     std::mem::swap(&mut body, &mut ctx.md);
 
-    let sections: [(&str, &str, Section); 8] = [
+    let sections: [(&str, &str, Section); 9] = [
         ("Table 1", "table1", table1::table1),
         ("Table 2", "table2", table2::table2),
         ("connectivity", "connectivity", connectivity::connectivity),
@@ -127,6 +128,7 @@ fn run() -> Res<()> {
         ("skipping", "skipping", skipping::skipping),
         ("Embree", "embree", embree::embree),
         ("direct volume rendering", "dvr", dvr::dvr),
+        ("Python", "python", python::python),
         ("whole job", "whole", whole::whole),
     ];
     if let Some(bad) = args

@@ -86,41 +86,6 @@ fn run(cmd: &Path, args: &[String]) -> Res<Run> {
     Ok(Run { wall, rss, out })
 }
 
-/// The `rrt` binary beside the bench's: for a full run built now (`cargo
-/// build -p rrt-host` with the bench's profile and flags, so both have the
-/// same instruction set); a quick run takes it as it is, `None` if absent.
-fn rrt_binary(ctx: &Ctx) -> Res<Option<PathBuf>> {
-    let exe = std::env::current_exe()?;
-    let dir = exe.parent().ok_or("no folder for the bench binary")?;
-    if ctx.cfg.quick {
-        let rrt = dir.join("rrt");
-        return Ok(rrt.is_file().then_some(rrt));
-    }
-    let profile = if dir.ends_with("release") {
-        "release"
-    } else {
-        "dev"
-    };
-    ctx.log(&format!("building rrt ({profile})"));
-    let status = Command::new(env!("CARGO"))
-        .args([
-            "build",
-            "-q",
-            "-p",
-            "rrt-host",
-            "--bin",
-            "rrt",
-            "--profile",
-            profile,
-        ])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .status()?;
-    if !status.success() {
-        return Err("cargo build -p rrt-host failed".into());
-    }
-    Ok(Some(dir.join("rrt")))
-}
-
 /// The scene file of `stem`.
 fn scene_path(ctx: &Ctx, stem: &str) -> PathBuf {
     if stem == "one-sphere" {

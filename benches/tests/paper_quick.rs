@@ -56,6 +56,7 @@ fn quick_run_writes_a_well_formed_report() {
         "## Verification and supersampling",
         "## Skipping",
         "## Against Embree",
+        "## Python",
         "## The whole job against Embree",
     ] {
         assert!(md.contains(section), "missing section {section}");

@@ -65,6 +65,8 @@ pub struct RenderArgs {
     pub frame: Option<(u64, u64)>,
     /// Linear `float32` values instead of 8-bit sRGB codes.
     pub float: bool,
+    /// A fourth channel, the coverage, with the colour in straight alpha.
+    pub alpha: bool,
 }
 
 impl RenderArgs {
@@ -78,6 +80,7 @@ impl RenderArgs {
         threads: i64,
         frame: Option<(i64, i64)>,
         float: bool,
+        alpha: bool,
     ) -> Result<Self, Error> {
         let side = i64::from(rrt_host::render::MAX_SIDE);
         let max_threads = i64::try_from(MAX_THREADS).unwrap_or(i64::MAX);
@@ -104,6 +107,7 @@ impl RenderArgs {
             threads: whole("threads", threads, 0, max_threads)? as usize,
             frame,
             float,
+            alpha,
         })
     }
 }

@@ -4,7 +4,7 @@ use indicatif::ProgressBar;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use rrt_host::cli::common::RasterArgs;
-use rrt_host::output::encoding::{Codes, Encoding, codes};
+use rrt_host::output::encoding::{Codes, Encoding, SampleKind, Samples, rgba};
 use rrt_host::render::camera::Camera;
 use rrt_host::render::{Image, RenderOptions, check_sizes, render};
 use rrt_host::scene::View;
@@ -40,25 +40,42 @@ pub fn render_view(
     let opts = RenderOptions {
         supersample: a.supersample,
         threads: a.threads,
+        alpha: a.alpha,
     };
     let (image, _, _) = render(&tracer, &camera, &opts, &ProgressBar::hidden())?;
     Ok(image)
 }
 
 /// The image as an `(H, W, 3)` array: the 8-bit sRGB codes of the PNG
-/// `rrt render` writes, or with `float` the linear `float32` values of
-/// its OpenEXR output.
-pub fn to_numpy<'py>(py: Python<'py>, image: Image, float: bool) -> PyResult<Bound<'py, PyAny>> {
-    let shape = [image.height as usize, image.width as usize, 3];
-    if float {
-        return Ok(PyArray1::from_vec(py, image.linear)
-            .reshape(shape)?
-            .into_any());
-    }
-    let Codes::Eight(bytes) = codes(&image, Encoding::default()) else {
-        return Err(pyo3::exceptions::PyRuntimeError::new_err(
-            "8-bit encoding gave 16-bit codes",
-        ));
+/// `rrt render` writes, or with `a.float` the linear `float32` values of
+/// its OpenEXR output; with `a.alpha` an `(H, W, 4)` array of the straight
+/// colour and the coverage ([`rgba`]).
+pub fn to_numpy<'py>(py: Python<'py>, image: Image, a: &RenderArgs) -> PyResult<Bound<'py, PyAny>> {
+    let kind = if a.float {
+        SampleKind::Float
+    } else {
+        SampleKind::Codes(Encoding::default())
     };
-    Ok(PyArray1::from_vec(py, bytes).reshape(shape)?.into_any())
+    let (channels, samples) = if a.alpha {
+        let samples = rgba(&image, kind).ok_or_else(|| {
+            pyo3::exceptions::PyRuntimeError::new_err("the image was rendered without alpha")
+        })?;
+        (4, samples)
+    } else if a.float {
+        (3, Samples::Float(image.linear.into()))
+    } else {
+        (3, Samples::of(&image, kind))
+    };
+    let shape = [image.height as usize, image.width as usize, channels];
+    match samples {
+        Samples::Float(v) => Ok(PyArray1::from_vec(py, v.into_owned())
+            .reshape(shape)?
+            .into_any()),
+        Samples::Codes(Codes::Eight(bytes)) => {
+            Ok(PyArray1::from_vec(py, bytes).reshape(shape)?.into_any())
+        }
+        Samples::Codes(Codes::Sixteen(_)) => Err(pyo3::exceptions::PyRuntimeError::new_err(
+            "8-bit encoding gave 16-bit codes",
+        )),
+    }
 }

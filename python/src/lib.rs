@@ -3,7 +3,9 @@
 //!
 //! * `rrt.render(scene, ...)`: an NFF or TOML scene or a saved raster, as
 //!   `rrt render` renders it (the same pixels as its PNG, or the linear
-//!   values of its OpenEXR output with `float=True`).
+//!   values of its OpenEXR output with `float=True`; with `alpha=True` a
+//!   fourth channel, each pixel's coverage, and the colour in straight
+//!   alpha).
 //! * `rrt.render_volume(array, ...)`: a 3D numpy array as a volume,
 //!   classified by a transfer function (the TOML `iso`, `opacity` and
 //!   `colours` keys), framed by a default camera.

@@ -52,8 +52,10 @@ impl Raster {
     /// Renders the raster from `view` (default: its own), or from frame
     /// `k` of the `n`-frame orbit of that view with `frame=(k, n)`, as
     /// `rrt render FILE.rrt` does: an `(H, W, 3)` array of the PNG's 8-bit
-    /// sRGB codes, or with `float=True` the linear `float32` values.
-    #[pyo3(signature = (view = None, *, frame = None, width = None, height = None, supersample = 1, depth = 3, threads = 0, mode = "exact", connectivity = "adaptive", float = false))]
+    /// sRGB codes, or with `float=True` the linear `float32` values; with
+    /// `alpha=True` an `(H, W, 4)` array, the coverage in the fourth
+    /// channel and the colour in straight alpha (as `rrt.render`).
+    #[pyo3(signature = (view = None, *, frame = None, width = None, height = None, supersample = 1, depth = 3, threads = 0, mode = "exact", connectivity = "adaptive", float = false, alpha = false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -68,13 +70,23 @@ impl Raster {
         mode: &str,
         connectivity: &str,
         float: bool,
+        alpha: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let a = RenderArgs::new(width, height, supersample, depth, threads, frame, float)?;
+        let a = RenderArgs::new(
+            width,
+            height,
+            supersample,
+            depth,
+            threads,
+            frame,
+            float,
+            alpha,
+        )?;
         let raster = raster_args(None, mode, connectivity)?;
         let view = view.map_or_else(|| self.scene.view.clone(), |v| v.inner.clone());
         let scene = Arc::clone(&self.scene);
         let image = py.detach(move || render_view(&scene, &view, &raster, &a))?;
-        to_numpy(py, image, a.float)
+        to_numpy(py, image, &a)
     }
 
     /// Saves the raster to `path` (a name ending in `.rrt`), as `rrt
@@ -123,12 +135,24 @@ fn view_args(view: Option<&View>) -> ViewArgs {
 /// `(H, W, 3)` array of the PNG's 8-bit sRGB codes, or with `float=True`
 /// the linear `float32` values of its OpenEXR output.
 ///
+/// `alpha=True` adds a fourth channel, `(H, W, 4)`: each pixel's coverage,
+/// 1 − the transmittance of its rays to the background (0 where they all
+/// see the background, 1 where they all end on a surface or in a volume
+/// opaque enough to end them, the opacity composited through volumes
+/// rendered directly in between, averaged over the supersamples), as a
+/// linear code 0–255 (or a float in [0, 1]). The colour is then straight
+/// (not premultiplied), as PNG's RGBA keeps it: the pixel's colour without
+/// the background divided by the coverage, the background's colour where
+/// the coverage is 0. Over the scene's background,
+/// `rgb · a + background · (1 − a)` (in linear values) is the 3-channel
+/// image; where the coverage is 0 or 1 the colour channels equal it.
+///
 /// `view` replaces the scene's camera (its resolution is the default
 /// size), `frame=(k, n)` renders frame `k` of the `n`-frame orbit of the
 /// view, `raster` is `--raster`, `mode` is `"exact"`, `"verified"` or
 /// `"paper"`, `connectivity` `"adaptive"`, `"six"` or `"twenty-six"`.
 #[pyfunction]
-#[pyo3(signature = (scene = None, *, view = None, frame = None, width = None, height = None, supersample = 1, depth = 3, threads = 0, mode = "exact", connectivity = "adaptive", raster = None, float = false))]
+#[pyo3(signature = (scene = None, *, view = None, frame = None, width = None, height = None, supersample = 1, depth = 3, threads = 0, mode = "exact", connectivity = "adaptive", raster = None, float = false, alpha = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -144,8 +168,18 @@ pub fn render<'py>(
     connectivity: &str,
     raster: Option<i64>,
     float: bool,
+    alpha: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let mut a = RenderArgs::new(width, height, supersample, depth, threads, frame, float)?;
+    let mut a = RenderArgs::new(
+        width,
+        height,
+        supersample,
+        depth,
+        threads,
+        frame,
+        float,
+        alpha,
+    )?;
     let raster = raster_args(raster, mode, connectivity)?;
     let given = view.as_deref().map(|v| v.inner.clone());
     if let Some(v) = &given {
@@ -182,7 +216,7 @@ pub fn render<'py>(
         let (Loaded::Built { scene, .. } | Loaded::Saved { scene, .. }) = &loaded;
         render_view(scene, &overrides.apply(&scene.view), &raster, &a)
     })?;
-    to_numpy(py, image, a.float)
+    to_numpy(py, image, &a)
 }
 
 /// Voxelizes an NFF or TOML scene (`None`: the built-in one) and saves

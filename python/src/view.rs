@@ -107,7 +107,7 @@ impl View {
     /// Frame `k` of an orbit of `n` frames: the eye rotated by 360°·k/n
     /// about the axis through `at` along `up` (frame 0 is this view).
     fn orbit(&self, k: i64, n: i64) -> PyResult<Self> {
-        let a = crate::args::RenderArgs::new(None, None, 1, 1, 0, Some((k, n)), false)?;
+        let a = crate::args::RenderArgs::new(None, None, 1, 1, 0, Some((k, n)), false, false)?;
         Ok(Self {
             inner: Self::framed(&self.inner, a.frame),
         })

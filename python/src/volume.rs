@@ -267,6 +267,13 @@ fn build(
     let volume = Volume::new(dims, Grid::axis_aligned(spacing_xyz, DVec3::ZERO), samples)
         .map_err(|e| Error::arg("array", e.to_string()))?;
     let classifier = classifier(transfer, volume.range())?;
+    // A raster that can be saved, unless the volume is rendered directly
+    // (which no raster file holds: `Raster.save` then says so).
+    let purpose = if classifier.is_direct() {
+        Purpose::Render
+    } else {
+        Purpose::Save
+    };
     let view = match camera {
         Some(v) => v.inner.clone(),
         None => framing(
@@ -313,7 +320,7 @@ fn build(
         build_scene(
             &scene,
             &raster,
-            Purpose::Save,
+            purpose,
             &ImageNeed {
                 view: &no_overrides,
                 width: w,
@@ -346,7 +353,7 @@ pub fn volume(
     raster: Option<i64>,
     threads: i64,
 ) -> PyResult<Raster> {
-    let a = RenderArgs::new(width, height, 1, 1, threads, None, false)?;
+    let a = RenderArgs::new(width, height, 1, 1, threads, None, false, false)?;
     Ok(build(
         py,
         array,
@@ -360,7 +367,10 @@ pub fn volume(
 }
 
 /// Renders a 3D numpy array as a volume: an `(H, W, 3)` array of 8-bit
-/// sRGB codes (`float=True`: linear `float32`).
+/// sRGB codes (`float=True`: linear `float32`; `alpha=True`: `(H, W, 4)`,
+/// the coverage in the fourth channel and the colour in straight alpha, as
+/// `rrt.render`: where nothing but the background is seen it is 0, through
+/// the volume the opacity composited).
 ///
 /// * `array`: indexed `[z, y, x]`, C-contiguous, dtype `uint8`, `int16`,
 ///   `uint16`, `float32` or `float64` (stored as `float32`).
@@ -374,7 +384,7 @@ pub fn volume(
 /// * `camera`: an `rrt.View`; default: the whole volume from the front,
 ///   right and above, z up. `frame=(k, n)`: frame `k` of its orbit.
 #[pyfunction]
-#[pyo3(signature = (array, *, width = None, height = None, spacing = [1.0, 1.0, 1.0], transfer = None, camera = None, frame = None, background = DEFAULT_BACKGROUND, supersample = 1, depth = 3, threads = 0, raster = None, float = false))]
+#[pyo3(signature = (array, *, width = None, height = None, spacing = [1.0, 1.0, 1.0], transfer = None, camera = None, frame = None, background = DEFAULT_BACKGROUND, supersample = 1, depth = 3, threads = 0, raster = None, float = false, alpha = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render_volume<'py>(
     py: Python<'py>,
@@ -391,8 +401,18 @@ pub fn render_volume<'py>(
     threads: i64,
     raster: Option<i64>,
     float: bool,
+    alpha: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let a = RenderArgs::new(width, height, supersample, depth, threads, frame, float)?;
+    let a = RenderArgs::new(
+        width,
+        height,
+        supersample,
+        depth,
+        threads,
+        frame,
+        float,
+        alpha,
+    )?;
     let r = build(
         py,
         array,
@@ -406,5 +426,5 @@ pub fn render_volume<'py>(
     let modes = raster_args(None, "exact", "adaptive")?;
     let scene = Arc::clone(&r.scene);
     let image = py.detach(move || render_view(&scene, &scene.view, &modes, &a))?;
-    to_numpy(py, image, a.float)
+    to_numpy(py, image, &a)
 }

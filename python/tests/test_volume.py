@@ -139,3 +139,18 @@ def test_bad_transfer_functions_name_the_point(transfer, message):
 def test_bad_volume_arguments_name_them(kwargs, arg):
     with pytest.raises(ValueError, match=f"^{arg}: "):
         rrt.render_volume(sphere_density(8), **kwargs)
+
+
+def test_a_volume_rendered_directly_renders_and_is_not_saved(tmp_path):
+    d = sphere_density()
+    glow = {"opacity": [[0.0, 0.0], [1.0, 0.3]], "render": "direct"}
+    img = rrt.render_volume(d, width=32, height=32, transfer=glow, float=True)
+    r = rrt.volume(d, width=32, height=32, transfer=glow)
+    np.testing.assert_array_equal(r.render(float=True), img)
+    # Through the glow the background shows, dimmed: neither the
+    # background nor an opaque surface.
+    centre, corner = img[16, 16], img[0, 0]
+    assert not np.allclose(centre, corner)
+    with pytest.raises(rrt.RrtError, match="rendered directly"):
+        r.save(tmp_path / "glow.rrt")
+    assert not (tmp_path / "glow.rrt").exists()

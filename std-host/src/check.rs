@@ -344,6 +344,7 @@ pub fn raster_file_input(data: &[u8]) -> Result<(), String> {
     let threads = RenderOptions {
         supersample: 1,
         threads: 1,
+        alpha: false,
     };
     let (image, _, _) = render(&tracer, &camera, &threads, &quiet)
         .map_err(|e| format!("a loaded raster does not render: {e}"))?;

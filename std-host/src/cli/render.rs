@@ -200,6 +200,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             &RenderOptions {
                 supersample: args.supersample,
                 threads: args.threads,
+                alpha: false,
             },
             rows.clone(),
             &bar,

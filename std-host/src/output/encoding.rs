@@ -86,6 +86,58 @@ pub fn codes(image: &Image, enc: Encoding) -> Codes {
     }
 }
 
+/// The image's alpha as RGBA samples, row by row, four per pixel: the
+/// straight (not premultiplied) colour ([`crate::render::Alpha::straight`]) encoded as
+/// [`codes`] encodes colours (sRGB or linear), then the coverage
+/// ([`crate::render::Alpha::coverage`]), always linear, as PNG's RGBA keeps it; or the
+/// linear floats of both with [`SampleKind::Float`]. `None` when the image
+/// was rendered without alpha.
+///
+/// ```
+/// use rrt_host::output::encoding::{Codes, Encoding, SampleKind, Samples, rgba};
+/// use rrt_host::render::{Alpha, Image};
+/// let image = Image {
+///     width: 2,
+///     height: 1,
+///     rgb: vec![0, 0, 0, 128, 128, 128],
+///     linear: vec![0.0, 0.0, 0.0, 0.5, 0.5, 0.5],
+///     alpha: Some(Alpha {
+///         coverage: vec![0.0, 0.5],
+///         straight: vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+///     }),
+/// };
+/// let linear = SampleKind::Codes(Encoding { bits: 8, linear: true });
+/// assert_eq!(
+///     rgba(&image, linear),
+///     Some(Samples::Codes(Codes::Eight(vec![0, 0, 0, 0, 255, 255, 255, 128])))
+/// );
+/// ```
+#[must_use]
+pub fn rgba(image: &Image, kind: SampleKind) -> Option<Samples<'static>> {
+    let a = image.alpha.as_ref()?;
+    let pixels = a.straight.chunks_exact(3).zip(&a.coverage);
+    Some(match kind {
+        SampleKind::Float => Samples::Float(Cow::Owned(
+            pixels
+                .flat_map(|(c, &alpha)| [c[0], c[1], c[2], alpha])
+                .collect(),
+        )),
+        SampleKind::Codes(enc) => {
+            let max = if enc.bits == 8 { 255 } else { u16::MAX };
+            let samples = pixels.flat_map(|(c, &alpha)| {
+                let q = |v| quantize(v, enc.linear, max);
+                [q(c[0]), q(c[1]), q(c[2]), quantize(alpha, true, max)]
+            });
+            // 8-bit codes are at most 255.
+            Samples::Codes(if enc.bits == 8 {
+                Codes::Eight(samples.map(|v| v as u8).collect())
+            } else {
+                Codes::Sixteen(samples.collect())
+            })
+        }
+    })
+}
+
 /// Integer samples of an image.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Codes {
@@ -147,7 +199,8 @@ impl SampleKind {
     }
 }
 
-/// An image's samples as a file stores them, row by row (3 per pixel).
+/// An image's samples as a file stores them, row by row (3 per pixel, 4
+/// with alpha: [`rgba`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Samples<'a> {
     /// Integer codes ([`codes`]).
@@ -166,7 +219,7 @@ impl Samples<'_> {
         }
     }
 
-    /// How many samples (three per pixel).
+    /// How many samples (three or four per pixel).
     #[must_use]
     pub fn len(&self) -> usize {
         match self {

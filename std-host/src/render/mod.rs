@@ -11,8 +11,14 @@
 //! sub-pixel offsets of [`crate::render::camera::sample_offset`] (row by row), and
 //! their colours are averaged (a box filter) before the 8-bit conversion.
 //!
-//! **Determinism.** Every pixel's colour depends only on its own rays, and
-//! its samples are summed in a fixed order; tiles are written back by
+//! **Alpha.** On request ([`RenderOptions::alpha`]) the image also has
+//! each pixel's coverage, the mean of its rays' coverage
+//! ([`Traced::alpha`]: 1 − the ray's transmittance to the background), and
+//! its colour without the background in straight (not premultiplied)
+//! alpha, as PNG's RGBA keeps it ([`Alpha`]).
+//!
+//! **Determinism.** Every pixel's colour and coverage depend only on its own
+//! rays, and its samples are summed in a fixed order; tiles are written back by
 //! index. The image is therefore byte-identical for every thread count.
 //! The ray counts are integer sums, identical as well.
 //!
@@ -29,12 +35,11 @@ pub mod camera;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
-use glam::DVec3;
 use indicatif::ProgressBar;
 
 use self::camera::{Camera, sample_offset};
 use crate::trace::shading;
-use crate::trace::{BLOCK, BLOCK_H, BLOCK_W, RayStats, Tracer};
+use crate::trace::{BLOCK, BLOCK_H, BLOCK_W, RayStats, Traced, Tracer};
 use crate::world::Ray;
 
 /// Tile width in pixels (a multiple of the block width).
@@ -63,6 +68,31 @@ pub struct Image {
     /// mean of its samples, as `f32`), for the sRGB, 16-bit and HDR
     /// outputs.
     pub linear: Vec<f32>,
+    /// The coverage and the straight colour, when asked for
+    /// ([`RenderOptions::alpha`]).
+    pub alpha: Option<Alpha>,
+}
+
+/// An image's alpha: per pixel, how much of it the background is not,
+/// and its colour without the background.
+///
+/// Compositing the straight colour over the scene's background,
+/// `straight · alpha + background · (1 − alpha)`, gives the image's
+/// [`Image::linear`] colour (to rounding); where `alpha` is 1 the straight
+/// colour is that colour exactly, and where it is 0 (nothing but the
+/// background) it is the background.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Alpha {
+    /// `width · height` coverages in `[0, 1]`, rows top to bottom: the
+    /// mean of the pixel's rays' [`Traced::alpha`] (0 where every ray sees
+    /// the background, 1 where every ray ends on a surface or in a volume
+    /// opaque enough to end it, the opacity composited in between).
+    pub coverage: Vec<f32>,
+    /// `3 · width · height` linear RGB values, unclamped: the pixel's
+    /// colour without the background in straight alpha (the mean of its
+    /// rays' [`Traced::foreground`] divided by the coverage); the
+    /// background's colour where the coverage is 0.
+    pub straight: Vec<f32>,
 }
 
 /// How to render.
@@ -72,6 +102,8 @@ pub struct RenderOptions {
     pub supersample: u32,
     /// Worker threads; 0 for rayon's default (one per core).
     pub threads: usize,
+    /// Keep each pixel's coverage and straight colour ([`Image::alpha`]).
+    pub alpha: bool,
 }
 
 impl Default for RenderOptions {
@@ -79,6 +111,7 @@ impl Default for RenderOptions {
         Self {
             supersample: 1,
             threads: 0,
+            alpha: false,
         }
     }
 }
@@ -217,8 +250,13 @@ pub fn render_rows(
     let mut done: Vec<(u64, TileResult)> = per_thread.into_iter().flatten().collect();
     done.sort_unstable_by_key(|&(t, _)| t);
     let bh = rows.end - rows.start;
-    let mut rgb = vec![0u8; 3 * w as usize * bh as usize];
-    let mut linear = vec![0f32; 3 * w as usize * bh as usize];
+    let n = w as usize * bh as usize;
+    let mut rgb = vec![0u8; 3 * n];
+    let mut linear = vec![0f32; 3 * n];
+    let mut alpha = opts.alpha.then(|| Alpha {
+        coverage: vec![0f32; n],
+        straight: vec![0f32; 3 * n],
+    });
     let mut stats = RayStats::default();
     for (t, (pixels, s)) in &done {
         stats.add(s);
@@ -229,10 +267,15 @@ pub fn render_rows(
         let tw = TILE_W.min(w - x0);
         for (j, row) in pixels.chunks(tw as usize).enumerate() {
             let y = y0 as usize + j;
-            let at = 3 * (y * w as usize + x0 as usize);
-            for (i, (p, l)) in row.iter().enumerate() {
-                rgb[at + 3 * i..at + 3 * i + 3].copy_from_slice(p);
-                linear[at + 3 * i..at + 3 * i + 3].copy_from_slice(l);
+            let first = y * w as usize + x0 as usize;
+            for (i, p) in row.iter().enumerate() {
+                let at = 3 * (first + i);
+                rgb[at..at + 3].copy_from_slice(&p.rgb);
+                linear[at..at + 3].copy_from_slice(&p.linear);
+                if let Some(a) = alpha.as_mut() {
+                    a.coverage[first + i] = p.coverage;
+                    a.straight[at..at + 3].copy_from_slice(&p.straight);
+                }
             }
         }
     }
@@ -242,14 +285,27 @@ pub fn render_rows(
             height: bh,
             rgb,
             linear,
+            alpha,
         },
         stats,
         elapsed,
     ))
 }
 
+/// One pixel of a tile: its samples' means.
+struct Pixel {
+    /// [`Image::rgb`]'s value.
+    rgb: [u8; 3],
+    /// [`Image::linear`]'s value.
+    linear: [f32; 3],
+    /// [`Alpha::coverage`]'s value.
+    coverage: f32,
+    /// [`Alpha::straight`]'s value.
+    straight: [f32; 3],
+}
+
 /// One tile's pixels, row by row, and its ray counts.
-type TileResult = (Vec<([u8; 3], [f32; 3])>, RayStats);
+type TileResult = (Vec<Pixel>, RayStats);
 
 /// A tile of the whole image's grid, clipped to the rows rendered.
 struct Tile {
@@ -268,7 +324,7 @@ fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, tile: &Tile) -> Til
     let y1 = (tile.y0 + TILE_H).min(camera.height).min(tile.rows.end);
     let y0 = tile.y0.max(tile.rows.start);
     let tw = (x1 - x0) as usize;
-    let mut sums = vec![DVec3::ZERO; tw * (y1 - y0) as usize];
+    let mut sums = vec![Traced::default(); tw * (y1 - y0) as usize];
     let mut stats = RayStats::default();
     // The blocks of the whole tile's grid that meet the rows.
     let first_by = tile.y0 + (y0 - tile.y0) / BLOCK_H * BLOCK_H;
@@ -285,10 +341,13 @@ fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, tile: &Tile) -> Til
                         let (x, y) = lane_pixel(lane as u32)?;
                         Some(camera.ray(f64::from(x) + ox, f64::from(y) + oy))
                     });
-                    let colours = tracer.trace_block(&rays, &mut stats);
-                    for (lane, c) in colours.iter().enumerate() {
+                    let traced = tracer.trace_block(&rays, &mut stats);
+                    for (lane, c) in traced.iter().enumerate() {
                         if let Some((x, y)) = lane_pixel(lane as u32) {
-                            sums[(y - y0) as usize * tw + (x - x0) as usize] += *c;
+                            let s = &mut sums[(y - y0) as usize * tw + (x - x0) as usize];
+                            s.colour += c.colour;
+                            s.foreground += c.foreground;
+                            s.alpha += c.alpha;
                         }
                     }
                 }
@@ -299,8 +358,19 @@ fn render_tile(tracer: &Tracer<'_>, camera: &Camera, k: u32, tile: &Tile) -> Til
     (
         sums.iter()
             .map(|s| {
-                let c = *s / n;
-                (shading::to_rgb8(c), c.as_vec3().to_array())
+                let c = s.colour / n;
+                let alpha = s.alpha / n;
+                let straight = if alpha > 0.0 {
+                    s.foreground / n / alpha
+                } else {
+                    c
+                };
+                Pixel {
+                    rgb: shading::to_rgb8(c),
+                    linear: c.as_vec3().to_array(),
+                    coverage: alpha as f32,
+                    straight: straight.as_vec3().to_array(),
+                }
             })
             .collect(),
         stats,

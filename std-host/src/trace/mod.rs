@@ -343,6 +343,27 @@ impl RayStats {
     }
 }
 
+/// What a ray sees: its colour and how much of it the background is not.
+///
+/// `alpha` is the ray's coverage, 1 − its transmittance to the background:
+/// 1 when it ends on a surface (any surface: what is seen through a
+/// translucent one or in a mirror is part of the picture) or when the
+/// volumes rendered directly along it are opaque enough to end it
+/// ([`composite::OPAQUE_ENOUGH`]); the opacity they composited when it
+/// leaves the raster; 0 when it meets nothing. `foreground` is the colour
+/// without the background, premultiplied by `alpha`, and `colour` the
+/// colour with the background behind:
+/// `colour = foreground + (1 − alpha) · background`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Traced {
+    /// The linear colour, the background included.
+    pub colour: DVec3,
+    /// The linear colour without the background, premultiplied by `alpha`.
+    pub foreground: DVec3,
+    /// The coverage, in `[0, 1]`.
+    pub alpha: f64,
+}
+
 /// A surface hit.
 #[derive(Clone, Copy, Debug)]
 struct SurfaceHit {
@@ -516,13 +537,13 @@ impl<'s> Tracer<'s> {
         };
         let mut acc = Composite::default();
         let hit = self.resolve(ray, &mut walk, tmin, leave, &mut acc, stats);
-        self.behind(ray, hit, depth, &acc, stats)
+        self.behind(ray, hit, depth, &acc, stats).colour
     }
 
-    /// The colour of a ray whose walk composited `acc` and ended on `hit`
-    /// (or left the raster): the hit shaded, or the background, seen
-    /// through what was composited (nothing more once compositing
-    /// stopped).
+    /// What a ray whose walk composited `acc` and ended on `hit` (or left
+    /// the raster) sees: the hit shaded, or the background, seen through
+    /// what was composited (nothing more once compositing stopped), and
+    /// its coverage ([`Traced`]).
     fn behind(
         &self,
         ray: &Ray,
@@ -530,26 +551,33 @@ impl<'s> Tracer<'s> {
         depth: u32,
         acc: &Composite,
         stats: &mut RayStats,
-    ) -> DVec3 {
-        if acc.done() {
-            return acc.colour;
-        }
-        let c = match hit {
-            None => self.background,
-            Some(h) => {
-                stats.hits += 1;
-                self.shade(ray, &h, depth, stats)
-            }
+    ) -> Traced {
+        let (foreground, alpha) = if acc.done() {
+            (acc.colour, 1.0)
+        } else if let Some(h) = hit {
+            stats.hits += 1;
+            (acc.over(self.shade(ray, &h, depth, stats)), 1.0)
+        } else {
+            (acc.colour, acc.alpha)
         };
-        acc.over(c)
+        Traced {
+            colour: foreground + self.background * (1.0 - alpha),
+            foreground,
+            alpha,
+        }
     }
 
     /// Traces up to eight primary rays (a 4×2 pixel block; `None` lanes lie
-    /// outside the image) and returns their colours (black for `None`).
-    /// Stage one walks every ray to its first non-transparent voxel; stage
-    /// two resolves and shades each (module docs, *For packets*).
-    pub fn trace_block(&self, rays: &[Option<Ray>; BLOCK], stats: &mut RayStats) -> [DVec3; BLOCK] {
-        let mut out = [DVec3::ZERO; BLOCK];
+    /// outside the image) and returns what each sees ([`Traced`]; nothing,
+    /// black and uncovered, for `None`). Stage one walks every ray to its
+    /// first non-transparent voxel; stage two resolves and shades each
+    /// (module docs, *For packets*).
+    pub fn trace_block(
+        &self,
+        rays: &[Option<Ray>; BLOCK],
+        stats: &mut RayStats,
+    ) -> [Traced; BLOCK] {
+        let mut out = [Traced::default(); BLOCK];
         if self.opts.packets {
             let mut walks = self.first_walks_packet(rays);
             for ((o, r), w) in out.iter_mut().zip(rays).zip(walks.iter_mut()) {
@@ -572,7 +600,7 @@ impl<'s> Tracer<'s> {
     }
 
     /// Stage two of a primary ray: resolve its walk and shade the hit.
-    fn primary(&self, r: &Ray, w: &mut FirstWalk, stats: &mut RayStats) -> DVec3 {
+    fn primary(&self, r: &Ray, w: &mut FirstWalk, stats: &mut RayStats) -> Traced {
         stats.primary += 1;
         let mut acc = Composite::default();
         let hit = self.resolve(r, w, 0.0, None, &mut acc, stats);
