@@ -3,7 +3,7 @@
 //! precomputed illumination) is done once and the scene rendered from any
 //! view (the paper's point).
 //!
-//! # Layout (versions 1 and 2)
+//! # Layout (versions 1 and 2: dense)
 //! All integers and floats are little-endian; floats are IEEE 754 `f64`.
 //!
 //! ```text
@@ -20,11 +20,10 @@
 //!               zeros to a multiple of 64
 //! ```
 //!
-//! The paper's raster (one object per voxel) is written as version 1,
-//! byte for byte as before exact rasters existed; an exact raster
-//! ([`VoxelScene::exact`]: conservative, with object lists, possibly none)
-//! as version 2, which an rrt reading only version 1 refuses by its
-//! version.
+//! [`Format::Dense`] writes the paper's raster (one object per voxel) as
+//! version 1 and an exact raster ([`VoxelScene::exact`]: conservative,
+//! with object lists, possibly none) as version 2; [`Format::Sparse`], the
+//! default, writes both as version 3 (below).
 //!
 //! | kind | section | contents |
 //! |---|---|---|
@@ -37,23 +36,57 @@
 //! | 7 | lights | per light 6 × f64: position, colour |
 //! | 8 | lists | version 2 only: the store's object-list array, u32 each ([`rrt_core::store`], *Object lists*) |
 //!
+//! # Layout (version 3: sparse, the default)
+//! The header is version 1's with a wider section table and 320 bytes
+//! long: `16 + 32·n` bytes of magic, version 3, section count 8 and
+//! 8 × { kind u32, codec u32, crc32 u32, zero u32, offset u64, length
+//! u64 }, then the crc32 of those bytes and zeros up to byte 320. The
+//! sections are version 2's, in the same order and alignment, except:
+//!
+//! * meta: byte 14 is 1 for an exact raster, 0 for the paper's;
+//! * kind 2, **plane bricks**, replaces the plane. The plane is not
+//!   stored: its opaque voxels are the records', and everything else in
+//!   it (distance field, PROXIMITY flags, rank hints) follows from them
+//!   ([`derive_plane`]), so the loader makes it again, byte for byte
+//!   (the line level too, as for every version). The writer makes it too
+//!   and stores each 8×8×8 brick whose cells differ from what it made, as
+//!   { brick index u64, 512 cells (x fastest, cells outside the raster 0) },
+//!   in increasing brick order: none for a raster as `rrt voxelize` builds
+//!   it.
+//! * codec 1 (**blocks**), allowed for the plane bricks, directory,
+//!   records and lists (the writer's default, [`Format::Sparse`]
+//!   `compress`): entries u64, entries per block u32, blocks u32, each
+//!   block's length u32, then the blocks. A block is its entries with each
+//!   field replaced by its difference from the previous entry's (modulo
+//!   the field's width; a record's fields as in the records row below, a
+//!   directory or list entry one `u32`, a plane brick's index then each
+//!   cell), their bytes grouped by place in the entry, LZ4-compressed
+//!   (`lz4_flex` block format). Codec 0: the entries as in version 2.
+//!
 //! The crc32 (IEEE, `crc32fast`) of each section is in its table entry.
 //!
 //! # Loading
-//! [`load`] refuses, with the file's name and what is wrong: a file that is
+//! The file is mapped (`memmap2`), not read in full: loading reads the
+//! sections it decodes and checks each one's checksum first. [`load`]
+//! refuses, with the file's name and what is wrong: a file that is
 //! not a raster, another version, a header or section whose checksum does
-//! not match (corrupt), a section that ends past the end of the file or a
+//! not match (corrupt, with the section's bytes), a section that ends past the end of the file or a
 //! file shorter than its last section's padding (truncated), bytes after
 //! that padding, a section whose length disagrees with the counts, and contents
 //! that break an invariant (dimensions, the record store's directory and
-//! sort order, object and material indices, non-finite numbers). Sizes are
-//! checked against the file's length before anything is allocated.
-//! [`load_bytes`] does the same for the bytes of a file in memory, and
-//! [`save_bytes`] gives the bytes [`save`] writes.
+//! sort order, object and material indices, non-finite numbers, a block
+//! that does not decompress to its entries, plane bricks out of order).
+//! Sizes are checked against the file's length before anything is
+//! allocated, and the memory the loaded raster needs against a limit
+//! ([`default_max_memory`], or [`load_bytes_within`]'s): a version 3 file
+//! is much smaller than its raster. [`load_bytes`] does the same for the
+//! bytes of a file in memory, and [`save_bytes`] gives the bytes [`save`]
+//! writes. [`verify`] (`rrt info --check`) checks every checksum and
+//! padding byte.
 //!
-//! The file is read, not memory-mapped: the checksums read every byte
-//! anyway, and a plane read into anonymous memory gets huge pages
-//! ([`Plane`]), which a file mapping does not.
+//! The plane is made in anonymous memory, which gets huge pages
+//! ([`Plane`]): a version 1 or 2 plane is copied there from the mapping,
+//! a version 3 plane made there.
 
 use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
