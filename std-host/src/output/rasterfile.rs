@@ -1305,7 +1305,7 @@ fn entry_count(b: &[u8], codec: u32, len: u64) -> Result<u64, String> {
     if codec == CODEC_BLOCKS {
         return Ok(Cursor::new(b).u64());
     }
-    if b.len() as u64 % len != 0 {
+    if !(b.len() as u64).is_multiple_of(len) {
         return Err(format!(
             "{} bytes, not a whole number of {len}-byte entries",
             b.len()
@@ -1581,7 +1581,7 @@ fn load_from(
         expect(1, extent.len() as u64)?;
         expect(2, dir_n as u64 * DIRECTORY_ENTRY_LEN)?;
         expect(3, m.records.saturating_mul(RECORD_LEN))?;
-        if h.sections[7].3 % 4 != 0 {
+        if !h.sections[7].3.is_multiple_of(4) {
             return Err(invalid(format!(
                 "lists section of {} bytes, not a whole number of u32 entries",
                 h.sections[7].3
@@ -1790,7 +1790,6 @@ fn load_sparse(
             }
         }
     }
-    let _ = (nx, ny);
     Ok(Raster {
         plane,
         directory,
