@@ -1752,7 +1752,7 @@ fn load_sparse(
     .map_err(|e| invalid(1, e))?;
     RecordStore::with_lists(extent, &directory, &records, &lists)
         .map_err(|e| invalid(3, e.to_string()))?;
-    let [nx, ny, nz] = extent.dims();
+    let nz = extent.dims()[2];
     let (mut plane, _) =
         derive_plane(extent, &directory, &records, &lists, [0, nz]).map_err(|source| {
             RasterFileError::Io {
