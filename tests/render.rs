@@ -475,8 +475,9 @@ fn damaged_raster_files_are_refused() {
     let good = dir.join("good.rrt");
     let scene = Scene::load(data("tetra.nff")).unwrap();
     let vs = voxelize(&scene, 48, Connectivity::Adaptive);
-    rasterfile::save(&vs, &good).unwrap();
-    let bytes = std::fs::read(&good).unwrap();
+    // The dense layout (version 2) first, then the sparse one (version 3).
+    let bytes = rasterfile::save_bytes_as(&vs, &good, rasterfile::Format::Dense).unwrap();
+    std::fs::write(&good, &bytes).unwrap();
     let load = |name: &str, b: &[u8]| -> String {
         let p = dir.join(name);
         std::fs::write(&p, b).unwrap();
@@ -510,11 +511,11 @@ fn damaged_raster_files_are_refused() {
     let e = load("long.rrt", &[&bytes[..], &[0u8; 64]].concat());
     assert!(e.contains("64 bytes after the end of the raster"), "{e}");
 
-    let mut v3 = bytes.clone();
-    v3[8] = 3;
-    let e = load("v3.rrt", &v3);
+    let mut v4 = bytes.clone();
+    v4[8] = 4;
+    let e = load("v4.rrt", &v4);
     assert!(
-        e.contains("raster file version 3; this rrt reads versions 1 to 2"),
+        e.contains("raster file version 4; this rrt reads versions 1 to 3"),
         "{e}"
     );
     // A version 1 file relabelled version 2 (which has 8 sections): its
@@ -542,6 +543,42 @@ fn damaged_raster_files_are_refused() {
     tail[n - 70] ^= 0x10;
     let e = load("tail.rrt", &tail);
     assert!(e.contains("corrupt:") && e.contains("checksum"), "{e}");
+
+    // Version 3: a flipped byte in each section is refused, naming the
+    // section and its bytes.
+    let sparse = rasterfile::save_bytes(&vs, &good).unwrap();
+    assert_eq!(u32::from_le_bytes(sparse[8..12].try_into().unwrap()), 3);
+    for (k, name) in [
+        "meta",
+        "plane bricks",
+        "directory",
+        "records",
+        "objects",
+        "materials",
+        "lights",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let at = 16 + 32 * k;
+        let off = u64::from_le_bytes(sparse[at + 16..at + 24].try_into().unwrap()) as usize;
+        let len = u64::from_le_bytes(sparse[at + 24..at + 32].try_into().unwrap()) as usize;
+        if len == 0 {
+            continue;
+        }
+        let mut bad = sparse.clone();
+        bad[off + len / 2] ^= 0x08;
+        let e = load(&format!("v3-{k}.rrt"), &bad);
+        assert!(
+            e.contains(&format!(
+                "corrupt: the {name} checksum does not match (bytes {off} to {})",
+                off + len
+            )),
+            "{e}"
+        );
+    }
+    let e = load("v3-short.rrt", &sparse[..sparse.len() - 64]);
+    assert!(e.contains("truncated"), "{e}");
 
     let e = load("nff.rrt", &std::fs::read(data("tetra.nff")).unwrap());
     assert!(e.contains("not an rrt raster file"), "{e}");

@@ -218,28 +218,40 @@ fn object_lists_survive_a_saved_raster() {
     let dir = std::env::temp_dir().join(format!("rrt-test-{}-lists", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("lists.rrt");
-    rasterfile::save(&vs, &path).unwrap();
-    assert_eq!(rasterfile::info(&path).unwrap().version, 2);
-    let back = rasterfile::load(&path).unwrap();
-    assert_eq!(back.lists, vs.lists);
-    assert_eq!(back.records, vs.records);
-    check_rays(&back, 3, 500, false);
-    // A damaged list is refused with the file's name, not used.
-    let mut bytes = std::fs::read(&path).unwrap();
-    // The lists section: the 8th entry of the table, offset at 192.
-    let off = u64::from_le_bytes(bytes[192..200].try_into().unwrap());
-    bytes[usize::try_from(off).unwrap() + 9] ^= 0x10;
-    let bad = dir.join("bad.rrt");
-    std::fs::write(&bad, &bytes).unwrap();
-    let e = rasterfile::load(&bad).unwrap_err().to_string();
-    assert!(e.contains("bad.rrt"), "{e}");
-    // The paper's raster (one object per voxel) stays version 1.
+    // Version 3 (the default) and the dense version 2; the lists
+    // section's offset in the section table of each.
+    for (format, version, table_offset) in [
+        (rasterfile::Format::default(), 3, 16 + 32 * 7 + 16),
+        (rasterfile::Format::Dense, 2, 16 + 24 * 7 + 8),
+    ] {
+        let bytes = rasterfile::save_bytes_as(&vs, &path, format).unwrap();
+        std::fs::write(&path, &bytes).unwrap();
+        assert_eq!(rasterfile::info(&path).unwrap().version, version);
+        let back = rasterfile::load(&path).unwrap();
+        assert_eq!(back.lists, vs.lists);
+        assert_eq!(back.records, vs.records);
+        check_rays(&back, 3, 500, false);
+        // A damaged list is refused with the file's name, not used.
+        let mut bytes = bytes;
+        let off = u64::from_le_bytes(bytes[table_offset..table_offset + 8].try_into().unwrap());
+        bytes[usize::try_from(off).unwrap() + 9] ^= 0x10;
+        let bad = dir.join("bad.rrt");
+        std::fs::write(&bad, &bytes).unwrap();
+        let e = rasterfile::load(&bad).unwrap_err().to_string();
+        assert!(e.contains("bad.rrt") && e.contains("lists"), "{e}");
+    }
+    // The paper's raster (one object per voxel) is version 3 too, or 1 in
+    // the dense layout.
     let scene = Scene::parse("random.nff", nff.as_bytes()).unwrap();
     let mut o = BuildOptions::paper(32);
     o.fit.max_memory = 1 << 30;
     let raw = build(&scene, &o, &ProgressBar::hidden()).unwrap().0;
     assert!(raw.lists.is_empty());
     rasterfile::save(&raw, &path).unwrap();
+    assert_eq!(rasterfile::info(&path).unwrap().version, 3);
+    assert!(!rasterfile::info(&path).unwrap().exact);
+    let dense = rasterfile::save_bytes_as(&raw, &path, rasterfile::Format::Dense).unwrap();
+    std::fs::write(&path, dense).unwrap();
     assert_eq!(rasterfile::info(&path).unwrap().version, 1);
     let _ = std::fs::remove_dir_all(&dir);
 }

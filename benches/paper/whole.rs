@@ -258,12 +258,16 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             [Vec::new(), Vec::new(), Vec::new()],
         ];
         let mut saved_last = Run::default();
+        let file_mib = std::fs::metadata(&rrt_file).map_or(f64::NAN, |m| m.len() as f64)
+            / f64::from(1u32 << 20);
+        let mut loads = Vec::new();
         for _ in 0..cfg.reps {
             for (ti, th) in [1usize, 2].into_iter().enumerate() {
                 let r = run(&rrt, &saved_args(th))?;
                 ts[ti][0].push(r.wall);
                 ts[ti][1].push(r.phase("render"));
                 if th == 1 {
+                    loads.push(r.phase("load"));
                     saved_last = r;
                 }
                 if let Some(e) = &embree {
@@ -278,6 +282,8 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
         let lit = saved_last.count("lights proven lit");
         saved_rows.push(vec![
             stem.to_string(),
+            f(file_mib, 1),
+            secs(median(&loads)),
             secs(median(&ts[0][0])),
             secs(median(&ts[0][1])),
             secs(median(&ts[0][2])),
@@ -377,11 +383,14 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
     md.para(
         "The same renders from the raster `rrt voxelize SCENE` saved (the default raster, with \
          the shadow classification), interleaved with Embree's whole process from the scene \
-         file. **Uncertain**: the share of the shadow queries of verified hits that the \
-         classification did not prove lit, which fired an exact shadow ray; **blocked by the \
-         last blocker**: the share of those the object that last blocked a shadow ray towards \
-         the same light in the tile was found to block, without a walk; **steps per shadow \
-         ray**: the voxels each walked one visited (an empty-space jump counts as one). \
+         file. **File**: the saved raster's size (format version 3: the plane made on load \
+         from the records, the large sections LZ4-compressed); **load**: the load phase of \
+         rrt's summary line (mapping, checksums, decoding, making the plane). **Uncertain**: \
+         the share of the shadow queries of verified hits that the classification did not \
+         prove lit, which fired an exact shadow ray; **blocked by the last blocker**: the share \
+         of those the object that last blocked a shadow ray towards the same light in the tile \
+         was found to block, without a walk; **steps per shadow ray**: the voxels each walked \
+         one visited (an empty-space jump counts as one). \
          **False hits**: discrete hits verification rejected, per traced ray (eye, reflected, \
          refracted). **Shared-voxel hits**: the share of verified hits found in a voxel that \
          several objects share (through its object list).",
@@ -389,6 +398,8 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
     md.table(
         &[
             "scene",
+            "file MiB",
+            "load s, 1 thread",
             "rrt s, 1 thread",
             "of which render s",
             "Embree s, 1 thread",

@@ -245,6 +245,8 @@ pub fn voxelize(
             i64::try_from(rrt_host::cli::common::MAX_THREADS).unwrap_or(i64::MAX),
         )? as usize,
         quiet: true,
+        uncompressed: false,
+        dense: false,
     };
     let scene = py.detach(move || -> Result<VoxelScene, Error> {
         rrt_host::cli::voxelize::run(&args, &mut std::io::sink())?;

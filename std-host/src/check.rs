@@ -245,25 +245,33 @@ const RASTER_FUZZ_SCENE: &str = "v\nfrom 0 -5 2\nat 0 0 0.5\nup 0 0 1\nangle 40\
     pp 3\n0 1 0.2 0 0 1\n1 1 0.2 0 0.6 0.8\n0 1.5 1 0 -0.6 0.8\n";
 
 /// The saved bytes of [`RASTER_FUZZ_SCENE`] on a 12-voxel raster: exact
-/// (version 2) and the paper's (version 1); made once.
-fn raster_fuzz_bases() -> Result<&'static [Vec<u8>; 2], String> {
-    use crate::output::rasterfile::save_bytes;
+/// and the paper's, each in version 3 (compressed) and in the dense
+/// version (2 and 1); made once.
+fn raster_fuzz_bases() -> Result<&'static [Vec<u8>; 4], String> {
+    use crate::output::rasterfile::{Format, save_bytes_as};
     use crate::scene::Scene;
     use crate::voxelize::{BuildOptions, build};
-    static BASES: std::sync::OnceLock<Result<[Vec<u8>; 2], String>> = std::sync::OnceLock::new();
+    static BASES: std::sync::OnceLock<Result<[Vec<u8>; 4], String>> = std::sync::OnceLock::new();
     BASES
         .get_or_init(|| {
             let scene = Scene::parse("fuzz-base.nff", RASTER_FUZZ_SCENE.as_bytes())
                 .map_err(|e| e.to_string())?;
             let quiet = indicatif::ProgressBar::hidden();
-            let mut bases = [Vec::new(), Vec::new()];
-            for (b, opts) in bases
-                .iter_mut()
-                .zip([BuildOptions::new(12), BuildOptions::paper(12)])
-            {
-                let opts = BuildOptions { threads: 1, ..opts };
+            let mut bases = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+            let formats = [
+                Format::default(),
+                Format::default(),
+                Format::Dense,
+                Format::Dense,
+            ];
+            let builds = [BuildOptions::new(12), BuildOptions::paper(12)];
+            for (i, b) in bases.iter_mut().enumerate() {
+                let opts = BuildOptions {
+                    threads: 1,
+                    ..builds[i % 2]
+                };
                 let (voxels, _) = build(&scene, &opts, &quiet).map_err(|e| e.to_string())?;
-                *b = save_bytes(&voxels, std::path::Path::new("fuzz-base.rrt"))
+                *b = save_bytes_as(&voxels, std::path::Path::new("fuzz-base.rrt"), formats[i])
                     .map_err(|e| e.to_string())?;
             }
             Ok(bases)
@@ -272,33 +280,44 @@ fn raster_fuzz_bases() -> Result<&'static [Vec<u8>; 2], String> {
         .map_err(Clone::clone)
 }
 
-/// Fuzz input as a raster file named `fuzz.rrt`. The first byte chooses
-/// what the rest is: (0) the file's bytes; (1, 2) changes to a valid
-/// exact (1) or paper (2) raster, five bytes each (a little-endian `u32`
-/// offset into the file, a byte to xor there), after which the checksums
-/// are recomputed ([`reseal`](crate::output::rasterfile::reseal)) so that
-/// the loader's checks behind them are reached; (3) the same changes to the
-/// exact raster without recomputing them. Checks: an error names the
-/// file; a corrupted file (3) is refused unless what it loads is what was
-/// saved (changes in padding only); a loaded raster saves to bytes that
-/// load again and save the same, and renders a small image in its mode
-/// without panicking and without NaN pixels. A panic or a hang inside is a bug the caller sees as
-/// such.
+/// The memory a raster loaded by [`raster_file_input`] may need.
+pub const RASTER_FUZZ_MEMORY: u64 = 64 << 20;
+
+/// Fuzz input as a raster file named `fuzz.rrt`, loaded with a memory
+/// limit of [`RASTER_FUZZ_MEMORY`]. The first byte chooses what the rest
+/// is: (0) the file's bytes; (1, 2) changes to a valid exact (1) or paper
+/// (2) raster of version 3, five bytes each (a little-endian `u32` offset
+/// into the file, a byte to xor there), after which the checksums are
+/// recomputed ([`reseal`](crate::output::rasterfile::reseal)) so that the
+/// loader's checks behind them are reached; (3) the same changes to the
+/// exact raster without recomputing them; (4, 5) as (1, 2) on the dense
+/// versions 2 and 1. Checks: an error names the file; a corrupted file (3)
+/// is refused unless what it loads is what was saved (changes in padding
+/// only); a loaded raster saves to bytes that load again and save the
+/// same, and renders a small image in its mode without panicking and
+/// without NaN pixels. A panic or a hang inside is a bug the caller sees
+/// as such.
 ///
 /// # Errors
 /// The first broken invariant.
 pub fn raster_file_input(data: &[u8]) -> Result<(), String> {
-    use crate::output::rasterfile::{load_bytes, reseal, save_bytes};
+    use crate::output::rasterfile::{load_bytes_within, reseal, save_bytes};
     use crate::render::{RenderOptions, render};
     use crate::trace::{Mode, TraceOptions, Tracer};
     let Some((&mode, rest)) = data.split_first() else {
         return Ok(());
     };
     let bases = raster_fuzz_bases()?;
-    let bytes = match mode % 4 {
+    let bytes = match mode % 6 {
         0 => rest.to_vec(),
         m => {
-            let mut b = bases[usize::from(m == 2)].clone();
+            let base = match m {
+                1 | 3 => 0,
+                2 => 1,
+                4 => 2,
+                _ => 3,
+            };
+            let mut b = bases[base].clone();
             for change in rest.chunks_exact(5) {
                 let at = u32::from_le_bytes([change[0], change[1], change[2], change[3]]);
                 let at = usize::try_from(at).unwrap_or(0) % b.len().max(1);
@@ -313,15 +332,16 @@ pub fn raster_file_input(data: &[u8]) -> Result<(), String> {
         }
     };
     let name = std::path::Path::new("fuzz.rrt");
-    let Some(scene) = read_or_refused("fuzz.rrt", load_bytes(name, &bytes))? else {
+    let load = |b: &[u8]| load_bytes_within(name, b, RASTER_FUZZ_MEMORY);
+    let Some(scene) = read_or_refused("fuzz.rrt", load(&bytes))? else {
         return Ok(());
     };
     let saved =
         save_bytes(&scene, name).map_err(|e| format!("a loaded raster does not save: {e}"))?;
-    if mode % 4 == 3 && saved != bases[0] {
+    if mode % 6 == 3 && saved != bases[0] {
         return Err("a file with a changed checksummed byte was loaded".into());
     }
-    let again = load_bytes(name, &saved).map_err(|e| format!("saved raster does not load: {e}"))?;
+    let again = load(&saved).map_err(|e| format!("saved raster does not load: {e}"))?;
     if save_bytes(&again, name).ok().as_ref() != Some(&saved) {
         return Err("a loaded raster saves differently the second time".into());
     }

@@ -271,10 +271,22 @@ fn info_checks_every_checksum() {
         f.to_str().unwrap(),
     ]);
     assert!(made.status.success());
-    let good = rrt(&["info", f.to_str().unwrap()]);
+    let quick = rrt(&["info", f.to_str().unwrap()]);
+    assert!(quick.status.success());
+    let text = String::from_utf8_lossy(&quick.stdout);
+    assert!(
+        text.contains("format version 3, sparse, compressed"),
+        "{text}"
+    );
+    assert!(
+        text.contains("checksums: not checked (rrt info --check)"),
+        "{text}"
+    );
+    let good = rrt(&["info", "--check", f.to_str().unwrap()]);
     assert!(good.status.success());
     assert!(
-        String::from_utf8_lossy(&good.stdout).contains("checksums: header and all sections match")
+        String::from_utf8_lossy(&good.stdout)
+            .contains("checksums: header and all sections match; the raster loads")
     );
     // One flipped bit in the records (the middle of the file) or the plane.
     let bytes = std::fs::read(&f).unwrap();
@@ -282,7 +294,7 @@ fn info_checks_every_checksum() {
         let mut bad = bytes.clone();
         bad[at] ^= 0x10;
         std::fs::write(&f, &bad).unwrap();
-        let out = rrt(&["info", f.to_str().unwrap()]);
+        let out = rrt(&["info", "--check", f.to_str().unwrap()]);
         assert!(!out.status.success(), "flipped byte {at} not found");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains("corrupt"), "{err}");

@@ -262,7 +262,8 @@ fn an_interrupted_voxelize_keeps_the_old_raster() {
     );
     // While the new raster is being written (where rrt used to write in
     // place and leave a truncated file): a sparse scene whose raster is
-    // large (a 500³ plane, 120 MiB) and quick to make.
+    // large (a 500³ plane, 120 MiB) and quick to make, in the dense
+    // layout (the sparse one writes a few KiB).
     std::fs::write(
         d.join("sparse.nff"),
         "s 0 0 0 0.05\ns 10 10 10 0.05\nl 5 5 20\nf 1 0.5 0.2 0.8 0.2 10 0 1\nv\nfrom 5 -20 5\nat 5 5 5\nup 0 0 1\nangle 45\nhither 0.1\nresolution 16 16\n",
@@ -275,6 +276,7 @@ fn an_interrupted_voxelize_keeps_the_old_raster() {
                 "voxelize",
                 "-q",
                 "sparse.nff",
+                "--dense",
                 "--raster",
                 "500",
                 "-o",

@@ -30,6 +30,14 @@ pub struct VoxelizeArgs {
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Leave the large sections of the file uncompressed (larger files,
+    /// no faster to load).
+    #[arg(long, conflicts_with = "dense")]
+    pub uncompressed: bool,
+    /// Write file version 1 or 2, with the dense plane (one byte per
+    /// voxel), for an rrt that reads only those.
+    #[arg(long)]
+    pub dense: bool,
 }
 
 /// Runs `rrt voxelize`, writing a summary line to `out`.
@@ -113,7 +121,14 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
     let t = std::time::Instant::now();
     let bar = progress(!args.quiet);
     crate::progress::phase(&bar, "saving", Unit::Bytes, 0);
-    let saved = rasterfile::save_to(&scene, file, &bar);
+    let format = if args.dense {
+        rasterfile::Format::Dense
+    } else {
+        rasterfile::Format::Sparse {
+            compress: !args.uncompressed,
+        }
+    };
+    let saved = rasterfile::save_to(&scene, file, &bar, format);
     bar.finish_and_clear();
     let bytes = saved?;
     if !args.quiet {

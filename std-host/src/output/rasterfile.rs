@@ -3,7 +3,7 @@
 //! precomputed illumination) is done once and the scene rendered from any
 //! view (the paper's point).
 //!
-//! # Layout (versions 1 and 2)
+//! # Layout (versions 1 and 2: dense)
 //! All integers and floats are little-endian; floats are IEEE 754 `f64`.
 //!
 //! ```text
@@ -20,11 +20,10 @@
 //!               zeros to a multiple of 64
 //! ```
 //!
-//! The paper's raster (one object per voxel) is written as version 1,
-//! byte for byte as before exact rasters existed; an exact raster
-//! ([`VoxelScene::exact`]: conservative, with object lists, possibly none)
-//! as version 2, which an rrt reading only version 1 refuses by its
-//! version.
+//! [`Format::Dense`] writes the paper's raster (one object per voxel) as
+//! version 1 and an exact raster ([`VoxelScene::exact`]: conservative,
+//! with object lists, possibly none) as version 2; [`Format::Sparse`], the
+//! default, writes both as version 3 (below).
 //!
 //! | kind | section | contents |
 //! |---|---|---|
@@ -37,23 +36,57 @@
 //! | 7 | lights | per light 6 × f64: position, colour |
 //! | 8 | lists | version 2 only: the store's object-list array, u32 each ([`rrt_core::store`], *Object lists*) |
 //!
+//! # Layout (version 3: sparse, the default)
+//! The header is version 1's with a wider section table and 320 bytes
+//! long: `16 + 32·n` bytes of magic, version 3, section count 8 and
+//! 8 × { kind u32, codec u32, crc32 u32, zero u32, offset u64, length
+//! u64 }, then the crc32 of those bytes and zeros up to byte 320. The
+//! sections are version 2's, in the same order and alignment, except:
+//!
+//! * meta: byte 14 is 1 for an exact raster, 0 for the paper's;
+//! * kind 2, **plane bricks**, replaces the plane. The plane is not
+//!   stored: its opaque voxels are the records', and everything else in
+//!   it (distance field, PROXIMITY flags, rank hints) follows from them
+//!   ([`derive_plane`]), so the loader makes it again, byte for byte
+//!   (the line level too, as for every version). The writer makes it too
+//!   and stores each 8×8×8 brick whose cells differ from what it made, as
+//!   { brick index u64, 512 cells (x fastest, cells outside the raster 0) },
+//!   in increasing brick order: none for a raster as `rrt voxelize` builds
+//!   it.
+//! * codec 1 (**blocks**), allowed for the plane bricks, directory,
+//!   records and lists (the writer's default, [`Format::Sparse`]
+//!   `compress`): entries u64, entries per block u32, blocks u32, each
+//!   block's length u32, then the blocks. A block is its entries with each
+//!   field replaced by its difference from the previous entry's (modulo
+//!   the field's width; a record's fields as in the records row below, a
+//!   directory or list entry one `u32`, a plane brick's index then each
+//!   cell), their bytes grouped by place in the entry, LZ4-compressed
+//!   (`lz4_flex` block format). Codec 0: the entries as in version 2.
+//!
 //! The crc32 (IEEE, `crc32fast`) of each section is in its table entry.
 //!
 //! # Loading
-//! [`load`] refuses, with the file's name and what is wrong: a file that is
+//! The file is mapped (`memmap2`), not read in full: loading reads the
+//! sections it decodes and checks each one's checksum first. [`load`]
+//! refuses, with the file's name and what is wrong: a file that is
 //! not a raster, another version, a header or section whose checksum does
-//! not match (corrupt), a section that ends past the end of the file or a
+//! not match (corrupt, with the section's bytes), a section that ends past the end of the file or a
 //! file shorter than its last section's padding (truncated), bytes after
 //! that padding, a section whose length disagrees with the counts, and contents
 //! that break an invariant (dimensions, the record store's directory and
-//! sort order, object and material indices, non-finite numbers). Sizes are
-//! checked against the file's length before anything is allocated.
-//! [`load_bytes`] does the same for the bytes of a file in memory, and
-//! [`save_bytes`] gives the bytes [`save`] writes.
+//! sort order, object and material indices, non-finite numbers, a block
+//! that does not decompress to its entries, plane bricks out of order).
+//! Sizes are checked against the file's length before anything is
+//! allocated, and the memory the loaded raster needs against a limit
+//! ([`default_max_memory`], or [`load_bytes_within`]'s): a version 3 file
+//! is much smaller than its raster. [`load_bytes`] does the same for the
+//! bytes of a file in memory, and [`save_bytes`] gives the bytes [`save`]
+//! writes. [`verify`] (`rrt info --check`) checks every checksum and
+//! padding byte.
 //!
-//! The file is read, not memory-mapped: the checksums read every byte
-//! anyway, and a plane read into anonymous memory gets huge pages
-//! ([`Plane`]), which a file mapping does not.
+//! The plane is made in anonymous memory, which gets huge pages
+//! ([`Plane`]): a version 1 or 2 plane is copied there from the mapping,
+//! a version 3 plane made there.
 
 use std::fs::File;
 use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
@@ -61,33 +94,38 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use indicatif::ProgressBar;
+use memmap2::Mmap;
+use rayon::prelude::*;
 
 use super::atomic::AtomicFile;
 use rrt_core::light::ExactRecords;
 use rrt_core::object_table::MAX_LIGHTS;
 use rrt_core::raster::{Extent, LINE_CELLS};
-use rrt_core::store::{RecordStore, directory_len};
+use rrt_core::store::{BRICK, BRICK_VOXELS, RecordStore, brick_count, brick_dims, directory_len};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
+use crate::fit::{Bytes, default_max_memory};
 use crate::frame::RasterFrame;
 use crate::scene::{Material, SourceLoc, View};
 use crate::shape::{SLOTS, Shape, Slots};
 use crate::voxelize::plane::Plane;
-use crate::voxelize::{MAX_MATERIALS, VoxelScene, line_level};
+use crate::voxelize::{MAX_MATERIALS, VoxelScene, derive_plane, line_level};
 use crate::voxelize::{WorldLight, WorldObject};
 
 /// The file's first bytes.
 pub const MAGIC: [u8; 8] = *b"RRTRASTR";
-/// The newest version this code writes and reads (it reads version 1
-/// too, and writes it for a raster without object lists).
-pub const VERSION: u32 = 2;
-/// Sections of a version 2 file (version 1 has the first 7).
+/// The newest version this code writes and reads (it reads versions 1
+/// and 2 too, and writes them as [`Format::Dense`]).
+pub const VERSION: u32 = 3;
+/// Sections of a version 2 or 3 file (version 1 has the first 7).
 const SECTIONS: usize = 8;
 /// The header of a version 1 file.
 const HEADER_LEN: u64 = 192;
 /// The header of a version 2 file.
 const HEADER2_LEN: u64 = 256;
+/// The header of a version 3 file.
+const HEADER3_LEN: u64 = 320;
 const META_LEN: u64 = 192;
 /// Every section starts at a multiple of this, and the file ends at one.
 const SECTION_ALIGN: u64 = 64;
@@ -98,8 +136,21 @@ const LIGHT_LEN: u64 = 48;
 /// A record in the file: its fields in order, as large as the core's
 /// record.
 const RECORD_LEN: u64 = size_of::<VoxelRecord>() as u64;
+/// The widths of a record's fields in the file, in order.
+const RECORD_FIELDS: &[usize] = &[4, 2, 2, 1, 1, 1, 1, 1, 1, 2, 2, 2];
 /// A brick directory entry (a `u32` record offset).
 const DIRECTORY_ENTRY_LEN: u64 = size_of::<u32>() as u64;
+/// Cells of a brick.
+const BRICK_CELLS: usize = BRICK_VOXELS as usize;
+/// A brick of the plane in a version 3 file: its index (`u64`), its cells.
+const PLANE_BRICK_LEN: u64 = 8 + BRICK_CELLS as u64;
+/// Entries of a compressed section are coded in blocks of about this many
+/// bytes; a block of more than [`MAX_BLOCK`] bytes is refused.
+const BLOCK_BYTES: usize = 1 << 20;
+const MAX_BLOCK: usize = 16 << 20;
+/// Section codecs (version 3): the entries as they are, or in blocks.
+const CODEC_RAW: u32 = 0;
+const CODEC_BLOCKS: u32 = 1;
 const NAMES: [&str; SECTIONS] = [
     "meta",
     "plane",
@@ -111,12 +162,35 @@ const NAMES: [&str; SECTIONS] = [
     "lists",
 ];
 
-/// The section count and header length of `version` (1 or 2).
-const fn layout(version: u32) -> (usize, u64) {
-    if version == 1 {
-        (SECTIONS - 1, HEADER_LEN)
-    } else {
-        (SECTIONS, HEADER2_LEN)
+/// The section count, header length and section table entry length of
+/// `version` (1 to 3).
+const fn layout(version: u32) -> (usize, u64, usize) {
+    match version {
+        1 => (SECTIONS - 1, HEADER_LEN, 24),
+        2 => (SECTIONS, HEADER2_LEN, 24),
+        _ => (SECTIONS, HEADER3_LEN, 32),
+    }
+}
+
+/// How [`save_to`] and [`save_bytes_as`] write a raster.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Version 3 (the default): the plane made again on load from the
+    /// records (only the bricks that differ from that are stored), the
+    /// directory, records, object lists and stored bricks compressed in
+    /// blocks when `compress` is set.
+    Sparse {
+        /// Compress the large sections.
+        compress: bool,
+    },
+    /// Version 1 (the paper's raster) or 2 (an exact raster): the dense
+    /// plane, one byte per voxel, for an rrt that reads only those.
+    Dense,
+}
+
+impl Default for Format {
+    fn default() -> Self {
+        Self::Sparse { compress: true }
     }
 }
 
@@ -158,12 +232,26 @@ pub enum RasterFileError {
         what: String,
     },
     /// A checksum does not match.
-    #[error("{}: corrupt: the {section} checksum does not match", path.display())]
+    #[error("{}: corrupt: the {section} checksum does not match (bytes {start} to {end})", path.display())]
     Checksum {
         /// The file.
         path: PathBuf,
         /// Which section (or the header).
         section: &'static str,
+        /// The checked bytes' first offset in the file.
+        start: u64,
+        /// The offset just past them.
+        end: u64,
+    },
+    /// Loading needs more memory than the limit.
+    #[error("{}: the raster needs {} once loaded, more than the limit of {}", path.display(), Bytes(*needed), Bytes(*limit))]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Bytes the loaded raster would hold.
+        needed: u64,
+        /// The limit.
+        limit: u64,
     },
     /// The scene holds what the format cannot store.
     #[error("{}: cannot save {what} in a raster file; render the scene itself", path.display())]
@@ -253,7 +341,7 @@ impl<'a> Cursor<'a> {
     }
 }
 
-fn meta_bytes(s: &VoxelScene) -> Vec<u8> {
+fn meta_bytes(s: &VoxelScene, version: u32) -> Vec<u8> {
     let mut b = Buf::default();
     for d in s.frame.extent.dims() {
         b.u32(d);
@@ -271,7 +359,10 @@ fn meta_bytes(s: &VoxelScene) -> Vec<u8> {
     } else {
         0
     });
-    b.0.extend_from_slice(&[0; 2]);
+    // Version 3 says here whether the raster is exact (versions 1 and 2
+    // by their number).
+    b.0.push(u8::from(version == 3 && s.exact));
+    b.0.push(0);
     b.vec(s.frame.origin);
     b.f64(s.frame.voxel_size);
     b.vec(s.background);
@@ -366,8 +457,8 @@ impl<W: Write> Checked<'_, W> {
     }
 }
 
-/// Writes `scene` to `path` (module docs for the layout) through a
-/// temporary file renamed over `path` when complete
+/// Writes `scene` to `path` in the default [`Format`] (module docs for the
+/// layout) through a temporary file renamed over `path` when complete
 /// ([`AtomicFile`]); returns the file's length.
 ///
 /// # Errors
@@ -378,12 +469,12 @@ pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
         what: "cannot create",
         source,
     })?;
-    save_to(scene, out, &ProgressBar::hidden())
+    save_to(scene, out, &ProgressBar::hidden(), Format::default())
 }
 
-/// Writes `scene` into `out`, opened earlier (so that an unwritable
-/// output is reported before voxelizing), and commits it over its target;
-/// returns the file's length. `progress` counts bytes.
+/// Writes `scene` in `format` into `out`, opened earlier (so that an
+/// unwritable output is reported before voxelizing), and commits it over
+/// its target; returns the file's length. `progress` counts bytes.
 ///
 /// # Errors
 /// [`RasterFileError::Io`] naming the target; the target is untouched.
@@ -391,6 +482,7 @@ pub fn save_to(
     scene: &VoxelScene,
     mut out: AtomicFile,
     progress: &ProgressBar,
+    format: Format,
 ) -> Result<u64, RasterFileError> {
     let path = out.target().to_path_buf();
     refuse_direct(scene, &path)?;
@@ -399,7 +491,7 @@ pub fn save_to(
         what: "cannot write",
         source,
     };
-    let len = write_raster(scene, out.file(), progress).map_err(io)?;
+    let len = write_raster(scene, out.file(), progress, format).map_err(io)?;
     out.commit().map_err(io)?;
     Ok(len)
 }
@@ -409,9 +501,21 @@ pub fn save_to(
 /// # Errors
 /// [`RasterFileError::Unsupported`] for what a raster file cannot hold.
 pub fn save_bytes(scene: &VoxelScene, path: &Path) -> Result<Vec<u8>, RasterFileError> {
+    save_bytes_as(scene, path, Format::default())
+}
+
+/// The bytes of `scene` saved in `format` (named `path` in errors).
+///
+/// # Errors
+/// [`RasterFileError::Unsupported`] for what a raster file cannot hold.
+pub fn save_bytes_as(
+    scene: &VoxelScene,
+    path: &Path,
+    format: Format,
+) -> Result<Vec<u8>, RasterFileError> {
     refuse_direct(scene, path)?;
     let mut out = std::io::Cursor::new(Vec::new());
-    write_raster(scene, &mut out, &ProgressBar::hidden()).map_err(|source| {
+    write_raster(scene, &mut out, &ProgressBar::hidden(), format).map_err(|source| {
         RasterFileError::Io {
             path: path.to_path_buf(),
             what: "cannot write",
@@ -436,28 +540,258 @@ fn refuse_direct(scene: &VoxelScene, path: &Path) -> Result<(), RasterFileError>
     }
 }
 
+/// The field widths of a stored plane brick: its index, then each cell.
+const PLANE_BRICK_FIELDS: [usize; 1 + BRICK_CELLS] = {
+    let mut f = [1; 1 + BRICK_CELLS];
+    f[0] = 8;
+    f
+};
+
+/// A brick of the plane stored in a version 3 file: its index and its
+/// cells (x fastest, the cells outside the raster 0).
+#[derive(Clone, Debug, Default, PartialEq)]
+struct PlaneBrick {
+    brick: u64,
+    cells: Vec<u8>,
+}
+
+/// Slices of the plane made at once when a raster is saved.
+const SAVE_SLAB_BYTES: usize = 256 << 20;
+
+/// The bricks of `scene`'s plane that differ from the plane made again
+/// from its records ([`derive_plane`]), in brick order: none for a raster
+/// as the builder makes it. Made slab by slab, so that the extra memory
+/// is about [`SAVE_SLAB_BYTES`] plus the margins.
+fn differing_bricks(scene: &VoxelScene) -> std::io::Result<Vec<PlaneBrick>> {
+    let extent = scene.extent();
+    let [nx, ny, nz] = extent.dims();
+    let [bx, by, _] = brick_dims(extent);
+    let (nxu, nyu) = (nx as usize, ny as usize);
+    let slab = ((SAVE_SLAB_BYTES / (nxu * nyu)).max(8) as u32) & !(BRICK - 1);
+    let mut out = Vec::new();
+    let mut z0 = 0;
+    while z0 < nz {
+        let z1 = z0.saturating_add(slab).min(nz);
+        let (derived, d0) = derive_plane(
+            extent,
+            &scene.directory,
+            &scene.records,
+            &scene.lists,
+            [z0, z1],
+        )?;
+        let rows: Vec<(u32, u32)> = (z0 / BRICK..z1.div_ceil(BRICK))
+            .flat_map(|bz| (0..by).map(move |byi| (bz, byi)))
+            .collect();
+        let found: Vec<Vec<PlaneBrick>> = rows
+            .par_iter()
+            .map(|&(bz, byi)| {
+                let mut row = Vec::new();
+                for bxi in 0..bx {
+                    let cells = |z: u32, y: u32| {
+                        let x0 = (bxi * BRICK) as usize;
+                        let x1 = (x0 + BRICK as usize).min(nxu);
+                        let at = |z: u32| x0 + nxu * (y as usize + nyu * z as usize);
+                        (at(z)..at(z) + x1 - x0, at(z - d0)..at(z - d0) + x1 - x0)
+                    };
+                    let voxels = || {
+                        (bz * BRICK..(bz * BRICK + BRICK).min(nz)).flat_map(move |z| {
+                            (byi * BRICK..(byi * BRICK + BRICK).min(ny)).map(move |y| (z, y))
+                        })
+                    };
+                    if voxels().all(|(z, y)| {
+                        let (a, b) = cells(z, y);
+                        scene.plane[a] == derived[b]
+                    }) {
+                        continue;
+                    }
+                    let mut brick = vec![0u8; BRICK_CELLS];
+                    for (z, y) in voxels() {
+                        let (a, _) = cells(z, y);
+                        let at = 8 * ((y - byi * BRICK) + 8 * (z - bz * BRICK)) as usize;
+                        brick[at..at + a.len()].copy_from_slice(&scene.plane[a]);
+                    }
+                    row.push(PlaneBrick {
+                        brick: u64::from(bxi)
+                            + u64::from(bx) * (u64::from(byi) + u64::from(by) * u64::from(bz)),
+                        cells: brick,
+                    });
+                }
+                row
+            })
+            .collect();
+        out.extend(found.into_iter().flatten());
+        z0 = z1;
+    }
+    Ok(out)
+}
+
+/// The little-endian number in `b` (at most 8 bytes).
+fn le_value(b: &[u8]) -> u64 {
+    b.iter().rev().fold(0, |v, &x| (v << 8) | u64::from(x))
+}
+
+/// The low `w` bytes of a `u64` (w from 1 to 8).
+fn width_mask(w: usize) -> u64 {
+    if w >= 8 {
+        u64::MAX
+    } else {
+        (1u64 << (8 * w)) - 1
+    }
+}
+
+/// A block of entries (fields of the widths `fields`, in order) made
+/// compressible: each field replaced by its difference from the previous
+/// entry's (modulo its width), then the bytes grouped by their place in
+/// the entry (all first bytes, all second bytes, …).
+fn transposed(raw: &[u8], fields: &[usize]) -> Vec<u8> {
+    let len: usize = fields.iter().sum();
+    let m = raw.len() / len;
+    let mut out = vec![0u8; m * len];
+    let mut at = 0;
+    for &w in fields {
+        let mut prev = 0u64;
+        for (e, entry) in raw.chunks_exact(len).enumerate() {
+            let v = le_value(&entry[at..at + w]);
+            let d = v.wrapping_sub(prev);
+            prev = v;
+            for i in 0..w {
+                out[(at + i) * m + e] = (d >> (8 * i)) as u8;
+            }
+        }
+        at += w;
+    }
+    out
+}
+
+/// The entries [`transposed`] made `t` from, into `raw` (as long).
+fn untransposed(t: &[u8], fields: &[usize], raw: &mut [u8]) {
+    let len: usize = fields.iter().sum();
+    let m = t.len() / len;
+    let mut at = 0;
+    for &w in fields {
+        let mask = width_mask(w);
+        let mut prev = 0u64;
+        for (e, entry) in raw.chunks_exact_mut(len).enumerate().take(m) {
+            let d = (0..w).fold(0u64, |d, i| d | (u64::from(t[(at + i) * m + e]) << (8 * i)));
+            let v = prev.wrapping_add(d) & mask;
+            prev = v;
+            for (i, b) in entry[at..at + w].iter_mut().enumerate() {
+                *b = (v >> (8 * i)) as u8;
+            }
+        }
+        at += w;
+    }
+}
+
+/// The bytes of a section of `n` entries with fields of the widths
+/// `fields`, entry `i` appended to a buffer by `entry`: the entries as
+/// they are, or (`compress`) in blocks ([`transposed`], then LZ4), after
+/// a table: entries u64, entries per block u32, blocks u32, each block's
+/// length u32.
+fn encode_entries(
+    n: usize,
+    fields: &[usize],
+    compress: bool,
+    entry: impl Fn(usize, &mut Vec<u8>) + Sync,
+) -> Vec<u8> {
+    let len: usize = fields.iter().sum();
+    let per = (BLOCK_BYTES / len).max(1);
+    let blocks: Vec<Vec<u8>> = (0..n.div_ceil(per))
+        .into_par_iter()
+        .map(|b| {
+            let mut raw = Vec::with_capacity(per * len);
+            for i in b * per..((b + 1) * per).min(n) {
+                entry(i, &mut raw);
+            }
+            if compress {
+                lz4_flex::block::compress(&transposed(&raw, fields))
+            } else {
+                raw
+            }
+        })
+        .collect();
+    if !compress {
+        return blocks.concat();
+    }
+    let mut out = Buf::default();
+    out.u64(n as u64);
+    out.u32(u32::try_from(per).unwrap_or(u32::MAX));
+    out.u32(u32::try_from(blocks.len()).unwrap_or(u32::MAX));
+    for b in &blocks {
+        out.u32(u32::try_from(b.len()).unwrap_or(u32::MAX));
+    }
+    for b in &blocks {
+        out.0.extend_from_slice(b);
+    }
+    out.0
+}
+
+/// The sections of a version 3 file: (codec, bytes) in kind order.
+fn sparse_sections(scene: &VoxelScene, compress: bool) -> std::io::Result<Vec<(u32, Vec<u8>)>> {
+    let codec = if compress { CODEC_BLOCKS } else { CODEC_RAW };
+    let bricks = differing_bricks(scene)?;
+    Ok(vec![
+        (CODEC_RAW, meta_bytes(scene, 3)),
+        (
+            codec,
+            encode_entries(bricks.len(), &PLANE_BRICK_FIELDS, compress, |i, b| {
+                b.extend_from_slice(&bricks[i].brick.to_le_bytes());
+                b.extend_from_slice(&bricks[i].cells);
+            }),
+        ),
+        (
+            codec,
+            encode_entries(scene.directory.len(), &[4], compress, |i, b| {
+                b.extend_from_slice(&scene.directory[i].to_le_bytes());
+            }),
+        ),
+        (
+            codec,
+            encode_entries(scene.records.len(), RECORD_FIELDS, compress, |i, b| {
+                record_bytes(&scene.records[i], b);
+            }),
+        ),
+        (CODEC_RAW, objects_bytes(scene)),
+        (CODEC_RAW, materials_bytes(scene)),
+        (CODEC_RAW, lights_bytes(scene)),
+        (
+            codec,
+            encode_entries(scene.lists.len(), &[4], compress, |i, b| {
+                b.extend_from_slice(&scene.lists[i].to_le_bytes());
+            }),
+        ),
+    ])
+}
+
 /// Writes `scene` into `file` from its start (module docs for the layout);
 /// returns the length written.
 fn write_raster<F: Write + Seek>(
     scene: &VoxelScene,
     file: &mut F,
     progress: &ProgressBar,
+    format: Format,
 ) -> std::io::Result<u64> {
+    let (version, sparse) = match format {
+        Format::Sparse { compress } => (3, Some(sparse_sections(scene, compress)?)),
+        Format::Dense => (if scene.exact { 2 } else { 1 }, None),
+    };
     let mut w = BufWriter::with_capacity(1 << 20, &mut *file);
-    let version = if scene.exact { 2 } else { 1 };
-    let (sections, header_len) = layout(version);
+    let (sections, header_len, _) = layout(version);
     w.write_all(&vec![0u8; header_len as usize])?;
     // Every section's bytes, as the writer below counts them.
-    progress.set_length(
-        META_LEN
-            + scene.plane.len() as u64
-            + scene.directory.len() as u64 * DIRECTORY_ENTRY_LEN
-            + scene.records.len() as u64 * RECORD_LEN
-            + scene.objects.len() as u64 * OBJECT_LEN
-            + scene.materials.len() as u64 * MATERIAL_LEN
-            + scene.lights.len() as u64 * LIGHT_LEN
-            + scene.lists.len() as u64 * 4,
-    );
+    progress.set_length(match &sparse {
+        Some(s) => s.iter().map(|(_, b)| b.len() as u64).sum(),
+        None => {
+            META_LEN
+                + scene.plane.len() as u64
+                + scene.directory.len() as u64 * DIRECTORY_ENTRY_LEN
+                + scene.records.len() as u64 * RECORD_LEN
+                + scene.objects.len() as u64 * OBJECT_LEN
+                + scene.materials.len() as u64 * MATERIAL_LEN
+                + scene.lights.len() as u64 * LIGHT_LEN
+                + scene.lists.len() as u64 * 4
+        }
+    });
     progress.set_position(0);
     let mut table = Vec::with_capacity(sections);
     let mut offset = header_len;
@@ -468,10 +802,16 @@ fn write_raster<F: Write + Seek>(
             len: 0,
             progress,
         };
-        match kind {
-            1 => c.put(&meta_bytes(scene))?,
-            2 => c.put(&scene.plane)?,
-            3 => {
+        let mut codec = CODEC_RAW;
+        match (&sparse, kind) {
+            (Some(s), k) => {
+                let (sc, b) = &s[k as usize - 1];
+                codec = *sc;
+                c.put(b)?;
+            }
+            (None, 1) => c.put(&meta_bytes(scene, version))?,
+            (None, 2) => c.put(&scene.plane)?,
+            (None, 3) => {
                 let mut b =
                     Vec::with_capacity(scene.directory.len() * DIRECTORY_ENTRY_LEN as usize);
                 for d in &scene.directory {
@@ -479,7 +819,7 @@ fn write_raster<F: Write + Seek>(
                 }
                 c.put(&b)?;
             }
-            4 => {
+            (None, 4) => {
                 let mut b = Vec::with_capacity(1 << 20);
                 for chunk in scene.records.chunks(1 << 15) {
                     b.clear();
@@ -489,16 +829,16 @@ fn write_raster<F: Write + Seek>(
                     c.put(&b)?;
                 }
             }
-            5 => c.put(&objects_bytes(scene))?,
-            6 => c.put(&materials_bytes(scene))?,
-            7 => c.put(&lights_bytes(scene))?,
-            _ => {
+            (None, 5) => c.put(&objects_bytes(scene))?,
+            (None, 6) => c.put(&materials_bytes(scene))?,
+            (None, 7) => c.put(&lights_bytes(scene))?,
+            (None, _) => {
                 let b: Vec<u8> = scene.lists.iter().flat_map(|v| v.to_le_bytes()).collect();
                 c.put(&b)?;
             }
         }
         let (len, crc) = (c.len, c.crc.finalize());
-        table.push((kind, crc, offset, len));
+        table.push((kind, codec, crc, offset, len));
         offset += len;
         let pad = offset.next_multiple_of(SECTION_ALIGN) - offset;
         w.write_all(&vec![0u8; pad as usize])?;
@@ -510,9 +850,15 @@ fn write_raster<F: Write + Seek>(
     h.extend_from_slice(&MAGIC);
     h.extend_from_slice(&version.to_le_bytes());
     h.extend_from_slice(&(sections as u32).to_le_bytes());
-    for (kind, crc, off, len) in &table {
+    for (kind, codec, crc, off, len) in &table {
         h.extend_from_slice(&kind.to_le_bytes());
+        if version == 3 {
+            h.extend_from_slice(&codec.to_le_bytes());
+        }
         h.extend_from_slice(&crc.to_le_bytes());
+        if version == 3 {
+            h.extend_from_slice(&0u32.to_le_bytes());
+        }
         h.extend_from_slice(&off.to_le_bytes());
         h.extend_from_slice(&len.to_le_bytes());
     }
@@ -522,6 +868,32 @@ fn write_raster<F: Write + Seek>(
     file.seek(SeekFrom::Start(0))?;
     file.write_all(&h)?;
     Ok(offset)
+}
+
+/// The (codec, crc, offset, length) of entry `k` of the section table of
+/// a `version` file whose header is `h` (long enough).
+fn table_entry(h: &[u8], version: u32, k: usize) -> (u32, u32, u64, u64) {
+    let (_, _, entry) = layout(version);
+    let at = 16 + entry * k;
+    let u32_at = |i: usize| u32::from_le_bytes([h[i], h[i + 1], h[i + 2], h[i + 3]]);
+    let u64_at = |i: usize| u64::from(u32_at(i)) | (u64::from(u32_at(i + 4)) << 32);
+    if version == 3 {
+        (
+            u32_at(at + 4),
+            u32_at(at + 8),
+            u64_at(at + 16),
+            u64_at(at + 24),
+        )
+    } else {
+        (CODEC_RAW, u32_at(at + 4), u64_at(at + 8), u64_at(at + 16))
+    }
+}
+
+/// Where entry `k`'s checksum is in the header of a `version` file.
+#[cfg(any(test, feature = "check"))]
+fn crc_at(version: u32, k: usize) -> usize {
+    let (_, _, entry) = layout(version);
+    16 + entry * k + if version == 3 { 8 } else { 4 }
 }
 
 /// Recomputes, in the bytes of a raster file, every checksum its section
@@ -537,18 +909,12 @@ pub fn reseal(bytes: &mut [u8]) {
     if !(1..=VERSION).contains(&version) {
         return;
     }
-    let (n, header_len) = layout(version);
+    let (n, header_len, entry) = layout(version);
     if (bytes.len() as u64) < header_len {
         return;
     }
-    let le64 = |b: &[u8], at: usize| {
-        let mut x = [0u8; 8];
-        x.copy_from_slice(&b[at..at + 8]);
-        u64::from_le_bytes(x)
-    };
     for k in 0..n {
-        let at = 16 + 24 * k;
-        let (off, len) = (le64(bytes, at + 8), le64(bytes, at + 16));
+        let (_, _, off, len) = table_entry(bytes, version, k);
         let Some(range) = usize::try_from(off)
             .ok()
             .zip(usize::try_from(len).ok())
@@ -558,9 +924,10 @@ pub fn reseal(bytes: &mut [u8]) {
             continue;
         };
         let crc = crc32fast::hash(&bytes[range]);
-        bytes[at + 4..at + 8].copy_from_slice(&crc.to_le_bytes());
+        let at = crc_at(version, k);
+        bytes[at..at + 4].copy_from_slice(&crc.to_le_bytes());
     }
-    let at = 16 + 24 * n;
+    let at = 16 + entry * n;
     let crc = crc32fast::hash(&bytes[..at]);
     bytes[at..at + 4].copy_from_slice(&crc.to_le_bytes());
 }
@@ -580,6 +947,13 @@ pub fn is_raster_file(path: &Path) -> bool {
 pub struct Info {
     /// The file's format version.
     pub version: u32,
+    /// Whether the raster is exact (object lists, renders in every mode).
+    pub exact: bool,
+    /// Whether its large sections are compressed (version 3).
+    pub compressed: bool,
+    /// Bricks of the plane stored in the file (version 3: those that
+    /// differ from the plane made again from the records).
+    pub plane_bricks: u64,
     /// Entries of the object lists (0 for a raster without them).
     pub list_entries: u64,
     /// Voxels per axis.
@@ -590,7 +964,7 @@ pub struct Info {
     pub voxel_size: f64,
     /// The voxelization's separation.
     pub separation: Separation,
-    /// What the light bits of records of exact objects hold (version 2).
+    /// What the light bits of records of exact objects hold.
     pub exact_records: ExactRecords,
     /// Records (non-transparent voxels).
     pub records: u64,
@@ -602,100 +976,114 @@ pub struct Info {
     pub lights: u32,
     /// The file's length.
     pub file_bytes: u64,
-    /// Memory for plane, its line level (built on load), directory and
-    /// records once loaded.
+    /// Memory for plane, its line level (built on load), directory,
+    /// records and object lists once loaded.
     pub memory: u64,
 }
 
 struct Header {
     version: u32,
     file_len: u64,
-    /// (crc, offset, length) per section; the lists' is all zero in a
-    /// version 1 file.
-    sections: [(u32, u64, u64); SECTIONS],
+    /// (codec, crc, offset, length) per section; the lists' is all zero
+    /// in a version 1 file.
+    sections: [(u32, u32, u64, u64); SECTIONS],
 }
 
-fn read_header<R: Read>(
-    file: &mut R,
-    file_len: u64,
-    path: &Path,
-) -> Result<Header, RasterFileError> {
+impl Header {
+    fn name(&self, k: usize) -> &'static str {
+        if self.version == 3 && k == 1 {
+            "plane bricks"
+        } else {
+            NAMES[k]
+        }
+    }
+}
+
+fn read_header(bytes: &[u8], path: &Path) -> Result<Header, RasterFileError> {
     let p = || path.to_path_buf();
-    let mut h = [0u8; HEADER2_LEN as usize];
-    let got = read_up_to(file, &mut h).map_err(|source| RasterFileError::Io {
-        path: p(),
-        what: "cannot read",
-        source,
-    })?;
-    if got < 12 && got > 0 && (MAGIC.starts_with(&h[..got.min(8)])) {
+    let file_len = bytes.len() as u64;
+    let got = bytes.len();
+    if got < 12 && got > 0 && (MAGIC.starts_with(&bytes[..got.min(8)])) {
         return Err(RasterFileError::Truncated {
             path: p(),
             what: format!("{got} bytes, shorter than the {HEADER_LEN}-byte header"),
         });
     }
-    if got < 8 || h[..8] != MAGIC {
+    if got < 8 || bytes[..8] != MAGIC {
         return Err(RasterFileError::NotRaster { path: p() });
     }
-    let mut c = Cursor::new(&h[8..]);
-    let version = c.u32();
+    let version = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
     if !(1..=VERSION).contains(&version) {
         return Err(RasterFileError::Version {
             path: p(),
             found: version,
         });
     }
-    let (n, header_len) = layout(version);
+    let (n, header_len, entry) = layout(version);
     if (got as u64) < header_len {
         return Err(RasterFileError::Truncated {
             path: p(),
             what: format!("{got} bytes, shorter than the {header_len}-byte header"),
         });
     }
-    let at = 16 + 24 * n;
+    let h = &bytes[..header_len as usize];
+    let at = 16 + entry * n;
     let stored = u32::from_le_bytes([h[at], h[at + 1], h[at + 2], h[at + 3]]);
     if crc32fast::hash(&h[..at]) != stored {
         return Err(RasterFileError::Checksum {
             path: p(),
             section: "header",
+            start: 0,
+            end: at as u64,
         });
     }
-    let count = c.u32();
+    let count = u32::from_le_bytes([h[12], h[13], h[14], h[15]]);
     if count as usize != n {
         return Err(RasterFileError::Invalid {
             path: p(),
             what: format!("{count} sections, expected {n} for version {version}"),
         });
     }
-    let mut sections = [(0u32, 0u64, 0u64); SECTIONS];
+    let mut header = Header {
+        version,
+        file_len,
+        sections: [(0, 0, 0, 0); SECTIONS],
+    };
     let mut end = header_len;
-    for (k, s) in sections.iter_mut().take(n).enumerate() {
-        let kind = c.u32();
-        let crc = c.u32();
-        let off = c.u64();
-        let len = c.u64();
-        if kind as usize != k + 1 || off < end {
+    for k in 0..n {
+        let kind = u32::from_le_bytes(h[16 + entry * k..][..4].try_into().unwrap_or([0; 4]));
+        let (codec, crc, off, len) = table_entry(h, version, k);
+        let reserved = version == 3 && h[16 + entry * k + 12..][..4] != [0; 4];
+        if kind as usize != k + 1 || off < end || reserved {
             return Err(RasterFileError::Invalid {
                 path: p(),
                 what: format!("section table entry {} is out of order", k + 1),
+            });
+        }
+        let blocks_allowed = matches!(k, 1 | 2 | 3 | 7);
+        if codec != CODEC_RAW && !(codec == CODEC_BLOCKS && blocks_allowed) {
+            return Err(RasterFileError::Invalid {
+                path: p(),
+                what: format!("{} section with unknown codec {codec}", header.name(k)),
             });
         }
         let stop = off
             .checked_add(len)
             .ok_or_else(|| RasterFileError::Invalid {
                 path: p(),
-                what: format!("{} section length overflows", NAMES[k]),
+                what: format!("{} section length overflows", header.name(k)),
             })?;
         if stop > file_len {
             return Err(RasterFileError::Truncated {
                 path: p(),
                 what: format!(
                     "the {} section ends at byte {stop}, the file has {file_len}",
-                    NAMES[k]
+                    header.name(k)
                 ),
             });
         }
         end = stop;
-        *s = (crc, off, len);
+        header.sections[k] = (codec, crc, off, len);
     }
     // The writer pads the last section to a multiple of 64 like every
     // other: a shorter file lost bytes (of padding only, perhaps, but it
@@ -719,62 +1107,45 @@ fn read_header<R: Read>(
             ),
         });
     }
-    Ok(Header {
-        version,
-        file_len,
-        sections,
-    })
+    Ok(header)
 }
 
-fn read_up_to<R: Read>(file: &mut R, buf: &mut [u8]) -> std::io::Result<usize> {
-    let mut got = 0;
-    while got < buf.len() {
-        match file.read(&mut buf[got..]) {
-            Ok(0) => break,
-            Ok(n) => got += n,
-            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(got)
-}
-
-/// Reads section `k` into `buf` (whose length is the section's) and checks
-/// its checksum; `progress` counts the bytes read.
-fn read_section<R: Read + Seek>(
-    file: &mut R,
+/// The bytes of section `k`, its checksum checked (in pieces, each given
+/// to `each` and counted on `progress`).
+fn section<'b>(
+    bytes: &'b [u8],
     path: &Path,
     h: &Header,
     k: usize,
-    buf: &mut [u8],
     progress: &ProgressBar,
-) -> Result<(), RasterFileError> {
-    let (crc, off, _) = h.sections[k];
-    let io = |source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot read",
-        source,
-    };
-    file.seek(SeekFrom::Start(off)).map_err(io)?;
-    // In pieces, so that the bar moves while a large plane is read.
+    mut each: impl FnMut(usize, &[u8]),
+) -> Result<&'b [u8], RasterFileError> {
+    let (_, crc, off, len) = h.sections[k];
+    // Inside the file: read_header checked it.
+    let b = &bytes[off as usize..(off + len) as usize];
     let mut hasher = crc32fast::Hasher::new();
-    for piece in buf.chunks_mut(1 << 22) {
-        file.read_exact(piece).map_err(io)?;
+    let mut at = 0;
+    for piece in b.chunks(1 << 22) {
         hasher.update(piece);
+        each(at, piece);
+        at += piece.len();
         progress.inc(piece.len() as u64);
     }
     if hasher.finalize() != crc {
         return Err(RasterFileError::Checksum {
             path: path.to_path_buf(),
-            section: NAMES[k],
+            section: h.name(k),
+            start: off,
+            end: off + len,
         });
     }
-    Ok(())
+    Ok(b)
 }
 
 struct Meta {
     dims: [u32; 3],
     separation: Separation,
+    exact: bool,
     exact_records: ExactRecords,
     origin: DVec3,
     voxel_size: f64,
@@ -786,42 +1157,52 @@ struct Meta {
     lights: u32,
 }
 
-fn read_meta<R: Read + Seek>(
-    file: &mut R,
-    path: &Path,
-    h: &Header,
-) -> Result<Meta, RasterFileError> {
+fn read_meta(bytes: &[u8], path: &Path, h: &Header) -> Result<Meta, RasterFileError> {
     let invalid = |what: String| RasterFileError::Invalid {
         path: path.to_path_buf(),
         what,
     };
-    if h.sections[0].2 != META_LEN {
+    if h.sections[0].3 != META_LEN {
         return Err(invalid(format!(
             "meta section of {} bytes, expected {META_LEN}",
-            h.sections[0].2
+            h.sections[0].3
         )));
     }
-    let mut b = vec![0u8; META_LEN as usize];
-    read_section(file, path, h, 0, &mut b, &ProgressBar::hidden())?;
-    let mut c = Cursor::new(&b);
+    let b = section(bytes, path, h, 0, &ProgressBar::hidden(), |_, _| {})?;
+    let mut c = Cursor::new(b);
     let dims = [c.u32(), c.u32(), c.u32()];
     let separation = match c.u8() {
         6 => Separation::Six,
         26 => Separation::TwentySix,
         s => return Err(invalid(format!("separation {s}, expected 6 or 26"))),
     };
-    let exact_records = match (h.version, c.u8()) {
-        (_, 0) => ExactRecords::Paper,
-        (2, 1) => ExactRecords::Classify,
-        (2, 2) => ExactRecords::Skip,
-        (v, b) => {
+    let records_byte = c.u8();
+    let exact = match (h.version, c.u8()) {
+        (1, 0) => false,
+        (2, 0) => true,
+        (3, e @ (0 | 1)) => e == 1,
+        (v, e) => {
             return Err(invalid(format!(
-                "light bits of exact records {b}, expected 0{} in a version {v} file",
-                if v == 2 { ", 1 or 2" } else { "" }
+                "exact flag {e}, expected 0{} in a version {v} file",
+                if v == 3 { " or 1" } else { "" }
             )));
         }
     };
-    c.take::<2>();
+    let exact_records = match (exact, records_byte) {
+        (_, 0) => ExactRecords::Paper,
+        (true, 1) => ExactRecords::Classify,
+        (true, 2) => ExactRecords::Skip,
+        (_, b) => {
+            return Err(invalid(format!(
+                "light bits of exact records {b}, expected 0{} in a version {} file",
+                if exact { ", 1 or 2" } else { "" },
+                h.version
+            )));
+        }
+    };
+    if c.u8() != 0 {
+        return Err(invalid("meta byte 15 is not zero".into()));
+    }
     let origin = c.vec();
     let voxel_size = c.f64();
     let background = c.vec();
@@ -834,6 +1215,7 @@ fn read_meta<R: Read + Seek>(
     let m = Meta {
         dims,
         separation,
+        exact,
         exact_records,
         origin,
         voxel_size,
@@ -877,35 +1259,167 @@ fn read_meta<R: Read + Seek>(
     Ok(m)
 }
 
-/// Opens `path` for reading, with its length.
-fn open(path: &Path) -> Result<(File, u64), RasterFileError> {
-    let file = File::open(path).map_err(|source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot open",
-        source,
-    })?;
-    let len = file
-        .metadata()
-        .map_err(|source| RasterFileError::Io {
-            path: path.to_path_buf(),
-            what: "cannot read",
-            source,
-        })?
-        .len();
-    Ok((file, len))
+/// A raster file's bytes: mapped, or none for an empty file.
+enum Mapped {
+    Map(Mmap),
+    Empty,
 }
 
-/// The header and meta section of a raster file.
+impl std::ops::Deref for Mapped {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match self {
+            Self::Map(m) => m,
+            Self::Empty => &[],
+        }
+    }
+}
+
+/// Maps the file at `path` (read-only, shared): its bytes are read from
+/// the page cache as they are used, not read in full.
+#[allow(unsafe_code)]
+fn map(path: &Path) -> Result<Mapped, RasterFileError> {
+    let io = |what, source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what,
+        source,
+    };
+    let file = File::open(path).map_err(|e| io("cannot open", e))?;
+    let len = file.metadata().map_err(|e| io("cannot read", e))?.len();
+    if len == 0 {
+        return Ok(Mapped::Empty);
+    }
+    // SAFETY: the map is read-only and private to this process; rrt
+    // writes raster files to a temporary file renamed over the target
+    // (so a file being replaced keeps its mapped inode). Another program
+    // truncating the file in place while it is mapped would end the
+    // process with SIGBUS; one changing it in place could change what is
+    // read after the checksums were checked.
+    let map = unsafe { Mmap::map(&file) }.map_err(|e| io("cannot map", e))?;
+    Ok(Mapped::Map(map))
+}
+
+/// The number of entries of `len` bytes in a section of `codec` (its block
+/// table's count, or its length over the entry's).
+fn entry_count(b: &[u8], codec: u32, len: u64) -> Result<u64, String> {
+    if codec == CODEC_BLOCKS {
+        return Ok(Cursor::new(b).u64());
+    }
+    if !(b.len() as u64).is_multiple_of(len) {
+        return Err(format!(
+            "{} bytes, not a whole number of {len}-byte entries",
+            b.len()
+        ));
+    }
+    Ok(b.len() as u64 / len)
+}
+
+/// The `count` entries (fields of the widths `fields`) of a section of
+/// `codec` whose bytes are `b` (at byte `off` of the file), each made by
+/// `parse` from its bytes; on the current rayon pool.
+fn decode_entries<T: Clone + Default + Send>(
+    b: &[u8],
+    off: u64,
+    codec: u32,
+    fields: &[usize],
+    count: u64,
+    parse: impl Fn(&[u8]) -> T + Sync,
+) -> Result<Vec<T>, String> {
+    let len: usize = fields.iter().sum();
+    let n = usize::try_from(count).map_err(|_| format!("{count} entries"))?;
+    if codec == CODEC_RAW {
+        if b.len() != n.saturating_mul(len) {
+            return Err(format!("{} bytes for {n} entries of {len}", b.len()));
+        }
+        return Ok(b.par_chunks_exact(len).map(&parse).collect());
+    }
+    let mut c = Cursor::new(b);
+    let _ = c.u64();
+    let (per, blocks) = (c.u32() as usize, c.u32() as usize);
+    if per == 0 || per.saturating_mul(len) > MAX_BLOCK || blocks != n.div_ceil(per) {
+        return Err(format!(
+            "block table of {blocks} blocks of {per} entries for {n} entries"
+        ));
+    }
+    let table_end = 16usize.saturating_add(blocks.saturating_mul(4));
+    if table_end > b.len() {
+        return Err(format!(
+            "block table of {blocks} blocks past the section's end"
+        ));
+    }
+    let mut ranges = Vec::with_capacity(blocks);
+    let mut at = table_end;
+    for _ in 0..blocks {
+        let l = c.u32() as usize;
+        let end = at.saturating_add(l);
+        if end > b.len() {
+            return Err(format!(
+                "block at byte {} ends past the section",
+                off + at as u64
+            ));
+        }
+        ranges.push(at..end);
+        at = end;
+    }
+    if at != b.len() {
+        return Err(format!("{} bytes after the last block", b.len() - at));
+    }
+    let mut out = vec![T::default(); n];
+    out.par_chunks_mut(per)
+        .zip(ranges.par_iter())
+        .try_for_each(|(dst, r)| {
+            let fail = || {
+                format!(
+                    "the block at byte {} does not decompress",
+                    off + r.start as u64
+                )
+            };
+            let mut t = vec![0u8; dst.len() * len];
+            let got =
+                lz4_flex::block::decompress_into(&b[r.clone()], &mut t).map_err(|_| fail())?;
+            if got != t.len() {
+                return Err(fail());
+            }
+            let mut raw = vec![0u8; t.len()];
+            untransposed(&t, fields, &mut raw);
+            for (d, e) in dst.iter_mut().zip(raw.chunks_exact(len)) {
+                *d = parse(e);
+            }
+            Ok(())
+        })?;
+    Ok(out)
+}
+
+fn u32_from(b: &[u8]) -> u32 {
+    u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+}
+
+/// The header and meta section of a raster file (and the counts of its
+/// version 3 block tables).
 ///
 /// # Errors
 /// As [`load`], for the header and meta section.
 pub fn info(path: &Path) -> Result<Info, RasterFileError> {
-    let (mut file, len) = open(path)?;
-    let h = read_header(&mut file, len, path)?;
-    let m = read_meta(&mut file, path, &h)?;
+    let bytes = map(path)?;
+    let h = read_header(&bytes, path)?;
+    let m = read_meta(&bytes, path, &h)?;
+    let count = |k: usize, len: u64| {
+        let (codec, _, off, l) = h.sections[k];
+        entry_count(&bytes[off as usize..(off + l) as usize], codec, len).unwrap_or(0)
+    };
+    let voxels = u64::from(m.dims[0]) * u64::from(m.dims[1]) * u64::from(m.dims[2]);
+    let lists = count(7, 4);
+    let dir = count(2, DIRECTORY_ENTRY_LEN);
     Ok(Info {
         version: h.version,
-        list_entries: h.sections[7].2 / 4,
+        exact: m.exact,
+        compressed: h.sections.iter().any(|s| s.0 == CODEC_BLOCKS),
+        plane_bricks: if h.version == 3 {
+            count(1, PLANE_BRICK_LEN)
+        } else {
+            0
+        },
+        list_entries: lists,
         dims: m.dims,
         origin: m.origin,
         voxel_size: m.voxel_size,
@@ -916,81 +1430,65 @@ pub fn info(path: &Path) -> Result<Info, RasterFileError> {
         materials: m.materials,
         lights: m.lights,
         file_bytes: h.file_len,
-        memory: h.sections[1].2
-            + h.sections[1].2.div_ceil(LINE_CELLS as u64)
-            + h.sections[2].2
-            + m.records * std::mem::size_of::<VoxelRecord>() as u64
-            + h.sections[7].2,
+        memory: memory_needed(voxels, dir, m.records, lists),
     })
+}
+
+/// Bytes of a loaded raster: plane, line level, directory, records, lists.
+fn memory_needed(voxels: u64, directory: u64, records: u64, lists: u64) -> u64 {
+    voxels
+        .saturating_add(voxels.div_ceil(LINE_CELLS as u64))
+        .saturating_add(directory.saturating_mul(DIRECTORY_ENTRY_LEN))
+        .saturating_add(records.saturating_mul(size_of::<VoxelRecord>() as u64))
+        .saturating_add(lists.saturating_mul(4))
 }
 
 /// Checks every section's checksum and that everything between and after
 /// the sections (the header's last word, the padding) is zero, reading
-/// the file once in 1 MiB pieces (nothing is kept); `progress` counts
-/// bytes.
+/// the mapped file once (nothing is kept); `progress` counts bytes.
+/// `rrt info --check` then loads the raster, which decodes and checks
+/// every entry.
 ///
 /// # Errors
 /// As [`load`] for the header, then [`RasterFileError::Checksum`] naming
 /// the first section that does not match, or [`RasterFileError::Invalid`]
 /// for a non-zero padding byte.
 pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError> {
-    let io = |source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot read",
-        source,
-    };
-    let (mut file, len) = open(path)?;
-    let h = read_header(&mut file, len, path)?;
+    let bytes = map(path)?;
+    let h = read_header(&bytes, path)?;
     progress.set_length(h.file_len);
     progress.set_position(0);
-    let (n, header_len) = layout(h.version);
+    let (n, header_len, entry) = layout(h.version);
     let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by_key(|&k| h.sections[k].1);
-    // The zero bytes after the header's checksum, then each section and
-    // the padding after it (to the next section or the end of the file).
-    let checksum_end = 16 + 24 * n as u64 + 4;
-    let mut pieces = vec![(None, checksum_end, header_len - checksum_end)];
-    for (n, &k) in order.iter().enumerate() {
-        let (_, off, len) = h.sections[k];
-        let end = off.saturating_add(len);
+    order.sort_by_key(|&k| h.sections[k].2);
+    // The zero bytes after the header's checksum, then the padding after
+    // each section (to the next section or the end of the file).
+    let checksum_end = (16 + entry * n + 4) as u64;
+    let mut gaps = vec![(checksum_end, header_len)];
+    for (i, &k) in order.iter().enumerate() {
+        section(&bytes, path, &h, k, progress, |_, _| {})?;
+        let (_, _, off, len) = h.sections[k];
+        let end = off + len;
         let next = order
-            .get(n + 1)
-            .map_or(h.file_len, |&j| h.sections[j].1)
+            .get(i + 1)
+            .map_or(h.file_len, |&j| h.sections[j].2)
             .max(end);
-        pieces.push((Some(k), off, len));
-        pieces.push((None, end, next - end));
+        gaps.push((end, next));
     }
-    let mut buf = vec![0u8; 1 << 20];
-    for (section, off, len) in pieces {
-        file.seek(SeekFrom::Start(off)).map_err(io)?;
-        let mut hasher = crc32fast::Hasher::new();
-        let mut left = len;
-        while left > 0 {
-            let take = usize::try_from(left).map_or(buf.len(), |l| l.min(buf.len()));
-            file.read_exact(&mut buf[..take]).map_err(io)?;
-            if section.is_none() && buf[..take].iter().any(|&b| b != 0) {
-                return Err(RasterFileError::Invalid {
-                    path: path.to_path_buf(),
-                    what: format!("non-zero padding between bytes {off} and {}", off + len),
-                });
-            }
-            hasher.update(&buf[..take]);
-            left -= take as u64;
-            progress.inc(take as u64);
-        }
-        if let Some(k) = section
-            && hasher.finalize() != h.sections[k].0
-        {
-            return Err(RasterFileError::Checksum {
+    for (from, to) in gaps {
+        if bytes[from as usize..to as usize].iter().any(|&b| b != 0) {
+            return Err(RasterFileError::Invalid {
                 path: path.to_path_buf(),
-                section: NAMES[k],
+                what: format!("non-zero padding between bytes {from} and {to}"),
             });
         }
+        progress.inc(to - from);
     }
     Ok(())
 }
 
-/// Loads a raster file (module docs).
+/// Loads a raster file (module docs), refusing one that needs more memory
+/// than [`default_max_memory`].
 ///
 /// # Errors
 /// [`RasterFileError`] naming the file and what is wrong.
@@ -998,14 +1496,14 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
     load_with(path, &ProgressBar::hidden())
 }
 
-/// [`load`], counting the bytes read on `progress` (its length is set to
-/// the file's).
+/// [`load`], counting the bytes checked on `progress` (its length is set
+/// to the file's).
 ///
 /// # Errors
 /// As [`load`].
 pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, RasterFileError> {
-    let (file, len) = open(path)?;
-    load_from(file, len, path, progress)
+    let bytes = map(path)?;
+    load_from(&bytes, path, progress, default_max_memory())
 }
 
 /// [`load`] from the bytes of a raster file in memory, named `path` in
@@ -1014,82 +1512,116 @@ pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, Rast
 /// # Errors
 /// As [`load`].
 pub fn load_bytes(path: &Path, bytes: &[u8]) -> Result<VoxelScene, RasterFileError> {
-    load_from(
-        std::io::Cursor::new(bytes),
-        bytes.len() as u64,
-        path,
-        &ProgressBar::hidden(),
-    )
+    load_bytes_within(path, bytes, default_max_memory())
 }
 
-/// [`load_with`] from `file` of `len` bytes, named `path` in errors.
-fn load_from<R: Read + Seek>(
-    mut file: R,
-    len: u64,
+/// [`load_bytes`], refusing a raster that needs more than `max_memory`
+/// bytes once loaded ([`RasterFileError::TooLarge`]) before allocating it.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_bytes_within(
+    path: &Path,
+    bytes: &[u8],
+    max_memory: u64,
+) -> Result<VoxelScene, RasterFileError> {
+    load_from(bytes, path, &ProgressBar::hidden(), max_memory)
+}
+
+/// The plane, directory, records and lists of a raster file.
+struct Raster {
+    plane: Plane,
+    directory: Vec<u32>,
+    records: Vec<VoxelRecord>,
+    lists: Vec<u32>,
+}
+
+/// [`load_with`] from the bytes of a file, named `path` in errors.
+fn load_from(
+    bytes: &[u8],
     path: &Path,
     progress: &ProgressBar,
+    max_memory: u64,
 ) -> Result<VoxelScene, RasterFileError> {
     let invalid = |what: String| RasterFileError::Invalid {
         path: path.to_path_buf(),
         what,
     };
-    let h = read_header(&mut file, len, path)?;
-    let m = read_meta(&mut file, path, &h)?;
+    let h = read_header(bytes, path)?;
+    let m = read_meta(bytes, path, &h)?;
     progress.set_length(h.file_len);
     progress.set_position(0);
     let extent =
         Extent::new(m.dims[0], m.dims[1], m.dims[2]).map_err(|e| invalid(e.to_string()))?;
-    let expect = |k: usize, len: u64| -> Result<usize, RasterFileError> {
-        if h.sections[k].2 != len {
+    let expect = |k: usize, len: u64| -> Result<(), RasterFileError> {
+        if h.sections[k].3 != len {
             return Err(invalid(format!(
                 "{} section of {} bytes, the counts say {len}",
-                NAMES[k], h.sections[k].2
+                h.name(k),
+                h.sections[k].3
             )));
         }
-        usize::try_from(len).map_err(|_| invalid(format!("{} section too large", NAMES[k])))
+        Ok(())
     };
-    // Every length below is checked against the section table, whose
-    // sections all lie inside the file: no allocation exceeds its size.
-    let plane_len = expect(1, extent.len() as u64)?;
     let dir_n = directory_len(extent).ok_or_else(|| invalid("too many bricks".into()))?;
-    let dir_len = expect(2, dir_n as u64 * DIRECTORY_ENTRY_LEN)?;
-    let rec_len = expect(3, m.records.saturating_mul(RECORD_LEN))?;
-    let obj_len = expect(4, m.objects.saturating_mul(OBJECT_LEN))?;
-    let mat_len = expect(5, u64::from(m.materials) * MATERIAL_LEN)?;
-    let light_len = expect(6, u64::from(m.lights) * LIGHT_LEN)?;
-    let lists_bytes = h.sections[7].2;
-    if lists_bytes % 4 != 0 {
-        return Err(invalid(format!(
-            "lists section of {lists_bytes} bytes, not a whole number of u32 entries"
-        )));
-    }
-    let lists_len = expect(7, lists_bytes)?;
-    let section = |file: &mut R, k: usize, len: usize| -> Result<Vec<u8>, RasterFileError> {
-        let mut b = vec![0u8; len];
-        read_section(file, path, &h, k, &mut b, progress)?;
-        Ok(b)
-    };
-
-    let mut plane = Plane::zeroed(plane_len).map_err(|source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot allocate the raster plane",
-        source,
-    })?;
-    read_section(&mut file, path, &h, 1, &mut plane, progress)?;
-    let directory = directory_from(&section(&mut file, 2, dir_len)?);
-    let records = read_records(&mut file, path, &h, rec_len, progress)?;
-    let materials = materials_from(&section(&mut file, 5, mat_len)?).map_err(invalid)?;
-    let objects =
-        objects_from(&section(&mut file, 4, obj_len)?, materials.len()).map_err(invalid)?;
-    let lights = lights_from(&section(&mut file, 6, light_len)?).map_err(invalid)?;
-    let lists: Vec<u32> = if lists_len == 0 {
-        Vec::new()
+    expect(4, m.objects.saturating_mul(OBJECT_LEN))?;
+    expect(5, u64::from(m.materials) * MATERIAL_LEN)?;
+    expect(6, u64::from(m.lights) * LIGHT_LEN)?;
+    let raw = |k: usize| section(bytes, path, &h, k, progress, |_, _| {});
+    let Raster {
+        plane,
+        directory,
+        records,
+        lists,
+    } = if h.version == 3 {
+        load_sparse(bytes, path, &h, &m, extent, progress, max_memory)?
     } else {
-        section(&mut file, 7, lists_len)?
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect()
+        // Every length below is checked against the section table, whose
+        // sections all lie inside the file.
+        expect(1, extent.len() as u64)?;
+        expect(2, dir_n as u64 * DIRECTORY_ENTRY_LEN)?;
+        expect(3, m.records.saturating_mul(RECORD_LEN))?;
+        if !h.sections[7].3.is_multiple_of(4) {
+            return Err(invalid(format!(
+                "lists section of {} bytes, not a whole number of u32 entries",
+                h.sections[7].3
+            )));
+        }
+        let needed = memory_needed(
+            extent.len() as u64,
+            dir_n as u64,
+            m.records,
+            h.sections[7].3 / 4,
+        );
+        if needed > max_memory {
+            return Err(RasterFileError::TooLarge {
+                path: path.to_path_buf(),
+                needed,
+                limit: max_memory,
+            });
+        }
+        let mut plane = Plane::zeroed(extent.len()).map_err(|source| RasterFileError::Io {
+            path: path.to_path_buf(),
+            what: "cannot allocate the raster plane",
+            source,
+        })?;
+        section(bytes, path, &h, 1, progress, |at, piece| {
+            plane[at..at + piece.len()].copy_from_slice(piece);
+        })?;
+        let words = |b: &[u8]| b.chunks_exact(4).map(u32_from).collect::<Vec<u32>>();
+        Raster {
+            plane,
+            directory: words(raw(2)?),
+            records: raw(3)?
+                .par_chunks_exact(RECORD_LEN as usize)
+                .map(record_from)
+                .collect(),
+            lists: words(raw(7)?),
+        }
     };
+    let materials = materials_from(raw(5)?).map_err(invalid)?;
+    let objects = objects_from(raw(4)?, materials.len()).map_err(invalid)?;
+    let lights = lights_from(raw(6)?).map_err(invalid)?;
     let store = RecordStore::with_lists(extent, &directory, &records, &lists)
         .map_err(|e| invalid(e.to_string()))?;
     for (i, r) in records.iter().enumerate() {
@@ -1111,7 +1643,7 @@ fn load_from<R: Read + Seek>(
             voxel_size: m.voxel_size,
         },
         separation: m.separation,
-        exact: h.version == 2,
+        exact: m.exact,
         exact_records: m.exact_records,
         lines: line_level(extent, &plane),
         plane,
@@ -1127,11 +1659,143 @@ fn load_from<R: Read + Seek>(
     })
 }
 
-/// The brick directory section.
-fn directory_from(b: &[u8]) -> Vec<u32> {
-    b.chunks_exact(4)
-        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect()
+/// The raster of a version 3 file: its entries decoded, the plane made
+/// from the records ([`derive_plane`]) and its stored bricks written over
+/// it.
+fn load_sparse(
+    bytes: &[u8],
+    path: &Path,
+    h: &Header,
+    m: &Meta,
+    extent: Extent,
+    progress: &ProgressBar,
+    max_memory: u64,
+) -> Result<Raster, RasterFileError> {
+    let invalid = |k: usize, what: String| RasterFileError::Invalid {
+        path: path.to_path_buf(),
+        what: format!(
+            "{} section (bytes {} to {}): {what}",
+            h.name(k),
+            h.sections[k].2,
+            h.sections[k].2 + h.sections[k].3
+        ),
+    };
+    let mut secs = Vec::with_capacity(4);
+    for k in [1, 2, 3, 7] {
+        let b = section(bytes, path, h, k, progress, |_, _| {})?;
+        let len = [PLANE_BRICK_LEN, DIRECTORY_ENTRY_LEN, RECORD_LEN, 4][secs.len()];
+        let n = entry_count(b, h.sections[k].0, len).map_err(|e| invalid(k, e))?;
+        secs.push((k, b, n));
+    }
+    let [
+        (_, bricks_b, bricks_n),
+        (_, dir_b, dir_n),
+        (_, rec_b, rec_n),
+        (_, lists_b, lists_n),
+    ] = secs[..]
+    else {
+        return Err(invalid(1, "sections missing".into()));
+    };
+    let bricks_total = brick_count(extent).unwrap_or(usize::MAX) as u64;
+    if dir_n != bricks_total + 1 {
+        return Err(invalid(
+            2,
+            format!("{dir_n} entries, the raster has {bricks_total} bricks"),
+        ));
+    }
+    if rec_n != m.records {
+        return Err(invalid(
+            3,
+            format!("{rec_n} records, the meta section says {}", m.records),
+        ));
+    }
+    if bricks_n > bricks_total {
+        return Err(invalid(
+            1,
+            format!("{bricks_n} bricks, the raster has {bricks_total}"),
+        ));
+    }
+    let needed = memory_needed(extent.len() as u64, dir_n, rec_n, lists_n)
+        .saturating_add(bricks_n.saturating_mul(PLANE_BRICK_LEN + 24));
+    if needed > max_memory {
+        return Err(RasterFileError::TooLarge {
+            path: path.to_path_buf(),
+            needed,
+            limit: max_memory,
+        });
+    }
+    let at = |k: usize| h.sections[k].2;
+    let directory = decode_entries(dir_b, at(2), h.sections[2].0, &[4], dir_n, u32_from)
+        .map_err(|e| invalid(2, e))?;
+    let records = decode_entries(
+        rec_b,
+        at(3),
+        h.sections[3].0,
+        RECORD_FIELDS,
+        rec_n,
+        record_from,
+    )
+    .map_err(|e| invalid(3, e))?;
+    let lists = decode_entries(lists_b, at(7), h.sections[7].0, &[4], lists_n, u32_from)
+        .map_err(|e| invalid(7, e))?;
+    let bricks = decode_entries(
+        bricks_b,
+        at(1),
+        h.sections[1].0,
+        &PLANE_BRICK_FIELDS,
+        bricks_n,
+        |e| PlaneBrick {
+            brick: le_value(&e[..8]),
+            cells: e[8..].to_vec(),
+        },
+    )
+    .map_err(|e| invalid(1, e))?;
+    RecordStore::with_lists(extent, &directory, &records, &lists)
+        .map_err(|e| invalid(3, e.to_string()))?;
+    let nz = extent.dims()[2];
+    let (mut plane, _) =
+        derive_plane(extent, &directory, &records, &lists, [0, nz]).map_err(|source| {
+            RasterFileError::Io {
+                path: path.to_path_buf(),
+                what: "cannot make the raster plane",
+                source,
+            }
+        })?;
+    let [bx, by, _] = brick_dims(extent).map(u64::from);
+    let mut prev = None;
+    for (i, b) in bricks.iter().enumerate() {
+        if b.brick >= bricks_total || prev.is_some_and(|p| p >= b.brick) {
+            return Err(invalid(
+                1,
+                format!("brick {i} (index {}) out of order or range", b.brick),
+            ));
+        }
+        prev = Some(b.brick);
+        let o = [b.brick % bx, (b.brick / bx) % by, b.brick / (bx * by)].map(|v| (v * 8) as u32);
+        for (c, &v) in b.cells.iter().enumerate() {
+            let p = [
+                o[0] + (c as u32 & 7),
+                o[1] + ((c as u32 >> 3) & 7),
+                o[2] + (c as u32 >> 6),
+            ];
+            match extent.index(p) {
+                Some(idx) => plane[idx] = v,
+                None if v != 0 => {
+                    return Err(invalid(
+                        1,
+                        format!("brick {i} has a non-zero cell outside the raster"),
+                    ));
+                }
+                None => {}
+            }
+        }
+    }
+    Ok(Raster {
+        plane,
+        directory,
+        records,
+        lists,
+    })
 }
 
 /// The materials section, each value in range.
@@ -1206,42 +1870,130 @@ fn lights_from(b: &[u8]) -> Result<Vec<WorldLight>, String> {
     Ok(lights)
 }
 
-fn read_records<R: Read + Seek>(
-    file: &mut R,
-    path: &Path,
-    h: &Header,
-    len: usize,
-    progress: &ProgressBar,
-) -> Result<Vec<VoxelRecord>, RasterFileError> {
-    let (crc, off, _) = h.sections[3];
-    let io = |source| RasterFileError::Io {
-        path: path.to_path_buf(),
-        what: "cannot read",
-        source,
-    };
-    file.seek(SeekFrom::Start(off)).map_err(io)?;
-    let n = len / RECORD_LEN as usize;
-    let mut records = Vec::with_capacity(n);
-    let mut hasher = crc32fast::Hasher::new();
-    let mut buf = vec![0u8; (1 << 15) * RECORD_LEN as usize];
-    let mut left = len;
-    while left > 0 {
-        let take = left.min(buf.len());
-        file.read_exact(&mut buf[..take]).map_err(io)?;
-        hasher.update(&buf[..take]);
-        records.extend(
-            buf[..take]
-                .chunks_exact(RECORD_LEN as usize)
-                .map(record_from),
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+    use crate::voxelize::{BuildOptions, build};
+
+    const SCENE: &str = "v\nfrom 0 -5 2\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0.1\nresolution 8 8\n\
+        b 0.1 0.2 0.3\nl 3 -4 6\nf 0.9 0.4 0.2 0.8 0.2 20 0 1\ns 0 0 0.7 0.7\ns 0.9 0.2 0.3 0.3\n\
+        c -1 0 0 0.3 -1 0 1 0.1\np 3\n-2 -2 0\n2 -2 0\n2 2 0\n";
+
+    fn built(opts: BuildOptions) -> VoxelScene {
+        let scene = Scene::parse("t.nff", SCENE.as_bytes()).unwrap();
+        build(
+            &scene,
+            &BuildOptions { threads: 2, ..opts },
+            &ProgressBar::hidden(),
+        )
+        .unwrap()
+        .0
+    }
+
+    fn same(a: &VoxelScene, b: &VoxelScene) {
+        assert_eq!(&a.plane[..], &b.plane[..]);
+        assert_eq!(a.lines, b.lines);
+        assert_eq!(a.directory, b.directory);
+        assert_eq!(a.records, b.records);
+        assert_eq!(a.lists, b.lists);
+        assert_eq!(a.objects, b.objects);
+        assert_eq!(a.frame, b.frame);
+        assert_eq!((a.exact, a.exact_records), (b.exact, b.exact_records));
+    }
+
+    /// Every format of an exact and a paper raster (of 40 voxels, and of
+    /// 70, more than one saving slab's margin): what loads is what was
+    /// saved, and saves again to the same bytes.
+    #[test]
+    fn every_format_loads_what_was_saved() {
+        let p = Path::new("t.rrt");
+        for opts in [
+            BuildOptions::new(40),
+            BuildOptions::paper(40),
+            BuildOptions::new(70),
+        ] {
+            let s = built(opts);
+            for format in [
+                Format::default(),
+                Format::Sparse { compress: false },
+                Format::Dense,
+            ] {
+                let bytes = save_bytes_as(&s, p, format).unwrap();
+                let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+                let expected = match (format, s.exact) {
+                    (Format::Dense, true) => 2,
+                    (Format::Dense, false) => 1,
+                    _ => 3,
+                };
+                assert_eq!(version, expected);
+                let back = load_bytes(p, &bytes).unwrap();
+                same(&s, &back);
+                assert_eq!(save_bytes_as(&back, p, format).unwrap(), bytes);
+            }
+        }
+    }
+
+    /// The compressed file of a built raster stores no plane brick and is
+    /// smaller than the dense one.
+    #[test]
+    fn a_built_raster_stores_no_plane_brick() {
+        let s = built(BuildOptions::new(64));
+        assert!(differing_bricks(&s).unwrap().is_empty());
+        let sparse = save_bytes(&s, Path::new("t.rrt")).unwrap();
+        let dense = save_bytes_as(&s, Path::new("t.rrt"), Format::Dense).unwrap();
+        assert!(
+            sparse.len() * 4 < dense.len(),
+            "{} {}",
+            sparse.len(),
+            dense.len()
         );
-        left -= take;
-        progress.inc(take as u64);
     }
-    if hasher.finalize() != crc {
-        return Err(RasterFileError::Checksum {
-            path: path.to_path_buf(),
-            section: "records",
-        });
+
+    /// A plane that is not the one made from the records (cells changed
+    /// in two bricks, one at the raster's edge) keeps its cells through
+    /// a version 3 file: those bricks are stored.
+    #[test]
+    fn changed_plane_cells_are_stored_as_bricks() {
+        let mut s = built(BuildOptions::new(37));
+        let e = s.extent();
+        let [nx, ny, nz] = e.dims();
+        let far = e.index([nx - 1, ny - 1, nz - 1]).unwrap();
+        let mid = e.index([nx / 3, ny / 2, nz / 2]).unwrap();
+        s.plane[far] ^= 0x04;
+        s.plane[mid] ^= 0x08;
+        let bricks = differing_bricks(&s).unwrap();
+        assert_eq!(bricks.len(), 2);
+        for format in [Format::default(), Format::Sparse { compress: false }] {
+            let bytes = save_bytes_as(&s, Path::new("t.rrt"), format).unwrap();
+            let back = load_bytes(Path::new("t.rrt"), &bytes).unwrap();
+            assert_eq!(&back.plane[..], &s.plane[..]);
+            assert_eq!(back.lines, line_level(e, &s.plane));
+        }
     }
-    Ok(records)
+
+    #[test]
+    fn transposed_entries_come_back() {
+        let fields = [4, 2, 1, 8, 1];
+        let raw: Vec<u8> = (0..16u32 * 37)
+            .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+            .collect();
+        let t = transposed(&raw, &fields);
+        let mut back = vec![0u8; raw.len()];
+        untransposed(&t, &fields, &mut back);
+        assert_eq!(back, raw);
+    }
+
+    /// A raster needing more memory than the limit is refused before its
+    /// plane is made.
+    #[test]
+    fn the_memory_limit_is_kept() {
+        let s = built(BuildOptions::new(40));
+        let bytes = save_bytes(&s, Path::new("t.rrt")).unwrap();
+        let e = load_bytes_within(Path::new("t.rrt"), &bytes, 1000)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.rrt: the raster needs"), "{e}");
+        assert!(e.contains("more than the limit of 1000 B"), "{e}");
+    }
 }

@@ -61,7 +61,9 @@ use rrt_core::voxelize::Separation;
 use rrt_core::voxelize::error::VoxelizeError;
 
 pub use self::materials::MAX_MATERIALS;
-pub use self::voxel_scene::{VoxelScene, WorldLight, WorldObject, finish_plane, line_level};
+pub use self::voxel_scene::{
+    DERIVE_MARGIN, VoxelScene, WorldLight, WorldObject, derive_plane, finish_plane, line_level,
+};
 
 use self::light::LightScene;
 use self::materials::MaterialTable;

@@ -10,8 +10,8 @@ use rayon::prelude::*;
 use rrt_core::light::ExactRecords;
 use rrt_core::proximity::field::{self, Area};
 use rrt_core::proximity::line_stand_ins;
-use rrt_core::raster::{Extent, LINE_CELLS, Raster, RasterMut, line_count};
-use rrt_core::store::{RecordStore, StoreError, write_rank_hints};
+use rrt_core::raster::{Extent, LINE_CELLS, Raster, RasterMut, cell, line_count};
+use rrt_core::store::{BRICK, RecordStore, StoreError, brick_dims, rank_hint, write_rank_hints};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
@@ -163,6 +163,77 @@ pub fn finish_plane(
         write_rank_hints(&mut raster, &store);
     }
     line_level(extent, plane)
+}
+
+/// Slices around a run of slices whose opaque voxels decide the run's
+/// finished cells: the distance field saturates at
+/// [`DISTANCE_LIMIT`](rrt_core::proximity::DISTANCE_LIMIT), so an opaque
+/// voxel this many slices away or more changes nothing (a multiple of the
+/// brick edge, so that the slices are whole brick layers).
+pub const DERIVE_MARGIN: u32 = 64;
+
+/// The finished plane ([`finish_plane`]) of the raster whose opaque voxels
+/// are exactly the records' (`directory`, `records` and `lists` a valid
+/// store over `extent`), computed for the slices `slices[0]..slices[1]`
+/// with [`DERIVE_MARGIN`] slices on either side (clipped to the raster):
+/// the cells of slices `z0..z1` of the raster in a plane of `nx·ny·(z1 −
+/// z0)` cells, with `z0` (a multiple of the brick edge). Its slices
+/// `slices[0]..slices[1]` are byte for byte the whole raster's finished
+/// cells; with `slices = [0, nz]` the plane is the whole raster's:
+/// distance field, PROXIMITY flags, OPAQUE cells with their records' rank
+/// hints ([`write_rank_hints`]). A saved raster's plane is made on load so
+/// (the builder's plane is exactly this for the records it made). On the
+/// current rayon pool.
+///
+/// # Errors
+/// The system's refusal of the plane's memory, or a store that breaks an
+/// invariant.
+pub fn derive_plane(
+    extent: Extent,
+    directory: &[u32],
+    records: &[VoxelRecord],
+    lists: &[u32],
+    slices: [u32; 2],
+) -> std::io::Result<(Plane, u32)> {
+    let store = RecordStore::with_lists(extent, directory, records, lists)
+        .map_err(std::io::Error::other)?;
+    let [nx, ny, nz] = extent.dims();
+    let z0 = slices[0].min(nz).saturating_sub(DERIVE_MARGIN) & !(BRICK - 1);
+    let z1 = slices[1].saturating_add(DERIVE_MARGIN).min(nz).max(z0 + 1);
+    let sub = Extent::new(nx, ny, z1 - z0).map_err(std::io::Error::other)?;
+    let mut plane = Plane::zeroed(sub.len())?;
+    // The records of the brick layers of slices z0..z1, in storage order,
+    // each with its index in the sub-plane and its rank hint.
+    let [bx, by, _] = brick_dims(extent).map(|b| b as usize);
+    let dir_at = |b: usize| directory.get(b).map_or(records.len(), |&d| d as usize);
+    let first_brick = (z0 / BRICK) as usize * bx * by;
+    let end_brick = (z1.div_ceil(BRICK) as usize * bx * by).min(directory.len().saturating_sub(1));
+    let (lo, hi) = (dir_at(first_brick), dir_at(end_brick));
+    let cells = || {
+        let mut brick = first_brick;
+        store
+            .iter_from(lo)
+            .take(hi.saturating_sub(lo))
+            .enumerate()
+            .filter_map(move |(k, (v, _))| {
+                let k = lo + k;
+                while dir_at(brick + 1) <= k {
+                    brick += 1;
+                }
+                let start = dir_at(brick);
+                let hint = rank_hint(k - start, dir_at(brick + 1) - start);
+                let i = sub.index([v[0], v[1], v[2].checked_sub(z0)?])?;
+                Some((i, hint))
+            })
+    };
+    for (i, _) in cells() {
+        plane[i] = cell::OPAQUE;
+    }
+    distance_field(sub, &mut plane);
+    for (i, hint) in cells() {
+        plane[i] = (plane[i] & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
+    }
+    Ok((plane, z0))
 }
 
 /// Boxes of fewer cells than this are relaxed on one thread.
