@@ -1289,7 +1289,7 @@ fn map(path: &Path) -> Result<Mapped, RasterFileError> {
     if len == 0 {
         return Ok(Mapped::Empty);
     }
-    // SAFETY: the map is read-only and private to this process; rrt
+    // SAFETY: the map is read-only (a shared mapping of the file); rrt
     // writes raster files to a temporary file renamed over the target
     // (so a file being replaced keeps its mapped inode). Another program
     // truncating the file in place while it is mapped would end the
