@@ -666,20 +666,52 @@ fn transposed(raw: &[u8], fields: &[usize]) -> Vec<u8> {
 /// The entries [`transposed`] made `t` from, into `raw` (as long).
 fn untransposed(t: &[u8], fields: &[usize], raw: &mut [u8]) {
     let len: usize = fields.iter().sum();
+    if len == 0 {
+        return;
+    }
     let m = t.len() / len;
+    let raw = &mut raw[..m * len];
     let mut at = 0;
     for &w in fields {
-        let mask = width_mask(w);
-        let mut prev = 0u64;
-        for (e, entry) in raw.chunks_exact_mut(len).enumerate().take(m) {
-            let d = (0..w).fold(0u64, |d, i| d | (u64::from(t[(at + i) * m + e]) << (8 * i)));
-            let v = prev.wrapping_add(d) & mask;
-            prev = v;
-            for (i, b) in entry[at..at + w].iter_mut().enumerate() {
-                *b = (v >> (8 * i)) as u8;
+        // The field's byte planes back into the entries: its differences.
+        for (i, plane) in t.chunks_exact(m.max(1)).skip(at).take(w).enumerate() {
+            for (entry, &b) in raw.chunks_exact_mut(len).zip(plane) {
+                entry[at + i] = b;
+            }
+        }
+        // The differences summed, modulo the field's width.
+        match w {
+            1 => running_sum::<1>(raw, len, at),
+            2 => running_sum::<2>(raw, len, at),
+            4 => running_sum::<4>(raw, len, at),
+            8 => running_sum::<8>(raw, len, at),
+            _ => {
+                let mask = width_mask(w);
+                let mut prev = 0u64;
+                for entry in raw.chunks_exact_mut(len) {
+                    let f = &mut entry[at..at + w];
+                    let v = prev.wrapping_add(le_value(f)) & mask;
+                    prev = v;
+                    f.copy_from_slice(&v.to_le_bytes()[..w]);
+                }
             }
         }
         at += w;
+    }
+}
+
+/// Replaces the `W`-byte field at `at` of each entry (`len` bytes) of
+/// `raw` by the running sum of the fields so far, modulo `2^(8W)`.
+fn running_sum<const W: usize>(raw: &mut [u8], len: usize, at: usize) {
+    let mask = width_mask(W);
+    let mut prev = 0u64;
+    for entry in raw.chunks_exact_mut(len) {
+        let f = &mut entry[at..at + W];
+        let mut b = [0u8; 8];
+        b[..W].copy_from_slice(f);
+        let v = prev.wrapping_add(u64::from_le_bytes(b)) & mask;
+        prev = v;
+        f.copy_from_slice(&v.to_le_bytes()[..W]);
     }
 }
 

@@ -327,12 +327,6 @@ impl Tracer<'_> {
         k: usize,
         stats: &mut RayStats,
     ) -> f64 {
-        let Some(ray) = self.light_segment(segment.origin, k) else {
-            return 0.0;
-        };
-        let Some(mut dray) = ray else {
-            return 1.0;
-        };
         let skip = (!self.meets_itself(h, n)).then_some(h.object);
         if self.opts.last_blocker
             && let Some(Some(id)) = stats.blockers.get(k).copied()
@@ -342,6 +336,12 @@ impl Tracer<'_> {
             stats.last_blocker += 1;
             return 0.0;
         }
+        let Some(ray) = self.light_segment(segment.origin, k) else {
+            return 0.0;
+        };
+        let Some(mut dray) = ray else {
+            return 1.0;
+        };
         let rule = self.leaving(h, n);
         let store = self.store;
         let extent = self.extent;

@@ -119,8 +119,9 @@ const NEIGHBOURS_BY_DISTANCE: [[i32; 3]; 26] = {
 /// changes the answer (the nearest candidate is kept apart).
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Mailbox {
-    ids: [u32; MAILBOX],
-    len: usize,
+    /// Each tested object's id plus one; 0 in a slot not used yet.
+    keys: [u64; MAILBOX],
+    /// The slot the next object takes.
     next: usize,
 }
 
@@ -130,15 +131,17 @@ pub const MAILBOX: usize = 16;
 impl Mailbox {
     /// Whether `id` was tested on this ray; if not, it is now recorded as
     /// tested (the oldest entry giving way when full).
+    #[inline]
     pub(super) fn tested(&mut self, id: u32) -> bool {
-        if self.ids.iter().take(self.len).any(|&x| x == id) {
+        // Every slot is compared (no early exit), so the scan vectorizes.
+        let key = u64::from(id) + 1;
+        if self.keys.iter().fold(false, |seen, &x| seen | (x == key)) {
             return true;
         }
-        if let Some(slot) = self.ids.get_mut(self.next) {
-            *slot = id;
+        if let Some(slot) = self.keys.get_mut(self.next) {
+            *slot = key;
         }
         self.next = (self.next + 1) % MAILBOX;
-        self.len = (self.len + 1).min(MAILBOX);
         false
     }
 }

@@ -195,7 +195,7 @@ pub fn derive_plane(
     lists: &[u32],
     slices: [u32; 2],
 ) -> std::io::Result<(Plane, u32)> {
-    let store = RecordStore::with_lists(extent, directory, records, lists)
+    RecordStore::with_lists(extent, directory, records, lists)
         .map_err(std::io::Error::other)?;
     let [nx, ny, nz] = extent.dims();
     let z0 = slices[0].min(nz).saturating_sub(DERIVE_MARGIN) & !(BRICK - 1);
@@ -208,23 +208,26 @@ pub fn derive_plane(
     let dir_at = |b: usize| directory.get(b).map_or(records.len(), |&d| d as usize);
     let first_brick = (z0 / BRICK) as usize * bx * by;
     let end_brick = (z1.div_ceil(BRICK) as usize * bx * by).min(directory.len().saturating_sub(1));
-    let (lo, hi) = (dir_at(first_brick), dir_at(end_brick));
+    // Every brick's records (positions checked by the store against the
+    // extent), each at its index in the sub-plane, with its rank hint.
     let cells = || {
-        let mut brick = first_brick;
-        store
-            .iter_from(lo)
-            .take(hi.saturating_sub(lo))
-            .enumerate()
-            .filter_map(move |(k, (v, _))| {
-                let k = lo + k;
-                while dir_at(brick + 1) <= k {
-                    brick += 1;
-                }
-                let start = dir_at(brick);
-                let hint = rank_hint(k - start, dir_at(brick + 1) - start);
-                let i = sub.index([v[0], v[1], v[2].checked_sub(z0)?])?;
-                Some((i, hint))
-            })
+        (first_brick..end_brick).flat_map(move |b| {
+            let (lo, hi) = (dir_at(b), dir_at(b + 1));
+            let origin = [b % bx, (b / bx) % by, b / (bx * by)].map(|c| c as u32 * BRICK);
+            let len = hi.saturating_sub(lo);
+            records
+                .get(lo..hi)
+                .unwrap_or(&[])
+                .iter()
+                .enumerate()
+                .filter_map(move |(j, r)| {
+                    let p = u32::from(r.position());
+                    let v = [p & 7, (p >> 3) & 7, p >> 6];
+                    let v = [0, 1, 2].map(|a| origin[a] + v[a]);
+                    let i = sub.index([v[0], v[1], v[2].checked_sub(z0)?])?;
+                    Some((i, rank_hint(j, len)))
+                })
+        })
     };
     for (i, _) in cells() {
         plane[i] = cell::OPAQUE;
