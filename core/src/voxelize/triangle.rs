@@ -493,7 +493,7 @@ impl Tri {
         sink: &mut S,
         n: &mut Counter,
     ) -> Result<(), VoxelizeError> {
-        self.scan_with(sep, extent, sink, n, &|t: &Self, v| t.surfel(v))
+        self.scan_surfels(sep, extent, sink, n, &|t: &Self, v| t.surfel(v), true)
     }
 
     /// [`Tri::scan`] with the surfel of each voxel computed by `surfel`
@@ -505,6 +505,25 @@ impl Tri {
         sink: &mut S,
         n: &mut Counter,
         surfel: &F,
+    ) -> Result<(), VoxelizeError>
+    where
+        S: VoxelSink + ?Sized,
+        F: Fn(&Self, [u32; 3]) -> Surfel,
+    {
+        self.scan_surfels(sep, extent, sink, n, surfel, false)
+    }
+
+    /// [`Tri::scan_with`]; `plain` says that `surfel` is [`Tri::surfel`],
+    /// which a flat triangle across its columns' axis gives without
+    /// barycentrics in the columns inside its outline ([`Tri::plane_surfel`]).
+    fn scan_surfels<S, F>(
+        &self,
+        sep: Separation,
+        extent: Extent,
+        sink: &mut S,
+        n: &mut Counter,
+        surfel: &F,
+        plain: bool,
     ) -> Result<(), VoxelizeError>
     where
         S: VoxelSink + ?Sized,
@@ -564,6 +583,14 @@ impl Tri {
         let Some((b0, b1)) = clip(b_lo, b_hi, nb) else {
             return Ok(());
         };
+        let inner = Outline::new(self, k);
+        // A voxel of a column inside the outline of a triangle across the
+        // columns' axis projects onto the plane inside the triangle.
+        let across = {
+            let (x, y, _) = pick(k, self.n);
+            x == 0 && y == 0
+        };
+        let plane_surfels = plain && across && self.normals.is_none();
         for bi in b0..=b1 {
             let cb = centre(bi);
             let (mut a_lo, mut a_hi) = (i128::MIN, i128::MAX);
@@ -577,52 +604,119 @@ impl Tri {
             let Some((a0, a1)) = clip(a_lo, a_hi, na) else {
                 continue;
             };
-            // Per column axis: floor((hi − q − α_k·H) / (α_k·V)) and
-            // floor((q + α_k·H − lo) / (α_k·V)) (= −ceil of the low bound),
-            // with q = α_a·c_a + α_b·c_b stepping by α_a·V per column.
-            let mut his = [None::<IncDiv>; 32];
-            let mut los = [None::<IncDiv>; 32];
-            let ca0 = centre(a0);
-            for ((ax, hi), lo) in cols.iter().zip(his.iter_mut()).zip(los.iter_mut()) {
-                let [pa, pb, pk] = ax.alpha;
-                let q = pa
-                    .checked_mul(ca0)
-                    .and_then(|x| x.checked_add(pb.checked_mul(cb)?));
-                let d = pk.checked_mul(V);
-                let kh = pk.checked_mul(H);
-                let dq = pa.checked_mul(V);
-                let (Some(q), Some(d), Some(kh), Some(dq)) = (q, d, kh, dq) else {
-                    return Err(VoxelizeError::Arithmetic);
-                };
-                let nhi = ax.hi.checked_sub(q).and_then(|x| x.checked_sub(kh));
-                let nlo = q.checked_add(kh).and_then(|x| x.checked_sub(ax.lo));
-                let (Some(nhi), Some(nlo), Some(ndq)) = (nhi, nlo, dq.checked_neg()) else {
-                    return Err(VoxelizeError::Arithmetic);
-                };
-                *hi = Some(IncDiv::new(nhi, ndq, d).ok_or(VoxelizeError::Arithmetic)?);
-                *lo = Some(IncDiv::new(nlo, dq, d).ok_or(VoxelizeError::Arithmetic)?);
-            }
-            for ai in a0..=a1 {
-                let (mut k_lo, mut k_hi) = (i128::MIN, i128::MAX);
-                for (hi, lo) in his.iter_mut().zip(los.iter_mut()).take(nc) {
-                    if let (Some(hi), Some(lo)) = (hi.as_mut(), lo.as_mut()) {
-                        k_hi = k_hi.min(hi.q);
-                        k_lo = k_lo.max(lo.q.saturating_neg());
-                        hi.step();
-                        lo.step();
-                    }
-                }
-                let Some((k0, k1)) = clip(k_lo, k_hi, nk) else {
+            // The columns whose footprint lies strictly inside the
+            // triangle's outline need the plane's axis only; the others
+            // all axes.
+            let (i0, i1) = inner
+                .as_ref()
+                .and_then(|o| o.columns(cb))
+                .map_or((1, 0), |(l, h)| {
+                    (l.max(i128::from(a0)), h.min(i128::from(a1)))
+                });
+            let whole = (i128::from(a0), i128::from(a1));
+            let runs = if i0 > i1 {
+                [(whole, cols), ((1, 0), cols), ((1, 0), cols)]
+            } else {
+                [
+                    ((whole.0, i0 - 1), cols),
+                    ((i0, i1), cols.get(..1).unwrap_or(cols)),
+                    ((i1 + 1, whole.1), cols),
+                ]
+            };
+            for (run, ((lo, hi), axes)) in runs.into_iter().enumerate() {
+                let (Ok(lo), Ok(hi)) = (u32::try_from(lo), u32::try_from(hi)) else {
                     continue;
                 };
-                for ki in k0..=k1 {
-                    let v = place(k, ai, bi, ki);
-                    sink.offer(v, if reads { surfel(self, v) } else { Surfel::NONE });
-                    n.bump();
+                if lo > hi {
+                    continue;
                 }
+                let plane = plane_surfels && run == 1;
+                self.columns(k, (lo, hi), bi, axes, nk, &mut |v| {
+                    let s = match (reads, plane) {
+                        (false, _) => Surfel::NONE,
+                        (true, true) => self.plane_surfel(v),
+                        (true, false) => surfel(self, v),
+                    };
+                    sink.offer(v, s);
+                    n.bump();
+                })?;
             }
         }
         Ok(())
+    }
+
+    /// Offers the cells of columns `a0 ..= a1` of row `bi` (along `k`, up
+    /// to `nk`) that satisfy every axis of `axes`: per axis,
+    /// floor((hi − q − α_k·H) / (α_k·V)) and floor((q + α_k·H − lo) /
+    /// (α_k·V)) (= −ceil of the low bound), with q = α_a·c_a + α_b·c_b
+    /// stepping by α_a·V per column.
+    fn columns(
+        &self,
+        k: usize,
+        (a0, a1): (u32, u32),
+        bi: u32,
+        axes: &[Axis],
+        nk: (u32, u32),
+        offer: &mut impl FnMut([u32; 3]),
+    ) -> Result<(), VoxelizeError> {
+        let cb = centre(bi);
+        let mut his = [None::<IncDiv>; 32];
+        let mut los = [None::<IncDiv>; 32];
+        let ca0 = centre(a0);
+        for ((ax, hi), lo) in axes.iter().zip(his.iter_mut()).zip(los.iter_mut()) {
+            let [pa, pb, pk] = ax.alpha;
+            let q = pa
+                .checked_mul(ca0)
+                .and_then(|x| x.checked_add(pb.checked_mul(cb)?));
+            let d = pk.checked_mul(V);
+            let kh = pk.checked_mul(H);
+            let dq = pa.checked_mul(V);
+            let (Some(q), Some(d), Some(kh), Some(dq)) = (q, d, kh, dq) else {
+                return Err(VoxelizeError::Arithmetic);
+            };
+            let nhi = ax.hi.checked_sub(q).and_then(|x| x.checked_sub(kh));
+            let nlo = q.checked_add(kh).and_then(|x| x.checked_sub(ax.lo));
+            let (Some(nhi), Some(nlo), Some(ndq)) = (nhi, nlo, dq.checked_neg()) else {
+                return Err(VoxelizeError::Arithmetic);
+            };
+            *hi = Some(IncDiv::new(nhi, ndq, d).ok_or(VoxelizeError::Arithmetic)?);
+            *lo = Some(IncDiv::new(nlo, dq, d).ok_or(VoxelizeError::Arithmetic)?);
+        }
+        let m = axes.len();
+        for ai in a0..=a1 {
+            let (mut k_lo, mut k_hi) = (i128::MIN, i128::MAX);
+            for (hi, lo) in his.iter_mut().zip(los.iter_mut()).take(m) {
+                if let (Some(hi), Some(lo)) = (hi.as_mut(), lo.as_mut()) {
+                    k_hi = k_hi.min(hi.q);
+                    k_lo = k_lo.max(lo.q.saturating_neg());
+                    hi.step();
+                    lo.step();
+                }
+            }
+            let Some((k0, k1)) = clip(k_lo, k_hi, nk) else {
+                continue;
+            };
+            for ki in k0..=k1 {
+                offer(place(k, ai, bi, ki));
+            }
+        }
+        Ok(())
+    }
+
+    /// The surfel of voxel `v` whose centre projects onto the plane inside
+    /// the triangle, for a triangle without vertex normals: what
+    /// [`Tri::surfel`] gives there.
+    fn plane_surfel(&self, v: [u32; 3]) -> Surfel {
+        Surfel {
+            normal: self.unit,
+            distance: dist_u32(self.plane_distance(v.map(centre))),
+        }
+    }
+
+    /// The distance of point `c` from the plane along the unit normal.
+    fn plane_distance(&self, c: [i128; 3]) -> i128 {
+        let u = self.unit.map(i128::from);
+        dot(u, sub(c, self.v[0])) >> 30
     }
 
     /// Nearest point data for voxel `v`: distance and normal.
@@ -631,12 +725,10 @@ impl Tri {
         let a = self.barycentric(c);
         if a.iter().all(|x| *x >= 0) {
             // Inside: the plane distance along the unit normal.
-            let u = self.unit.map(i128::from);
-            let d = dot(u, sub(c, self.v[0])) >> 30;
             let normal = self.interpolate(a).unwrap_or(self.unit);
             return Surfel {
                 normal,
-                distance: dist_u32(d),
+                distance: dist_u32(self.plane_distance(c)),
             };
         }
         // Outside: nearest point on an edge opposite a negative weight.
@@ -707,6 +799,72 @@ impl Tri {
     }
 }
 
+/// The triangle's outline seen along the column axis: per edge `e`, the
+/// components `(α_a, α_b)` of the axis `e × k̂` and the triangle's extent
+/// `[tmin, tmax]` along it. A column whose footprint (the square of side
+/// `V` about its centre in `(a, b)`) lies strictly inside the outline
+/// holds the triangle's cells exactly where the probe meets the plane:
+/// the probe meets the plane only above its footprint, so at points inside
+/// the triangle, and every other separating axis holds there with room to
+/// spare (no tie), or is parallel to the normal and says what it says.
+struct Outline {
+    edges: [(i128, i128, i128, i128); 3],
+}
+
+impl Outline {
+    /// `None` where the arithmetic would not fit (no column is then
+    /// taken as inside).
+    fn new(t: &Tri, k: usize) -> Option<Self> {
+        let kk = place(k, 0, 0, 1);
+        let mut edges = [(0, 0, 0, 0); 3];
+        for (slot, e) in edges.iter_mut().zip(&t.e) {
+            let alpha = checked_cross(*e, kk)?;
+            let mut p = [0i128; 3];
+            for (pi, v) in p.iter_mut().zip(&t.v) {
+                *pi = checked_dot(alpha, *v)?;
+            }
+            let (pa, pb, _) = pick(k, alpha);
+            *slot = (pa, pb, p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        }
+        Some(Self { edges })
+    }
+
+    /// The columns `lo ..= hi` of the row with centre coordinate `cb`
+    /// whose footprint lies strictly inside the outline; `None` when there
+    /// are none (or the arithmetic would not fit).
+    fn columns(&self, cb: i128) -> Option<(i128, i128)> {
+        let (mut lo, mut hi) = (i128::MIN, i128::MAX);
+        for &(pa, pb, tmin, tmax) in &self.edges {
+            // The footprint's reach along the axis.
+            let r = i128::try_from(pa.unsigned_abs().checked_add(pb.unsigned_abs())?)
+                .ok()?
+                .checked_mul(H)?;
+            let q = pb.checked_mul(cb)?;
+            // tmin < α_a·c_a + q − r and α_a·c_a + q + r < tmax.
+            let l = tmin.checked_add(r)?.checked_sub(q)?;
+            let h = tmax.checked_sub(r)?.checked_sub(q)?;
+            if pa == 0 {
+                if l < 0 && 0 < h {
+                    continue;
+                }
+                return None;
+            }
+            let (p, l, h) = if pa > 0 {
+                (pa, l, h)
+            } else {
+                (pa.checked_neg()?, h.checked_neg()?, l.checked_neg()?)
+            };
+            // l < p·(iV + H) < h.
+            let (d, ph) = (p.checked_mul(V)?, p.checked_mul(H)?);
+            let i_lo = floor_div(l.checked_sub(ph)?, d)?.checked_add(1)?;
+            let i_hi = ceil_div(h.checked_sub(ph)?, d)?.checked_sub(1)?;
+            lo = lo.max(i_lo);
+            hi = hi.min(i_hi);
+        }
+        (lo <= hi).then_some((lo, hi))
+    }
+}
+
 /// Cell range `i` with centre `c = iV + H` satisfying `lo ≤ p·c + q ≤ hi`
 /// (`p > 0`).
 fn centre_range(p: i128, q: i128, lo: i128, hi: i128) -> Option<(i128, i128)> {
@@ -759,6 +917,11 @@ mod tests {
                 r.unwrap();
                 let inside = |v| contains(&t, sep, v).unwrap();
                 assert_offers_are(&c, e, inside, &format!("case {case} {sep:?} {t:?}"));
+                // The columns inside the outline give Tri::surfel's surfels.
+                let tri = Tri::new(&t).unwrap();
+                for (v, (s, _)) in &c.0 {
+                    assert_eq!(*s, tri.surfel(*v), "case {case} {sep:?} {v:?}");
+                }
             }
         }
     }

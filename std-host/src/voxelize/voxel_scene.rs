@@ -195,8 +195,7 @@ pub fn derive_plane(
     lists: &[u32],
     slices: [u32; 2],
 ) -> std::io::Result<(Plane, u32)> {
-    RecordStore::with_lists(extent, directory, records, lists)
-        .map_err(std::io::Error::other)?;
+    RecordStore::with_lists(extent, directory, records, lists).map_err(std::io::Error::other)?;
     let [nx, ny, nz] = extent.dims();
     let z0 = slices[0].min(nz).saturating_sub(DERIVE_MARGIN) & !(BRICK - 1);
     let z1 = slices[1].saturating_add(DERIVE_MARGIN).min(nz).max(z0 + 1);
