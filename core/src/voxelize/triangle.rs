@@ -59,7 +59,11 @@
 //! of the normal; each axis with no component along the column bounds the
 //! rows and the columns of a row, each other axis bounds the cells of a
 //! column. Every bound is an exact floor/ceil division, stepped along a row
-//! by an incremental quotient and remainder, without dividing again.
+//! by an incremental quotient and remainder, without dividing again. The
+//! columns whose footprint lies strictly inside the triangle's outline
+//! (most of a large triangle's) are bounded by the plane's axis alone: the
+//! probe meets the plane there only at points inside the triangle, where
+//! every other axis holds with room to spare.
 //!
 //! # Accepted input and cost
 //! Coordinates within [`COORD_LIMIT`](super::error::COORD_LIMIT).
