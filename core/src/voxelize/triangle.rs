@@ -622,9 +622,9 @@ impl Tri {
                 [(whole, cols), ((1, 0), cols), ((1, 0), cols)]
             } else {
                 [
-                    ((whole.0, i0 - 1), cols),
+                    ((whole.0, i0.saturating_sub(1)), cols),
                     ((i0, i1), cols.get(..1).unwrap_or(cols)),
-                    ((i1 + 1, whole.1), cols),
+                    ((i1.saturating_add(1), whole.1), cols),
                 ]
             };
             for (run, ((lo, hi), axes)) in runs.into_iter().enumerate() {
