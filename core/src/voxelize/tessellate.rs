@@ -134,7 +134,7 @@ impl<'a, S: VoxelSink + ?Sized> Emitter<'a, S> {
             return Ok(());
         }
         match Tri::from_points(p, normals) {
-            Ok(t) => t.scan_with(self.sep, self.extent, self.sink, &mut self.n, surfel),
+            Ok(t) => t.scan_with(self.sep, self.extent, self.sink, &mut self.n, surfel, false),
             Err(VoxelizeError::Degenerate) => Ok(()),
             Err(e) => Err(e),
         }

@@ -497,30 +497,15 @@ impl Tri {
         sink: &mut S,
         n: &mut Counter,
     ) -> Result<(), VoxelizeError> {
-        self.scan_surfels(sep, extent, sink, n, &|t: &Self, v| t.surfel(v), true)
+        self.scan_with(sep, extent, sink, n, &|t: &Self, v| t.surfel(v), true)
     }
 
     /// [`Tri::scan`] with the surfel of each voxel computed by `surfel`
     /// (surfaces tessellated into triangles use their own exact normals).
+    /// `plain` says that `surfel` is [`Tri::surfel`], which a flat
+    /// triangle across its columns' axis gives without barycentrics in the
+    /// columns inside its outline ([`Tri::plane_surfel`]).
     pub(crate) fn scan_with<S, F>(
-        &self,
-        sep: Separation,
-        extent: Extent,
-        sink: &mut S,
-        n: &mut Counter,
-        surfel: &F,
-    ) -> Result<(), VoxelizeError>
-    where
-        S: VoxelSink + ?Sized,
-        F: Fn(&Self, [u32; 3]) -> Surfel,
-    {
-        self.scan_surfels(sep, extent, sink, n, surfel, false)
-    }
-
-    /// [`Tri::scan_with`]; `plain` says that `surfel` is [`Tri::surfel`],
-    /// which a flat triangle across its columns' axis gives without
-    /// barycentrics in the columns inside its outline ([`Tri::plane_surfel`]).
-    fn scan_surfels<S, F>(
         &self,
         sep: Separation,
         extent: Extent,
