@@ -40,10 +40,8 @@ use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
 
 use super::BuildError;
 use super::pass::Pass;
-use super::volume::VolumeColors;
-use crate::assets::volume::{
-    Classifier, DimsFmt, PlacedVolume, SampleType, VolumeError, sample_count,
-};
+use super::volume::{VolumeColors, sample_grid};
+use crate::assets::volume::{Classifier, PlacedVolume, SampleType, VolumeError};
 use crate::frame::RasterFrame;
 use crate::scene::{SceneVolume, VolumeObject};
 
@@ -111,23 +109,8 @@ impl DirectVolume {
         let Some((first, dims)) = placed.raster_box(frame) else {
             return Ok(None);
         };
-        let voxels = sample_count(dims);
-        let bytes = voxels.saturating_mul(4);
-        if bytes > max_bytes {
-            return Err(VolumeError::TooLarge {
-                path: "direct volume samples".into(),
-                at: String::new(),
-                dims: DimsFmt(dims),
-                ty: SampleType::F32,
-                bytes,
-                limit: max_bytes,
-            });
-        }
-        let count = usize::try_from(voxels).map_err(|_| VolumeError::Invalid {
-            what: "direct volume samples".into(),
-            msg: "too many voxels for this machine".into(),
-        })?;
-        let mut values = vec![0f32; count];
+        let mut values =
+            sample_grid::<f32>(dims, SampleType::F32, "direct volume samples", max_bytes)?;
         let row = dims[0].max(1) as usize;
         let layer = row * dims[1].max(1) as usize;
         values

@@ -44,6 +44,34 @@ use crate::assets::volume::{
 use crate::frame::RasterFrame;
 use crate::scene::VolumeObject;
 
+/// A zeroed grid of `dims` samples of type `T` (`ty` names it), checked
+/// against `max_bytes` before allocating; `what` names the grid in errors.
+pub(super) fn sample_grid<T: Clone + Default>(
+    dims: [u32; 3],
+    ty: SampleType,
+    what: &str,
+    max_bytes: u64,
+) -> Result<Vec<T>, VolumeError> {
+    let voxels = sample_count(dims);
+    let size = u64::try_from(std::mem::size_of::<T>()).unwrap_or(u64::MAX);
+    let bytes = voxels.saturating_mul(size);
+    if bytes > max_bytes {
+        return Err(VolumeError::TooLarge {
+            path: what.into(),
+            at: String::new(),
+            dims: DimsFmt(dims),
+            ty,
+            bytes,
+            limit: max_bytes,
+        });
+    }
+    let count = usize::try_from(voxels).map_err(|_| VolumeError::Invalid {
+        what: what.into(),
+        msg: "too many voxels for this machine".into(),
+    })?;
+    Ok(vec![T::default(); count])
+}
+
 /// A predicate on raster voxels: which to keep (see
 /// [`PlacedVolume::voxelize_where`]).
 pub type Keep<'k> = &'k (dyn Fn([u32; 3]) -> bool + Sync);
@@ -324,25 +352,9 @@ impl PlacedVolume<'_> {
         max_bytes: u64,
     ) -> Result<RasterBlock, VolumeError> {
         classifier.validate()?;
-        let voxels = sample_count(n);
-        let bytes = voxels.saturating_mul(2);
-        if bytes > max_bytes {
-            return Err(VolumeError::TooLarge {
-                path: "raster block".into(),
-                at: String::new(),
-                dims: DimsFmt(n),
-                ty: SampleType::U16,
-                bytes,
-                limit: max_bytes,
-            });
-        }
-        let count = usize::try_from(voxels).map_err(|_| VolumeError::Invalid {
-            what: "raster block".into(),
-            msg: "too many voxels for this machine".into(),
-        })?;
+        let mut samples = sample_grid::<u16>(n, SampleType::U16, "raster block", max_bytes)?;
         let quant = Quantizer::for_volume(self.volume());
         let threshold = quant.quantize(classifier.iso).max(1);
-        let mut samples = vec![0u16; count];
         let layer = usize::try_from(u64::from(n[0]) * u64::from(n[1])).unwrap_or(usize::MAX);
         samples
             .par_chunks_mut(layer.max(1))
