@@ -459,10 +459,14 @@ fn shadow_ray<const N: usize>(
         if c & cell::OPAQUE == 0 {
             return false;
         }
-        let Some(b) = view.get(index) else {
+        let Some(vb) = extent.coord(index) else {
             return true;
         };
-        if rule.ignores(view, index, b) {
+        // The cell's rank hint narrows the lookup; the record is the same.
+        let Some(b) = view.get_hinted(vb, c) else {
+            return true;
+        };
+        if Some(index) == rule.start || rule.ignores_voxel(view, vb, b) {
             return false;
         }
         if materials
