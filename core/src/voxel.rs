@@ -333,7 +333,17 @@ pub fn encode_normal(n: [i32; 3]) -> [i16; 2] {
     let (p, den) = project(n);
     let one = i128::from(SNORM16_ONE);
     // Floor of p·32767/den per axis; |p| <= den so the result is in ±32767.
-    let fl = p.map(|pi| pi.saturating_mul(one).div_euclid(den.max(1)));
+    // For i32 inputs both sides fit in 64 bits (|p|·32767 < 2^49): the
+    // 64-bit division gives the same floor.
+    let den = den.max(1);
+    let fl = p.map(|pi| {
+        let num = pi.saturating_mul(one);
+        match (i64::try_from(num), i64::try_from(den)) {
+            (Ok(a), Ok(b)) => a.checked_div_euclid(b).map_or(0, i128::from),
+            _ => num.div_euclid(den),
+        }
+    });
+    let n = to_31_bits(n);
     let mut best = [0i16; 2];
     let mut best_score: Option<(u128, u128)> = None;
     for du in 0..2i128 {
@@ -347,7 +357,9 @@ pub fn encode_normal(n: [i32; 3]) -> [i16; 2] {
             let better = match (score, best_score) {
                 (Some(_), None) => true,
                 // a = (dot², |d|²): compare dot_a²/|d_a|² > dot_b²/|d_b|².
-                (Some((na, da)), Some((nb, db))) => na.saturating_mul(db) > nb.saturating_mul(da),
+                // dot² < 2^96 and |d|² < 2^31 (cos2_score): the products
+                // stay below 2^127 and never wrap.
+                (Some((na, da)), Some((nb, db))) => na.wrapping_mul(db) > nb.wrapping_mul(da),
                 (None, _) => false,
             };
             if better {
@@ -365,12 +377,16 @@ fn clamp_snorm(v: i128) -> i16 {
     i16::try_from(c).unwrap_or(0)
 }
 
-/// `(dot², |d|²)` for `dot = n·d > 0`, else `None`. Squares are taken after
-/// scaling `n` down to 31 bits so that `dot² · |d|²` fits in u128.
-fn cos2_score(n: [i64; 3], d: [i64; 3]) -> Option<(u128, u128)> {
+/// `n` scaled down (arithmetic shift) so that every `|n_i| < 2^31`.
+fn to_31_bits(n: [i64; 3]) -> [i64; 3] {
     let m = n.iter().map(|v| v.unsigned_abs()).max().unwrap_or(0);
     let shift = (64u32.saturating_sub(m.leading_zeros())).saturating_sub(31);
-    let n = n.map(|v| v >> shift);
+    n.map(|v| v >> shift)
+}
+
+/// `(dot², |d|²)` for `dot = n·d > 0`, else `None`, for `n` scaled by
+/// [`to_31_bits`], so that `dot² · |d|²` fits in u128.
+fn cos2_score(n: [i64; 3], d: [i64; 3]) -> Option<(u128, u128)> {
     // |n_i| < 2^31, |d_i| <= 2^15: each product < 2^46, the sum < 2^48.
     let dot: i64 = n
         .iter()
@@ -385,9 +401,10 @@ fn cos2_score(n: [i64; 3], d: [i64; 3]) -> Option<(u128, u128)> {
         .iter()
         .map(|v| v.unsigned_abs().saturating_mul(v.unsigned_abs()))
         .fold(0u64, u64::saturating_add);
-    // dot² < 2^96, |d|² < 2^32: products compared stay below 2^128.
+    // dot < 2^48: dot² < 2^96 (one 64 × 64-bit product); |d|² ≤ 32767² <
+    // 2^31: products compared stay below 2^127.
     Some((
-        u128::from(dot).saturating_mul(u128::from(dot)),
+        u128::from(dot).wrapping_mul(u128::from(dot)),
         u128::from(d2),
     ))
 }

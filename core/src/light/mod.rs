@@ -455,24 +455,10 @@ fn shadow_ray<const N: usize>(
         slab: params.slab,
         same_surface_cos: params.same_surface_cos,
     };
+    // Transparent voxels, most of a walk, are decided here; an opaque one
+    // out of line, so that the stepper's loop stays small.
     let mut test = |index: usize, c: u8| -> bool {
-        if c & cell::OPAQUE == 0 {
-            return false;
-        }
-        let Some(b) = view.get(index) else {
-            return true;
-        };
-        if rule.ignores(view, index, b) {
-            return false;
-        }
-        if materials
-            .get(b.material)
-            .is_some_and(|m| m.transmission > 0)
-        {
-            translucent = true;
-            return false;
-        }
-        true
+        c & cell::OPAQUE != 0 && blocks(view, materials, &rule, index, c, &mut translucent)
     };
     let outcome = to_light(extent, c0, light, |ray| {
         walk_piece(raster, params.mode, ray, &mut test)
@@ -482,6 +468,39 @@ fn shadow_ray<const N: usize>(
         (Piece::Clear, true) => LightVisibility::Translucent,
         (Piece::Clear, false) => LightVisibility::Visible,
     })
+}
+
+/// Whether the opaque voxel at `index` (cell `c`) blocks a shadow ray
+/// leaving a surface by `rule`: not when it is part of that surface, nor
+/// when its material transmits light (then `translucent` is set). A voxel
+/// without a record blocks.
+#[inline(never)]
+fn blocks<const N: usize>(
+    view: &RecordStore<'_>,
+    materials: &Materials<N>,
+    rule: &LeavingSurface,
+    index: usize,
+    c: u8,
+    translucent: &mut bool,
+) -> bool {
+    let Some(vb) = view.extent().coord(index) else {
+        return true;
+    };
+    // The cell's rank hint narrows the lookup; the record is the same.
+    let Some(b) = view.get_hinted(vb, c) else {
+        return true;
+    };
+    if Some(index) == rule.start || rule.ignores_voxel(view, vb, b) {
+        return false;
+    }
+    if materials
+        .get(b.material)
+        .is_some_and(|m| m.transmission > 0)
+    {
+        *translucent = true;
+        return false;
+    }
+    true
 }
 
 /// The shadow classification of voxel `v` (centre `c0`, objects `own`)

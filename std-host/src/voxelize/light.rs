@@ -92,7 +92,9 @@ impl LightScene {
             // The storage holds exactly these objects: no push fails.
             let _ = table.push(*o);
         }
-        let mut out = store.records().to_vec();
+        // Copied on the pool's threads, as the copy is as large as the store.
+        let mut out: Vec<VoxelRecord> =
+            pool.install(|| store.records().par_iter().copied().collect());
         let reports: Vec<Result<LightReport, LightError>> = pool.install(|| {
             out.par_chunks_mut(LIGHT_RUN)
                 .enumerate()

@@ -23,6 +23,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use indicatif::ProgressBar;
 use rayon::ThreadPool;
+use rayon::prelude::*;
 use rrt_core::raster::{Extent, RasterMut};
 use rrt_core::store::{BRICK, Counter, Limits, Sizing, brick_count, directory_len, shift_lists};
 use rrt_core::voxel::VoxelRecord;
@@ -247,7 +248,14 @@ impl Passes<'_> {
         })?;
         let offers = sizings.iter().map(|(_, o)| *o).sum();
 
-        let mut records = vec![VoxelRecord::default(); records_n];
+        // Written (and its pages first touched) on the pool's threads: the
+        // records are the build's largest allocation.
+        let mut records: Vec<VoxelRecord> = pool.install(|| {
+            (0..records_n)
+                .into_par_iter()
+                .map(|_| VoxelRecord::default())
+                .collect()
+        });
         let mut lists = vec![0u32; list_n];
         let record_counts: Vec<usize> = sizings.iter().map(|(s, _)| s.records()).collect();
         let mut jobs = Vec::with_capacity(sizings.len());
