@@ -85,7 +85,12 @@ pub fn run_packet_case(case: &PacketCase) {
     };
     let mut plane = if case.field & 2 != 0 {
         (0..extent.len())
-            .map(|i| case.cells.get(i % case.cells.len().max(1)).copied().unwrap_or(0))
+            .map(|i| {
+                case.cells
+                    .get(i % case.cells.len().max(1))
+                    .copied()
+                    .unwrap_or(0)
+            })
             .collect()
     } else {
         repeated_cells(&case.cells, extent.len())

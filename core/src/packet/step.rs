@@ -181,7 +181,11 @@ fn jump_lanes<const MODE: u8>(
         put(&mut n1, lane, j.f1.wrapping_add(thr_b));
         put(&mut n2, lane, j.f2.wrapping_add(thr_c));
         if MODE != TWENTY_SIX {
-            put(&mut n3, lane, rules::e3_after(at(&e3, lane), j.nb, j.nc, p.inc));
+            put(
+                &mut n3,
+                lane,
+                rules::e3_after(at(&e3, lane), j.nb, j.nc, p.inc),
+            );
         }
         put(&mut na, lane, at(&ra, lane).wrapping_sub(i64::from(k)));
         put(&mut nb, lane, at(&rb, lane).wrapping_sub(j.nb));

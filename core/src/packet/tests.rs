@@ -236,7 +236,13 @@ fn small_random_packets_match_their_scalar_rays() {
 /// no longer exact: lanes must still equal their scalar skipping walks.
 fn skipping_plane(e: Extent, rng: &mut Rng, per_mille: u64, disturb: bool) -> (Vec<u8>, Vec<u8>) {
     let mut plane: Vec<u8> = (0..e.len())
-        .map(|_| if rng.below(1000) < per_mille { cell::OPAQUE } else { 0 })
+        .map(|_| {
+            if rng.below(1000) < per_mille {
+                cell::OPAQUE
+            } else {
+                0
+            }
+        })
         .collect();
     distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
     let mut lines = vec![0u8; line_count(plane.len())];
@@ -262,7 +268,8 @@ fn skipping_packets_match_their_scalar_skipping_walks() {
         let plain = Raster::new(e, &plane).unwrap();
         let with_lines = plain.with_lines(&lines).unwrap();
         // A camera-like block: one origin, nearby directions.
-        let eye = [0, 1, 2].map(|k| rng.range(-i64::from(dims[k]) * VOXEL, 2 * i64::from(dims[k]) * VOXEL));
+        let eye = [0, 1, 2]
+            .map(|k| rng.range(-i64::from(dims[k]) * VOXEL, 2 * i64::from(dims[k]) * VOXEL));
         let aim = [0, 1, 2].map(|k| rng.range(0, i64::from(dims[k]) * VOXEL) - eye[k]);
         let m = aim.iter().map(|v| v.unsigned_abs()).max().unwrap().max(1);
         let d = aim.map(|v| (i128::from(v) * (1 << 28) / i128::from(m)) as i32);
