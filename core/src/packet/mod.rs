@@ -12,6 +12,12 @@
 //! state, so [`RayPacket8::lane_ray`] returns the very `DiscreteRay` the
 //! scalar walk leaves behind, and either may resume the walk.
 //!
+//! Skipping walks ([`RayPacket8::walk_skipping`],
+//! [`RayPacket8::first_hit_skipping`]) are likewise lane by lane the
+//! scalar [`DiscreteRay::walk_skipping`]: a lane taking a 26-step from a
+//! voxel far from every non-transparent voxel jumps exactly as its scalar
+//! ray does, so hits, faces, step counts and resume states stay identical.
+//!
 //! Lanes without a ray (a ray that misses the raster, or one left out) are
 //! simply empty. Lanes that hit, exit or run out of budget drop out of the
 //! walk; it returns when every lane has ended, with one [`PacketEnd`] bitmask

@@ -49,6 +49,17 @@
 //   modulo 2^64 truncated to `usize` is the scalar's wrapping arithmetic
 //   modulo 2^usize::BITS, on 32- and 64-bit targets alike. Crossing
 //   counters are `u32` in 64-bit lanes the same way.
+// * Skipping. A skipping walk reads every cell through `skip::skip_cell`
+//   (a line's stand-in where the line level allows, else the plane), as the
+//   scalar skipping walk does, and keeps each lane's current cell. Where a
+//   lane takes a 26-step (every lane in TwentySix, the lanes not taking a
+//   6-step in Adaptive) and `skip::skip_count` allows k ≥ 2 steps, its
+//   single step is replaced by the scalar jump (`skip::jump` on the lane's
+//   own constants: its divisions and products are 64-bit, which the lanes
+//   lack, so they run per lane). A jump is one visit, as in the scalar
+//   walk, so step counts stay visit counts; and it never passes the exit
+//   (k is at most the driving crossings left, and a 26-run never takes a
+//   minor crossing past its counter), so the vector step's exit test holds.
 
 use super::lanes::{BIT, I64x8, LANES, Mask8};
 use super::{PacketEnd, RayPacket8};
