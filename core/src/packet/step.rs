@@ -176,7 +176,7 @@ fn jump_lanes<const MODE: u8>(
     let [mut na, mut nb, mut nc] = s.next.rem.map(I64x8::to_array);
     let mut nidx = s.next.idx.to_array();
     let (mut lb, mut lc) = (0u8, 0u8);
-    for (lane, ((&bit, ray), r)) in BIT.iter().zip(&pk.rays).zip(by_a.iter_mut()).enumerate() {
+    for (lane, ((&bit, ray), r)) in (0..LANES).zip(BIT.iter().zip(&pk.rays).zip(by_a.iter_mut())) {
         let (true, Some(ray), Some(&k)) = (lanes & bit != 0, ray, ks.get(lane)) else {
             continue;
         };
