@@ -1,5 +1,6 @@
-//! Every lane of a `RayPacket8` equals the scalar discrete ray: the shared
-//! checker (`rrt_core::check_packet`) on many seeded random packets.
+//! Every lane of a `RayPacket8` equals the scalar discrete ray, in plain
+//! and skipping walks: the shared checker (`rrt_core::check_packet`) on
+//! many seeded random packets.
 //!
 //! Every packet derives from a printed seed: a failure names the seed, and
 //! `RRT_SEED=<seed> cargo test -p rrt-tests --release --test packet` replays
@@ -9,8 +10,8 @@ use rrt_core::check_packet::{Walk, check_packet, check_packet_script};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::packet::{LANES, RayPacket8};
-use rrt_core::proximity::flag_neighbourhood;
-use rrt_core::raster::{Extent, Raster, RasterMut, cell};
+use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 use rrt_tests::{Rng, env_count, random_opaque, replay_seed};
 
 /// What the lanes of one packet look like.
@@ -94,14 +95,41 @@ fn aimed_dir(rng: &mut Rng, dims: [u32; 3], o: [i64; 3]) -> [i32; 3] {
 struct Packet {
     dims: [u32; 3],
     plane: Vec<u8>,
+    /// A line level for the skipping walks (empty: none).
+    lines: Vec<u8>,
     rays: [Option<DiscreteRay>; LANES],
     bundle: Bundle,
 }
 
-fn random_plane(rng: &mut Rng, e: Extent) -> Vec<u8> {
+/// A plane and its line level (empty: none). The skipping walks jump on
+/// the distance bits: exact fields, fields with cells disturbed, and random
+/// distance bits all must give lanes equal to their scalar rays.
+fn random_plane(rng: &mut Rng, e: Extent) -> (Vec<u8>, Vec<u8>) {
     let density = rng.below(30);
     let mut plane = random_opaque(rng, e.len(), density, 100);
-    match rng.below(3) {
+    let mut lines = Vec::new();
+    match rng.below(6) {
+        // The distance field (and flags) as the renderer makes them, with a
+        // line level or without, the field exact or disturbed.
+        3..=5 => {
+            let den = 1 + rng.below(400);
+            let sparse = random_opaque(rng, e.len(), 1, den);
+            for (c, s) in plane.iter_mut().zip(sparse) {
+                *c = if density < 10 { s } else { *c | s };
+            }
+            distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+            if rng.chance(1, 2) {
+                lines = vec![0; line_count(plane.len())];
+                line_distances(&Raster::new(e, &plane).unwrap(), &mut lines).unwrap();
+            }
+            if rng.chance(1, 3) {
+                for c in &mut plane {
+                    if rng.chance(1, 40) {
+                        *c = rng.below(256) as u8;
+                    }
+                }
+            }
+        }
         // Proximity flags as the renderer sets them.
         0 => flag_neighbourhood(&mut RasterMut::new(e, &mut plane).unwrap()),
         // Random flags: Adaptive switches anywhere.
@@ -112,30 +140,33 @@ fn random_plane(rng: &mut Rng, e: Extent) -> Vec<u8> {
                 }
             }
         }
-        // Flags, then some flipped.
+        // Flags, then some flipped, and random distance bits.
         _ => {
             flag_neighbourhood(&mut RasterMut::new(e, &mut plane).unwrap());
             for c in &mut plane {
                 if rng.chance(1, 10) {
                     *c ^= cell::PROXIMITY;
                 }
+                *c |= (rng.below(64) as u8) << cell::DISTANCE_SHIFT;
             }
         }
     }
-    plane
+    (plane, lines)
 }
 
 fn random_packet(seed: u64) -> Packet {
     let mut rng = Rng::new(seed);
+    // Some rasters long enough for lines of the line level and long jumps.
+    let most = if rng.chance(1, 4) { 80 } else { 20 };
     let dims = [0; 3].map(|_| {
         if rng.chance(1, 8) {
             1
         } else {
-            1 + rng.below(20) as u32
+            1 + rng.below(most) as u32
         }
     });
     let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
-    let plane = random_plane(&mut rng, e);
+    let (plane, lines) = random_plane(&mut rng, e);
     let bundle = [
         Bundle::Mixed,
         Bundle::Coherent,
@@ -197,8 +228,20 @@ fn random_packet(seed: u64) -> Packet {
     Packet {
         dims,
         plane,
+        lines,
         rays,
         bundle,
+    }
+}
+
+/// The raster of a packet case, with its line level if it has one.
+fn raster_of(p: &Packet) -> Raster<'_> {
+    let e = Extent::new(p.dims[0], p.dims[1], p.dims[2]).unwrap();
+    let r = Raster::new(e, &p.plane).unwrap();
+    if p.lines.is_empty() {
+        r
+    } else {
+        r.with_lines(&p.lines).unwrap()
     }
 }
 
@@ -216,7 +259,7 @@ fn random_packets_equal_their_scalar_rays() {
     for seed in replay_seed().into_iter().chain((0..n).map(seed_of)) {
         let p = random_packet(seed);
         let e = Extent::new(p.dims[0], p.dims[1], p.dims[2]).unwrap();
-        let r = Raster::new(e, &p.plane).unwrap();
+        let r = raster_of(&p);
         let packet = RayPacket8::from_rays(e, p.rays).unwrap();
         lanes += u64::from(packet.lanes().count_ones());
         let report = check_packet(&r, &packet)
@@ -244,12 +287,16 @@ fn random_walk_scripts_equal_their_scalar_rays() {
         let p = random_packet(seed);
         let mut rng = Rng::new(seed);
         let e = Extent::new(p.dims[0], p.dims[1], p.dims[2]).unwrap();
-        let r = Raster::new(e, &p.plane).unwrap();
+        let r = raster_of(&p);
         let mut rays = p.rays;
         for ray in rays.iter_mut().flatten() {
             let mode = Connectivity::ALL[rng.below(3) as usize];
             let budget = rng.below(6) as u32;
-            let _ = ray.walk(&r, mode, budget, |_, c| c & cell::OPAQUE != 0);
+            let _ = if rng.chance(1, 2) {
+                ray.walk_skipping(&r, mode, budget, |_, c| c & cell::OPAQUE != 0)
+            } else {
+                ray.walk(&r, mode, budget, |_, c| c & cell::OPAQUE != 0)
+            };
         }
         let packet = RayPacket8::from_rays(e, rays).unwrap();
         let script: Vec<Walk> = (0..rng.below(8))
@@ -257,6 +304,7 @@ fn random_walk_scripts_equal_their_scalar_rays() {
                 mode: Connectivity::ALL[rng.below(3) as usize],
                 budget: [0, 1, 2, 3, 7, u32::MAX][rng.below(6) as usize],
                 hit_bits: [0, cell::OPAQUE, cell::PROXIMITY, 0xff][rng.below(4) as usize],
+                skip: rng.chance(1, 2),
             })
             .collect();
         check_packet_script(&r, &packet, &script)

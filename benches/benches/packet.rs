@@ -1,21 +1,25 @@
 //! Rays per second of `RayPacket8` against the scalar discrete ray on the
-//! same rays, in all three connectivities.
+//! same rays, in all three connectivities, walking plainly (every voxel)
+//! and with empty-space skipping on both sides (the renderer's walk).
 //!
 //! Scene: a sphereflake built like SPD's `balls` at depth 4 (7381 solid
 //! spheres, each with nine children of a third its radius; generated here
 //! so that the bench needs neither `../shared/data` nor the host's
 //! pipeline, and without balls4's floor polygon, so that every ray's walk
 //! is decided by spheres), voxelized into a raster of 512 and of 1024
-//! voxels along its longest axis, with proximity flags from
-//! `flag_neighbourhood` (which writes every cell, so every page of the
-//! plane is touched before timing: no calloc'ed zero pages). The renderer's
-//! end-to-end comparison on the real `balls4.nff` is in the README.
+//! voxels along its longest axis, with proximity flags and the distance
+//! field from `distance_field` and the line level from `line_distances`,
+//! as the renderer's raster has them (the field writes every cell, so every
+//! page of the plane is touched before timing: no calloc'ed zero pages).
+//! The renderer's end-to-end comparison on the real `balls4.nff` is in the
+//! README.
 //!
 //! Rays: coherent primary rays of a 512² camera in 4×2 pixel blocks (one
 //! block = one packet), and incoherent rays (random origins in empty voxels,
 //! random directions), also sorted by driving axis and signs. Each walk is
-//! `first_hit` (the first OPAQUE voxel); ray setup is not timed (rays and
-//! packets are built beforehand and copied per walk).
+//! `first_hit` or `first_hit_skipping` (the first OPAQUE voxel); ray setup
+//! is not timed (rays and packets are built beforehand and copied per
+//! walk).
 //!
 //! Besides criterion's groups, the bench first prints a table of rays/s and
 //! packet/scalar ratios measured in this one run, scalar and packet timed
@@ -25,8 +29,9 @@
 //!     cargo bench -p rrt-benches --bench packet
 //!     RUSTFLAGS="-C target-cpu=native" cargo bench -p rrt-benches --bench packet
 //!
-//! `RRT_BENCH_SIZES=512`, `RRT_BENCH_SETS=coherent,random,sorted` and
-//! `RRT_BENCH_MODES=six,twenty-six,adaptive` limit what runs,
+//! `RRT_BENCH_SIZES=512`, `RRT_BENCH_SETS=coherent,random,sorted`,
+//! `RRT_BENCH_MODES=six,twenty-six,adaptive` and
+//! `RRT_BENCH_WALKS=plain,skipping` limit what runs,
 //! `RRT_BENCH_TABLE_ONLY=1` skips criterion.
 
 use rrt_core::rng::Rng;
@@ -37,8 +42,8 @@ use criterion::{BenchmarkId, Criterion, Throughput};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::fixed::VOXEL;
 use rrt_core::packet::{LANES, RayPacket8};
-use rrt_core::proximity::flag_neighbourhood;
-use rrt_core::raster::{Extent, Raster, RasterMut, cell};
+use rrt_core::proximity::{distance_field, line_distances};
+use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 
 /// A sphere in scene units.
 #[derive(Clone, Copy, Debug)]
@@ -120,6 +125,8 @@ struct Scene {
     n: u32,
     extent: Extent,
     plane: Vec<u8>,
+    /// The line level of the plane.
+    lines: Vec<u8>,
     /// Scene units → voxels: `voxel = (p - lo) * k`.
     lo: [f64; 3],
     k: f64,
@@ -157,11 +164,14 @@ fn voxelize(spheres: &[Sphere], n: u32) -> Scene {
         }
     }
     // Writes every cell: every page of the plane is touched.
-    flag_neighbourhood(&mut RasterMut::new(extent, &mut plane).unwrap());
+    distance_field(&mut RasterMut::new(extent, &mut plane).unwrap());
+    let mut lines = vec![0; line_count(plane.len())];
+    line_distances(&Raster::new(extent, &plane).unwrap(), &mut lines).unwrap();
     Scene {
         n,
         extent,
         plane,
+        lines,
         lo,
         k,
     }
@@ -270,12 +280,49 @@ fn ray_set(name: &'static str, scene: &Scene, rays: &[([i64; 3], [i32; 3])]) -> 
     }
 }
 
+/// Every voxel (`plain`), or skipping empty space.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Walk {
+    Plain,
+    Skipping,
+}
+
+impl Walk {
+    fn name(self) -> &'static str {
+        match self {
+            Walk::Plain => "plain",
+            Walk::Skipping => "skipping",
+        }
+    }
+
+    fn scalar(
+        self,
+        ray: &mut DiscreteRay,
+        raster: &Raster<'_>,
+        mode: Connectivity,
+    ) -> Option<rrt_core::discrete_ray::Hit> {
+        match self {
+            Walk::Plain => ray.first_hit(raster, mode),
+            Walk::Skipping => ray.first_hit_skipping(raster, mode),
+        }
+        .unwrap()
+    }
+
+    fn packet(self, p: &mut RayPacket8, raster: &Raster<'_>, mode: Connectivity) -> u8 {
+        match self {
+            Walk::Plain => p.first_hit(raster, mode),
+            Walk::Skipping => p.first_hit_skipping(raster, mode),
+        }
+        .unwrap()
+    }
+}
+
 /// First hits of every ray, one at a time; a checksum of the hits.
-fn walk_scalar(raster: &Raster<'_>, rays: &[DiscreteRay], mode: Connectivity) -> u64 {
+fn walk_scalar(raster: &Raster<'_>, rays: &[DiscreteRay], mode: Connectivity, walk: Walk) -> u64 {
     let mut sum = 0u64;
     for ray in rays {
         let mut r = *ray;
-        if let Some(h) = r.first_hit(raster, mode).unwrap() {
+        if let Some(h) = walk.scalar(&mut r, raster, mode) {
             sum = sum.wrapping_add(h.index as u64 ^ u64::from(h.steps) << 40);
         }
     }
@@ -283,11 +330,16 @@ fn walk_scalar(raster: &Raster<'_>, rays: &[DiscreteRay], mode: Connectivity) ->
 }
 
 /// First hits of every ray, eight at a time; the same checksum.
-fn walk_packets(raster: &Raster<'_>, packets: &[RayPacket8], mode: Connectivity) -> u64 {
+fn walk_packets(
+    raster: &Raster<'_>,
+    packets: &[RayPacket8],
+    mode: Connectivity,
+    walk: Walk,
+) -> u64 {
     let mut sum = 0u64;
     for packet in packets {
         let mut p = packet.clone();
-        let hits = p.first_hit(raster, mode).unwrap();
+        let hits = walk.packet(&mut p, raster, mode);
         for lane in 0..LANES {
             if hits & (1 << lane) != 0 {
                 let h = p.hit(lane).unwrap();
@@ -298,12 +350,12 @@ fn walk_packets(raster: &Raster<'_>, packets: &[RayPacket8], mode: Connectivity)
     sum
 }
 
-/// Steps taken by the scalar rays (Six/26/Adaptive voxel visits).
-fn visits(raster: &Raster<'_>, rays: &[DiscreteRay], mode: Connectivity) -> u64 {
+/// Voxels visited by the scalar rays (a jump visits one).
+fn visits(raster: &Raster<'_>, rays: &[DiscreteRay], mode: Connectivity, walk: Walk) -> u64 {
     rays.iter()
         .map(|ray| {
             let mut r = *ray;
-            let _ = r.first_hit(raster, mode).unwrap();
+            let _ = walk.scalar(&mut r, raster, mode);
             u64::from(r.steps())
         })
         .sum()
@@ -322,36 +374,40 @@ fn best_of(rounds: u32, mut f: impl FnMut() -> u64) -> (Duration, u64) {
 
 fn table(scenes: &[(Scene, Vec<RaySet>)]) {
     println!(
-        "| raster | rays | mode | voxels/ray | scalar Mrays/s | packet Mrays/s | packet/scalar |"
+        "| raster | rays | mode | walk | voxels/ray | scalar Mrays/s | packet Mrays/s | packet/scalar |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for (scene, sets) in scenes {
-        let raster = Raster::new(scene.extent, &scene.plane).unwrap();
+        let raster = raster_of(scene);
         for set in sets {
-            for mode in modes() {
+            for (mode, walk) in modes()
+                .into_iter()
+                .flat_map(|m| walks().into_iter().map(move |w| (m, w)))
+            {
                 // Alternate the two, so that noise from other processes
                 // hits both alike; best of the rounds.
                 let mut ts = Duration::MAX;
                 let mut tp = Duration::MAX;
                 let (mut cs, mut cp) = (0, 0);
                 for _ in 0..4 {
-                    let (t, c) = best_of(1, || walk_scalar(&raster, &set.rays, mode));
+                    let (t, c) = best_of(1, || walk_scalar(&raster, &set.rays, mode, walk));
                     ts = ts.min(t);
                     cs = c;
-                    let (t, c) = best_of(1, || walk_packets(&raster, &set.packets, mode));
+                    let (t, c) = best_of(1, || walk_packets(&raster, &set.packets, mode, walk));
                     tp = tp.min(t);
                     cp = c;
                 }
                 assert_eq!(cs, cp, "packet and scalar hits differ");
-                let per_ray = visits(&raster, &set.rays, mode) as f64 / set.count as f64;
+                let per_ray = visits(&raster, &set.rays, mode, walk) as f64 / set.count as f64;
                 let rs = set.count as f64 / ts.as_secs_f64() / 1e6;
                 let rp = set.count as f64 / tp.as_secs_f64() / 1e6;
                 println!(
-                    "| {}³-ish ({:?}) | {} | {} | {:.0} | {:.3} | {:.3} | {:.2}× |",
+                    "| {}³-ish ({:?}) | {} | {} | {} | {:.0} | {:.3} | {:.3} | {:.2}× |",
                     scene.n,
                     scene.extent.dims(),
                     set.name,
                     mode.name(),
+                    walk.name(),
                     per_ray,
                     rs,
                     rp,
@@ -369,6 +425,23 @@ fn modes() -> Vec<Connectivity> {
         .into_iter()
         .filter(|m| want.is_empty() || want.split(',').any(|w| w.trim() == m.name()))
         .collect()
+}
+
+/// The walks to run (`RRT_BENCH_WALKS=plain,skipping`; default both).
+fn walks() -> Vec<Walk> {
+    let want = std::env::var("RRT_BENCH_WALKS").unwrap_or_default();
+    [Walk::Plain, Walk::Skipping]
+        .into_iter()
+        .filter(|w| want.is_empty() || want.split(',').any(|x| x.trim() == w.name()))
+        .collect()
+}
+
+/// The scene's raster with its line level.
+fn raster_of(scene: &Scene) -> Raster<'_> {
+    Raster::new(scene.extent, &scene.plane)
+        .unwrap()
+        .with_lines(&scene.lines)
+        .unwrap()
 }
 
 fn main() {
@@ -422,17 +495,20 @@ fn main() {
         .measurement_time(Duration::from_secs(4))
         .configure_from_args();
     for (scene, sets) in &scenes {
-        let raster = Raster::new(scene.extent, &scene.plane).unwrap();
+        let raster = raster_of(scene);
         for set in sets {
             let mut g = c.benchmark_group(format!("packet/{}/{}", scene.n, set.name));
             g.throughput(Throughput::Elements(set.count));
             for mode in modes() {
-                g.bench_with_input(BenchmarkId::new("scalar", mode.name()), &mode, |b, &m| {
-                    b.iter(|| walk_scalar(&raster, &set.rays, m));
-                });
-                g.bench_with_input(BenchmarkId::new("packet", mode.name()), &mode, |b, &m| {
-                    b.iter(|| walk_packets(&raster, &set.packets, m));
-                });
+                for walk in walks() {
+                    let id = format!("{}/{}", mode.name(), walk.name());
+                    g.bench_with_input(BenchmarkId::new("scalar", &id), &mode, |b, &m| {
+                        b.iter(|| walk_scalar(&raster, &set.rays, m, walk));
+                    });
+                    g.bench_with_input(BenchmarkId::new("packet", &id), &mode, |b, &m| {
+                        b.iter(|| walk_packets(&raster, &set.packets, m, walk));
+                    });
+                }
             }
             g.finish();
         }

@@ -65,8 +65,10 @@ impl core::fmt::Display for LaneViolation {
     }
 }
 
-/// One walk of a script: its connectivity, its step budget, and the cell
-/// bits that make a voxel a hit (`cell & hit_bits != 0`; 0 never hits).
+/// One walk of a script: its connectivity, its step budget, the cell bits
+/// that make a voxel a hit (`cell & hit_bits != 0`; 0 never hits), and
+/// whether it skips empty space (the packet's `walk_skipping` against the
+/// scalar [`DiscreteRay::walk_skipping`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Walk {
     /// Connectivity of the walk.
@@ -75,6 +77,8 @@ pub struct Walk {
     pub budget: u32,
     /// Cell bits that make a hit.
     pub hit_bits: u8,
+    /// Skip empty space.
+    pub skip: bool,
 }
 
 /// What a successful [`check_packet`] saw.
@@ -124,26 +128,35 @@ impl<'a, 'r> Twins<'a, 'r> {
         let mut seen_p: [Option<(usize, u8)>; LANES] = [None; LANES];
         let mut calls_p = [0u32; LANES];
         let bits = w.hit_bits;
-        let end = self
-            .packet
-            .walk(self.raster, w.mode, w.budget, |lane, index, c| {
-                if let (Some(s), Some(n)) = (seen_p.get_mut(lane), calls_p.get_mut(lane)) {
-                    *s = Some((index, c));
-                    *n = n.saturating_add(1);
-                }
-                c & bits != 0
-            })
-            .map_err(|_| self.fail(0, w.mode, Mismatch::Setup))?;
+        let test = |lane: usize, index: usize, c: u8| {
+            if let (Some(s), Some(n)) = (seen_p.get_mut(lane), calls_p.get_mut(lane)) {
+                *s = Some((index, c));
+                *n = n.saturating_add(1);
+            }
+            c & bits != 0
+        };
+        let end = if w.skip {
+            self.packet
+                .walk_skipping(self.raster, w.mode, w.budget, test)
+        } else {
+            self.packet.walk(self.raster, w.mode, w.budget, test)
+        }
+        .map_err(|_| self.fail(0, w.mode, Mismatch::Setup))?;
         for lane in 0..LANES {
             let mut seen_s = None;
             let mut calls_s = 0u32;
+            let test = |index: usize, c: u8| {
+                seen_s = Some((index, c));
+                calls_s = calls_s.saturating_add(1);
+                c & bits != 0
+            };
             let scalar = match self.rays.get_mut(lane).and_then(Option::as_mut) {
                 Some(ray) => Some(
-                    ray.walk(self.raster, w.mode, w.budget, |index, c| {
-                        seen_s = Some((index, c));
-                        calls_s = calls_s.saturating_add(1);
-                        c & bits != 0
-                    })
+                    if w.skip {
+                        ray.walk_skipping(self.raster, w.mode, w.budget, test)
+                    } else {
+                        ray.walk(self.raster, w.mode, w.budget, test)
+                    }
                     .map_err(|_| self.fail(lane, w.mode, Mismatch::Setup))?,
                 ),
                 None => None,
@@ -179,13 +192,17 @@ impl<'a, 'r> Twins<'a, 'r> {
     }
 
     /// [`Twins::walk`], and beside it a clone of the packet through the
-    /// cell-bits fast path ([`RayPacket8::walk_until`]), which must end and
-    /// leave every lane the same way.
+    /// cell-bits fast path ([`RayPacket8::walk_until`], or
+    /// [`RayPacket8::walk_until_skipping`]), which must end and leave every
+    /// lane the same way.
     fn walk_both(&mut self, w: Walk) -> Result<(), LaneViolation> {
         let mut fast = self.packet.clone();
-        let fast_end = fast
-            .walk_until(self.raster, w.mode, w.budget, w.hit_bits)
-            .map_err(|_| self.fail(0, w.mode, Mismatch::Setup))?;
+        let fast_end = if w.skip {
+            fast.walk_until_skipping(self.raster, w.mode, w.budget, w.hit_bits)
+        } else {
+            fast.walk_until(self.raster, w.mode, w.budget, w.hit_bits)
+        }
+        .map_err(|_| self.fail(0, w.mode, Mismatch::Setup))?;
         let end = self.walk(w)?;
         for lane in 0..LANES {
             if fast_end.lane(lane) != end.lane(lane) {
@@ -244,7 +261,10 @@ impl<'a, 'r> Twins<'a, 'r> {
 ///   the whole resume state of every lane;
 /// * walking to the first [`cell::OPAQUE`] voxel and resuming after each hit
 ///   until done, with the same comparisons (both with a closure test and the
-///   cell-bits test of [`RayPacket8::walk_until`]).
+///   cell-bits test of [`RayPacket8::walk_until`]);
+/// * both again with empty-space skipping, against the scalar
+///   [`DiscreteRay::walk_skipping`] (the raster's distances and line level
+///   decide the jumps; any cells are compared, not only valid fields).
 ///
 /// # Errors
 /// The first [`LaneViolation`].
@@ -253,26 +273,26 @@ pub fn check_packet_mode(
     packet: &RayPacket8,
     mode: Connectivity,
 ) -> Result<PacketReport, LaneViolation> {
-    let mut t = Twins::new(raster, packet);
-    t.until_done(Walk {
-        mode,
-        budget: 1,
-        hit_bits: 0,
-    })?;
-    let mut t2 = Twins::new(raster, packet);
-    t2.until_done(Walk {
-        mode,
-        budget: u32::MAX,
-        hit_bits: cell::OPAQUE,
-    })?;
-    Ok(PacketReport {
-        lane_walks: t.report.lane_walks.saturating_add(t2.report.lane_walks),
-        hits: t.report.hits.saturating_add(t2.report.hits),
-    })
+    let mut total = PacketReport::default();
+    for skip in [false, true] {
+        for (budget, hit_bits) in [(1, 0), (u32::MAX, cell::OPAQUE)] {
+            let mut t = Twins::new(raster, packet);
+            t.until_done(Walk {
+                mode,
+                budget,
+                hit_bits,
+                skip,
+            })?;
+            total.lane_walks = total.lane_walks.saturating_add(t.report.lane_walks);
+            total.hits = total.hits.saturating_add(t.report.hits);
+        }
+    }
+    Ok(total)
 }
 
 /// Runs a script of walks (modes, budgets and hit tests may change from one
-/// walk to the next, as a renderer resuming after a false hit does) on
+/// walk to the next, as a renderer resuming after a false hit does; skipping
+/// or not) on
 /// `packet` and on each lane's scalar ray, comparing every lane after every
 /// walk as [`check_packet_mode`] does; then finishes every lane with
 /// budget-1 steps in the last walk's mode.
@@ -286,14 +306,17 @@ pub fn check_packet_script(
 ) -> Result<PacketReport, LaneViolation> {
     let mut t = Twins::new(raster, packet);
     let mut mode = Connectivity::Adaptive;
+    let mut skip = false;
     for &w in script {
         t.walk_both(w)?;
         mode = w.mode;
+        skip = w.skip;
     }
     t.until_done(Walk {
         mode,
         budget: 1,
         hit_bits: cell::OPAQUE,
+        skip,
     })?;
     Ok(t.report)
 }

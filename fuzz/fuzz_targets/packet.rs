@@ -1,7 +1,8 @@
-//! Fuzzes the ray packet: arbitrary rasters, cells, up to eight lanes
-//! (degenerate, out-of-range, part-walked) and scripts of walks, each lane
-//! checked against its scalar discrete ray after every walk. Crashes replay
-//! with `cargo test -p rrt-tests --test packet` once copied to
+//! Fuzzes the ray packet: arbitrary rasters, cells, distance fields and
+//! line levels, up to eight lanes (degenerate, out-of-range, part-walked)
+//! and scripts of walks, plain and skipping, each lane checked against its
+//! scalar discrete ray after every walk. Crashes replay with
+//! `cargo test -p rrt-tests --test packet` once copied to
 //! tests/fuzz_regressions/packet/.
 #![no_main]
 

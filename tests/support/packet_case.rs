@@ -8,15 +8,17 @@ use rrt_core::check_packet::{Walk, check_packet, check_packet_script};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::error::RayError;
 use rrt_core::packet::{LANES, RayPacket8};
-use rrt_core::proximity::flag_neighbourhood;
-use rrt_core::raster::{Extent, Raster, RasterMut};
+use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+use rrt_core::raster::{Extent, Raster, RasterMut, line_count};
 
 use crate::fuzz::{Component, Coord, decode_ray, repeated_cells};
 
-/// A walk: connectivity (mod 3), budget (255 = unlimited) and hit bits.
+/// A walk: connectivity (mod 3) and skipping (bit 7), budget (255 =
+/// unlimited) and hit bits.
 #[derive(Arbitrary, Debug, Clone, Copy)]
 pub struct WalkCase {
-    /// 0 Six, 1 TwentySix, 2 Adaptive (mod 3).
+    /// 0 Six, 1 TwentySix, 2 Adaptive (mod 3); skips empty space when bit 7
+    /// is set.
     pub mode: u8,
     /// Step budget; 255 is `u32::MAX`.
     pub budget: u8,
@@ -34,6 +36,7 @@ impl WalkCase {
                 u32::from(self.budget)
             },
             hit_bits: self.hit_bits,
+            skip: self.mode & 0x80 != 0,
         }
     }
 }
@@ -58,10 +61,14 @@ pub struct LaneCase {
 pub struct PacketCase {
     /// Raster dimensions, each taken modulo 16, plus one.
     pub dims: [u8; 3],
-    /// Cell bits, repeated over the plane (OPAQUE and PROXIMITY kept).
+    /// Cells, repeated over the plane (OPAQUE and PROXIMITY kept, unless
+    /// `field` keeps them whole).
     pub cells: Vec<u8>,
-    /// Recompute the proximity flags from the opaque voxels.
-    pub flag: bool,
+    /// Bit 0: recompute the proximity flags from the opaque voxels; bit 1:
+    /// keep the cells whole (arbitrary distance bits); bit 2: compute the
+    /// distance field (and flags) from the opaque voxels; bit 3: give the
+    /// raster its line level.
+    pub field: u8,
     /// The lanes (`None`: empty).
     pub lanes: [Option<LaneCase>; LANES],
     /// Walks run on the packet and the scalar rays (at most 16 are used).
@@ -76,11 +83,32 @@ pub fn run_packet_case(case: &PacketCase) {
     let Ok(extent) = Extent::new(dims[0], dims[1], dims[2]) else {
         unreachable!("dims in 1..=16")
     };
-    let mut plane = repeated_cells(&case.cells, extent.len());
-    if case.flag {
+    let mut plane = if case.field & 2 != 0 {
+        (0..extent.len())
+            .map(|i| {
+                case.cells
+                    .get(i % case.cells.len().max(1))
+                    .copied()
+                    .unwrap_or(0)
+            })
+            .collect()
+    } else {
+        repeated_cells(&case.cells, extent.len())
+    };
+    if case.field & 1 != 0 {
         flag_neighbourhood(&mut RasterMut::new(extent, &mut plane).expect("plane length"));
     }
+    if case.field & 4 != 0 {
+        distance_field(&mut RasterMut::new(extent, &mut plane).expect("plane length"));
+    }
+    let mut lines = vec![0; line_count(plane.len())];
     let raster = Raster::new(extent, &plane).expect("plane length");
+    let raster = if case.field & 8 != 0 {
+        line_distances(&raster, &mut lines).expect("line count");
+        raster.with_lines(&lines).expect("line count")
+    } else {
+        raster
+    };
     let rays: [Option<DiscreteRay>; LANES] = std::array::from_fn(|lane| {
         let l = case.lanes[lane].as_ref()?;
         let (_, _, set_up) = decode_ray(extent, l.origin, l.dir, l.segment);
@@ -94,8 +122,13 @@ pub fn run_packet_case(case: &PacketCase) {
         if let Some(w) = l.before {
             let w = w.walk();
             let bits = w.hit_bits;
-            ray.walk(&raster, w.mode, w.budget, |_, c| c & bits != 0)
-                .expect("same extent");
+            let test = |_, c| c & bits != 0;
+            if w.skip {
+                ray.walk_skipping(&raster, w.mode, w.budget, test)
+            } else {
+                ray.walk(&raster, w.mode, w.budget, test)
+            }
+            .expect("same extent");
         }
         Some(ray)
     });

@@ -99,6 +99,26 @@ fn drive() {
                 }
                 sink(u64::from(hits));
             }
+            // Skipping, over the raster with its line level when it has one.
+            let skipping = lined.unwrap_or(raster);
+            if let Ok(mut q) = RayPacket8::from_rays(extent, lanes) {
+                let e = q
+                    .walk_skipping(&skipping, m, budget, |l, i, c| {
+                        (l as u8 ^ i as u8 ^ c) & 5 == 1
+                    })
+                    .unwrap_or_default();
+                sink(u64::from(e.hit ^ e.exit ^ e.budget));
+                let e = q
+                    .walk_until_skipping(&skipping, m, budget, input::<1>(106)[0])
+                    .unwrap_or_default();
+                sink(u64::from(e.hit ^ e.exit ^ e.budget));
+                while let Ok(hits) = q.first_hit_skipping(&skipping, m) {
+                    if hits == 0 {
+                        break;
+                    }
+                    sink(u64::from(hits));
+                }
+            }
             for lane in 0..8 {
                 if let (Some(h), Some(r)) = (p.hit(lane), p.lane_ray(lane)) {
                     sink(h.index as u64 ^ u64::from(r.steps()));

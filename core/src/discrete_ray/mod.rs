@@ -73,13 +73,13 @@
 
 mod params;
 pub(crate) mod rules;
-mod skip;
+pub(crate) mod skip;
 mod step;
 #[cfg(test)]
 mod tests;
 
 use crate::error::RayError;
-use crate::raster::{Extent, LINE_BITS, Raster, cell};
+use crate::raster::{Extent, Raster, cell};
 use params::Params;
 
 pub use crate::connectivity::Connectivity;
@@ -390,10 +390,7 @@ impl DiscreteRay {
         } else {
             // A line's stand-in where the line is far from surfaces, else
             // the plane.
-            let cells = |i: usize| match lines.get(i >> LINE_BITS) {
-                Some(&l) if l >= skip::LINE_JUMP => Some(l),
-                _ => plane.get(i).copied(),
-            };
+            let cells = |i: usize| skip::skip_cell(plane, lines, i);
             self.run::<true, _, _>(mode, cells, budget, test)
         })
     }
@@ -453,10 +450,7 @@ impl DiscreteRay {
             let cells = |i: usize| plane.get(i).copied().map(dilated);
             self.run::<true, _, _>(Connectivity::Adaptive, cells, budget, &mut test_plane)
         } else {
-            let cells = |i: usize| match lines.get(i >> LINE_BITS) {
-                Some(&l) if l >= skip::LINE_JUMP => Some(dilated(l)),
-                _ => plane.get(i).copied().map(dilated),
-            };
+            let cells = |i: usize| skip::skip_cell(plane, lines, i).map(dilated);
             self.run::<true, _, _>(Connectivity::Adaptive, cells, budget, &mut test_plane)
         })
     }

@@ -33,12 +33,72 @@ pub(crate) const LINE_JUMP: u8 = 8 << crate::raster::cell::DISTANCE_SHIFT;
 /// the same state; the voxel the jump lands on (step `d − 1`, possibly
 /// flagged) is visited as single steps would visit it.
 #[inline(always)]
-pub(super) fn skip_count(cur: u8, todo: u32) -> u32 {
+pub(crate) fn skip_count(cur: u8, todo: u32) -> u32 {
     let d = crate::proximity::distance(cur);
     if d > MIN_JUMP {
         u32::from(d.wrapping_sub(1)).min(todo)
     } else {
         1
+    }
+}
+
+/// The cell a skipping walk reads for voxel `index`: the stand-in of its
+/// line ([`crate::raster::Raster::with_lines`], empty `lines`: none) when
+/// that is at least [`LINE_JUMP`], else the plane's cell; `None` outside
+/// the plane.
+#[inline(always)]
+pub(crate) fn skip_cell(plane: &[u8], lines: &[u8], index: usize) -> Option<u8> {
+    match lines.get(index >> crate::raster::LINE_BITS) {
+        Some(&l) if l >= LINE_JUMP => Some(l),
+        _ => plane.get(index).copied(),
+    }
+}
+
+/// What `k ≥ 2` 26-steps taken at once do ([`jump`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Jump {
+    /// Crossings of minor axes b and c among the `k` steps.
+    pub(crate) nb: i64,
+    pub(crate) nc: i64,
+    /// The threshold-shifted terms of b and c after them.
+    pub(crate) f1: i64,
+    pub(crate) f2: i64,
+    /// Whether the last step crossed b, c.
+    pub(crate) lb: bool,
+    pub(crate) lc: bool,
+}
+
+impl Jump {
+    /// The index offset of the jump: `k` steps along the driving axis and
+    /// the minor crossings, from the per-axis offsets `off` (wrapping, as
+    /// single steps add them).
+    #[inline(always)]
+    pub(crate) fn offset(&self, k: u32, off: [usize; 3]) -> usize {
+        let [off_a, off_b, off_c] = off;
+        let times = |off: usize, n: i64| off.wrapping_mul(usize::try_from(n).unwrap_or(0));
+        times(off_a, i64::from(k))
+            .wrapping_add(times(off_b, self.nb))
+            .wrapping_add(times(off_c, self.nc))
+    }
+}
+
+/// `k ≥ 2` 26-steps at once from the threshold-shifted terms `f = [f1, f2]`
+/// of minor axes b and c, with the increments `inc = [inc_a, inc_b, inc_c]`
+/// and `by_a` dividing by `inc_a` ([`jump_count`] per minor axis). The one
+/// jump of the scalar stepper and of each packet lane.
+#[inline(always)]
+pub(crate) fn jump(f: [i64; 2], k: u32, by_a: Reciprocal, inc: [i64; 3]) -> Jump {
+    let [inc_a, inc_b, inc_c] = inc;
+    let [f1, f2] = f;
+    let (nb, f1, lb) = jump_count(f1, k, by_a, inc_a, inc_b);
+    let (nc, f2, lc) = jump_count(f2, k, by_a, inc_a, inc_c);
+    Jump {
+        nb,
+        nc,
+        f1,
+        f2,
+        lb,
+        lc,
     }
 }
 
@@ -58,7 +118,7 @@ pub(super) fn skip_count(cur: u8, todo: u32) -> u32 {
 /// `(inc_m − inc_a, 2·inc_m − inc_a]`; otherwise it lands in
 /// `(2·inc_m − inc_a, inc_m]`. One comparison tells them apart.
 #[inline(always)]
-pub(super) fn jump_count(
+pub(crate) fn jump_count(
     f: i64,
     k: u32,
     by_a: Reciprocal,
@@ -81,13 +141,13 @@ pub(super) fn jump_count(
 /// at a run's first jump). `⌊x·m / 2^64⌋` is `⌊x / d⌋` or one less, since
 /// `x/d − 1 < x·m/2^64 ≤ x/d`; one comparison corrects it.
 #[derive(Clone, Copy)]
-pub(super) struct Reciprocal {
+pub(crate) struct Reciprocal {
     d: u64,
     m: u64,
 }
 
 impl Reciprocal {
-    pub(super) fn new(d: i64) -> Self {
+    pub(crate) fn new(d: i64) -> Self {
         let d = u64::try_from(d).unwrap_or(0).max(2);
         // ⌊(2^64 − 1) / d⌋ = ⌊2^64 / d⌋ unless d divides 2^64, when it is one
         // less: either way x·m/2^64 > x/d − 1, and a 64-bit division suffices.
@@ -96,7 +156,7 @@ impl Reciprocal {
     }
 
     #[inline(always)]
-    pub(super) fn div(self, x: u64) -> u64 {
+    pub(crate) fn div(self, x: u64) -> u64 {
         let q = u64::try_from(u128::from(x).wrapping_mul(u128::from(self.m)) >> 64).unwrap_or(0);
         let r = x.wrapping_sub(q.wrapping_mul(self.d));
         if r >= self.d { q.wrapping_add(1) } else { q }

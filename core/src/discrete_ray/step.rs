@@ -31,7 +31,7 @@
 
 use super::params::Params;
 use super::rules::{self, MOVE_A, MOVE_B, MOVE_C, Moves, SIX, TWENTY_SIX};
-use super::skip::{Reciprocal, jump_count, skip_count};
+use super::skip::{Reciprocal, jump, skip_count};
 use super::{State, WalkEnd};
 use crate::raster::cell;
 
@@ -327,27 +327,20 @@ impl Run26 {
     /// and the terms that `k` single steps reach.
     #[inline(always)]
     fn jump<const BUDGETED: bool>(&mut self, p: &Params, k: u32) {
-        let [inc_a, inc_b, inc_c] = p.inc;
+        let [inc_a, _, _] = p.inc;
         let by_a = *self.by_a.get_or_insert_with(|| Reciprocal::new(inc_a));
-        let (nb, f1, lb) = jump_count(self.f1, k, by_a, inc_a, inc_b);
-        let (nc, f2, lc) = jump_count(self.f2, k, by_a, inc_a, inc_c);
-        self.f1 = f1;
-        self.f2 = f2;
-        let [off_a, off_b, off_c] = p.off;
-        let times = |off: usize, n: i64| off.wrapping_mul(usize::try_from(n).unwrap_or(0));
-        self.idx = self
-            .idx
-            .wrapping_add(times(off_a, i64::from(k)))
-            .wrapping_add(times(off_b, nb))
-            .wrapping_add(times(off_c, nc));
+        let j = jump([self.f1, self.f2], k, by_a, p.inc);
+        self.f1 = j.f1;
+        self.f2 = j.f2;
+        self.idx = self.idx.wrapping_add(j.offset(k, p.off));
         self.todo = self.todo.wrapping_sub(k);
-        self.minors = usize::from(lb) | (usize::from(lc) << 1);
+        self.minors = usize::from(j.lb) | (usize::from(j.lc) << 1);
         if BUDGETED {
-            self.e3 = rules::e3_after(self.e3, nb, nc, p.inc);
-            self.rb = self.rb.wrapping_sub(u32::try_from(nb).unwrap_or(0));
-            self.rc = self.rc.wrapping_sub(u32::try_from(nc).unwrap_or(0));
+            self.e3 = rules::e3_after(self.e3, j.nb, j.nc, p.inc);
+            self.rb = self.rb.wrapping_sub(u32::try_from(j.nb).unwrap_or(0));
+            self.rc = self.rc.wrapping_sub(u32::try_from(j.nc).unwrap_or(0));
             self.steps = self.steps.wrapping_add(1);
-            self.last = rules::last_of([true, lb, lc]);
+            self.last = rules::last_of([true, j.lb, j.lc]);
         }
     }
 

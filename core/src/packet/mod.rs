@@ -12,6 +12,12 @@
 //! state, so [`RayPacket8::lane_ray`] returns the very `DiscreteRay` the
 //! scalar walk leaves behind, and either may resume the walk.
 //!
+//! Skipping walks ([`RayPacket8::walk_skipping`],
+//! [`RayPacket8::first_hit_skipping`]) are likewise lane by lane the
+//! scalar [`DiscreteRay::walk_skipping`]: a lane taking a 26-step from a
+//! voxel far from every non-transparent voxel jumps exactly as its scalar
+//! ray does, so hits, faces, step counts and resume states stay identical.
+//!
 //! Lanes without a ray (a ray that misses the raster, or one left out) are
 //! simply empty. Lanes that hit, exit or run out of budget drop out of the
 //! walk; it returns when every lane has ended, with one [`PacketEnd`] bitmask
@@ -332,7 +338,7 @@ impl RayPacket8 {
         budget: u32,
         test: T,
     ) -> Result<PacketEnd, RayError> {
-        self.run(raster, mode, budget, &mut Closure(test))
+        self.run::<false, _>(raster, mode, budget, &mut Closure(test))
     }
 
     /// [`RayPacket8::walk`] with the test "the cell has any bit of `bits`"
@@ -367,7 +373,7 @@ impl RayPacket8 {
         budget: u32,
         bits: u8,
     ) -> Result<PacketEnd, RayError> {
-        self.run(raster, mode, budget, &mut CellBits(bits))
+        self.run::<false, _>(raster, mode, budget, &mut CellBits(bits))
     }
 
     /// Walks every lane to its first non-transparent ([`cell::OPAQUE`])
@@ -381,7 +387,83 @@ impl RayPacket8 {
         Ok(self.walk_until(raster, mode, u32::MAX, cell::OPAQUE)?.hit)
     }
 
-    fn run<T: step::LaneTest>(
+    /// As [`RayPacket8::walk`], with **empty-space skipping**: per lane
+    /// exactly [`DiscreteRay::walk_skipping`] (the same jumps from the
+    /// proximity distances and the line level, so the same voxels tested,
+    /// hits, faces, step counts and resume states). The test is called once
+    /// per live lane and visited voxel, lanes in increasing order within an
+    /// iteration.
+    ///
+    /// **Contract** (as for the scalar walk): `test` must reject every cell
+    /// without [`cell::OPAQUE`], or skipped voxels go untested; each lane
+    /// still equals its scalar skipping walk either way.
+    ///
+    /// # Errors
+    /// As [`RayPacket8::walk`].
+    pub fn walk_skipping<T: FnMut(usize, usize, u8) -> bool>(
+        &mut self,
+        raster: &Raster<'_>,
+        mode: Connectivity,
+        budget: u32,
+        test: T,
+    ) -> Result<PacketEnd, RayError> {
+        self.run::<true, _>(raster, mode, budget, &mut Closure(test))
+    }
+
+    /// [`RayPacket8::walk_skipping`] with the test "the cell has any bit of
+    /// `bits`", evaluated for eight lanes at once.
+    ///
+    /// # Errors
+    /// As [`RayPacket8::walk`].
+    pub fn walk_until_skipping(
+        &mut self,
+        raster: &Raster<'_>,
+        mode: Connectivity,
+        budget: u32,
+        bits: u8,
+    ) -> Result<PacketEnd, RayError> {
+        self.run::<true, _>(raster, mode, budget, &mut CellBits(bits))
+    }
+
+    /// [`RayPacket8::first_hit`] with empty-space skipping: per lane exactly
+    /// [`DiscreteRay::first_hit_skipping`].
+    ///
+    /// ```
+    /// use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
+    /// use rrt_core::fixed::{voxel_centre, VOXEL};
+    /// use rrt_core::packet::RayPacket8;
+    /// use rrt_core::proximity::distance_field;
+    /// use rrt_core::raster::{cell, Extent, RasterMut};
+    ///
+    /// let e = Extent::cube(64).unwrap();
+    /// let mut plane = vec![cell::EMPTY; e.len()];
+    /// plane[e.index([60, 9, 9]).unwrap()] = cell::OPAQUE;
+    /// let mut r = RasterMut::new(e, &mut plane).unwrap();
+    /// distance_field(&mut r);
+    /// let r = r.as_raster();
+    /// let origins = core::array::from_fn(|l| [0, voxel_centre(9), voxel_centre(9) + l as i64]);
+    /// let mut packet = RayPacket8::new(e, origins, [[VOXEL as i32, 1, 0]; 8]).unwrap();
+    /// assert_eq!(packet.first_hit_skipping(&r, Connectivity::Adaptive).unwrap(), 0xff);
+    /// // Lane 0 is the scalar skipping walk, jumps and all.
+    /// let mut ray = DiscreteRay::new(e, origins[0], [VOXEL as i32, 1, 0]).unwrap().unwrap();
+    /// let hit = ray.first_hit_skipping(&r, Connectivity::Adaptive).unwrap().unwrap();
+    /// assert_eq!(packet.hit(0), Some(hit));
+    /// assert!(hit.steps < 10);
+    /// ```
+    ///
+    /// # Errors
+    /// As [`RayPacket8::walk`].
+    pub fn first_hit_skipping(
+        &mut self,
+        raster: &Raster<'_>,
+        mode: Connectivity,
+    ) -> Result<u8, RayError> {
+        Ok(self
+            .walk_until_skipping(raster, mode, u32::MAX, cell::OPAQUE)?
+            .hit)
+    }
+
+    fn run<const SKIP: bool, T: step::LaneTest>(
         &mut self,
         raster: &Raster<'_>,
         mode: Connectivity,
@@ -392,10 +474,16 @@ impl RayPacket8 {
             return Err(RayError::ExtentMismatch);
         }
         let plane = raster.plane();
+        // A plain walk reads the plane only.
+        let lines = if SKIP { raster.lines() } else { &[] };
         Ok(match mode {
-            Connectivity::Six => step::run::<SIX, T>(self, plane, budget, test),
-            Connectivity::TwentySix => step::run::<TWENTY_SIX, T>(self, plane, budget, test),
-            Connectivity::Adaptive => step::run::<ADAPTIVE, T>(self, plane, budget, test),
+            Connectivity::Six => step::run::<SIX, SKIP, T>(self, plane, lines, budget, test),
+            Connectivity::TwentySix => {
+                step::run::<TWENTY_SIX, SKIP, T>(self, plane, lines, budget, test)
+            }
+            Connectivity::Adaptive => {
+                step::run::<ADAPTIVE, SKIP, T>(self, plane, lines, budget, test)
+            }
         })
     }
 }

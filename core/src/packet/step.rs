@@ -49,11 +49,23 @@
 //   modulo 2^64 truncated to `usize` is the scalar's wrapping arithmetic
 //   modulo 2^usize::BITS, on 32- and 64-bit targets alike. Crossing
 //   counters are `u32` in 64-bit lanes the same way.
+// * Skipping. A skipping walk reads every cell through `skip::skip_cell`
+//   (a line's stand-in where the line level allows, else the plane), as the
+//   scalar skipping walk does, and keeps each lane's current cell. Where a
+//   lane takes a 26-step (every lane in TwentySix, the lanes not taking a
+//   6-step in Adaptive) and `skip::skip_count` allows k ≥ 2 steps, its
+//   single step is replaced by the scalar jump (`skip::jump` on the lane's
+//   own constants: its divisions and products are 64-bit, which the lanes
+//   lack, so they run per lane). A jump is one visit, as in the scalar
+//   walk, so step counts stay visit counts; and it never passes the exit
+//   (k is at most the driving crossings left, and a 26-run never takes a
+//   minor crossing past its counter), so the vector step's exit test holds.
 
 use super::lanes::{BIT, I64x8, LANES, Mask8};
 use super::{PacketEnd, RayPacket8};
 use crate::discrete_ray::State;
 use crate::discrete_ray::rules::{self, ADAPTIVE, Flag, SIX, TWENTY_SIX};
+use crate::discrete_ray::skip::{self, Reciprocal};
 use crate::raster::cell;
 
 /// TwentySix steps inside an Adaptive walk (`e3` is stepped too): a mode
@@ -115,6 +127,100 @@ fn proximity_bits(cells: u64) -> u8 {
     // (each bit lands on its own position: no carries).
     let ones = (cells >> 1) & 0x0101_0101_0101_0101;
     (ones.wrapping_mul(0x0102_0408_1020_4080) >> 56).to_le_bytes()[0]
+}
+
+/// The cell a walk reads for voxel `index`: with `SKIP` the skipping
+/// walk's ([`skip::skip_cell`]: a line's stand-in or the plane's), else the
+/// plane's; `None` outside the plane.
+#[inline(always)]
+fn cell_at<const SKIP: bool>(plane: &[u8], lines: &[u8], index: usize) -> Option<u8> {
+    if SKIP {
+        skip::skip_cell(plane, lines, index)
+    } else {
+        plane.get(index).copied()
+    }
+}
+
+/// `a[lane]` (0 outside the array).
+#[inline(always)]
+fn at(a: &[i64; LANES], lane: usize) -> i64 {
+    a.get(lane).copied().unwrap_or(0)
+}
+
+/// `a[lane] = v` (no-op outside the array).
+#[inline(always)]
+fn put(a: &mut [i64; LANES], lane: usize, v: i64) {
+    if let Some(slot) = a.get_mut(lane) {
+        *slot = v;
+    }
+}
+
+/// Replaces, in the lanes of `lanes`, the single 26-step `s` (taken from
+/// state `v`) by a jump of `ks[lane] ≥ 2` 26-steps: the scalar stepper's
+/// jump ([`skip::jump`]) on each lane's own constants, so the lane lands on
+/// the voxel, terms, counters and moves of the scalar jump. `e3` is kept
+/// exact except in TwentySix walks, which rebuild it at write-back.
+#[inline(never)]
+fn jump_lanes<const MODE: u8>(
+    pk: &RayPacket8,
+    by_a: &mut [Option<Reciprocal>; LANES],
+    v: &Lanes,
+    s: &mut Step,
+    lanes: u8,
+    ks: &[u32; LANES],
+) {
+    let [e1, e2, e3] = v.e.map(I64x8::to_array);
+    let [ra, rb, rc] = v.rem.map(I64x8::to_array);
+    let idx = v.idx.to_array();
+    let [mut n1, mut n2, mut n3] = s.next.e.map(I64x8::to_array);
+    let [mut na, mut nb, mut nc] = s.next.rem.map(I64x8::to_array);
+    let mut nidx = s.next.idx.to_array();
+    let (mut lb, mut lc) = (0u8, 0u8);
+    for (lane, ((&bit, ray), r)) in (0..LANES).zip(BIT.iter().zip(&pk.rays).zip(by_a.iter_mut())) {
+        let (true, Some(ray), Some(&k)) = (lanes & bit != 0, ray, ks.get(lane)) else {
+            continue;
+        };
+        let p = ray.params();
+        let [inc_a, _, _] = p.inc;
+        let [thr_b, thr_c] = p.thr;
+        let by = *r.get_or_insert_with(|| Reciprocal::new(inc_a));
+        let f = [
+            at(&e1, lane).wrapping_sub(thr_b),
+            at(&e2, lane).wrapping_sub(thr_c),
+        ];
+        let j = skip::jump(f, k, by, p.inc);
+        put(&mut n1, lane, j.f1.wrapping_add(thr_b));
+        put(&mut n2, lane, j.f2.wrapping_add(thr_c));
+        if MODE != TWENTY_SIX {
+            put(
+                &mut n3,
+                lane,
+                rules::e3_after(at(&e3, lane), j.nb, j.nc, p.inc),
+            );
+        }
+        put(&mut na, lane, at(&ra, lane).wrapping_sub(i64::from(k)));
+        put(&mut nb, lane, at(&rb, lane).wrapping_sub(j.nb));
+        put(&mut nc, lane, at(&rc, lane).wrapping_sub(j.nc));
+        let i = index_of(at(&idx, lane)).wrapping_add(j.offset(k, p.off));
+        put(&mut nidx, lane, lane_of(i));
+        if j.lb {
+            lb |= bit;
+        }
+        if j.lc {
+            lc |= bit;
+        }
+    }
+    s.next = Lanes {
+        e: [n1, n2, n3].map(I64x8::new),
+        rem: [na, nb, nc].map(I64x8::new),
+        idx: I64x8::new(nidx),
+    };
+    let [a, b, c] = s.moves;
+    s.moves = [
+        a.or(Mask8::from_bits(lanes)),
+        Mask8::from_bits((b.bits() & !lanes) | lb),
+        Mask8::from_bits((c.bits() & !lanes) | lc),
+    ];
 }
 
 /// How a packet walk decides which lanes hit.
@@ -277,6 +383,12 @@ fn step<const MODE: u8>(v: &Lanes, k: &Consts, tie: u8, prox: u8) -> Step {
 /// cold write-back gets copies), so the compiler keeps it in registers.
 struct Walker<'p, 'b> {
     plane: &'p [u8],
+    /// The line level a skipping walk reads (empty: none, or no skipping).
+    lines: &'p [u8],
+    /// With skipping: each lane's current cell, and the division by its
+    /// `inc_a` for jumps (made at the lane's first jump).
+    cur: [u8; LANES],
+    by_a: [Option<Reciprocal>; LANES],
     v: Lanes,
     k: Consts,
     book: &'b Book,
@@ -396,14 +508,18 @@ impl Walker<'_, '_> {
     /// ends lanes outside the plane, counts the visit and tests. Returns
     /// false when no lane is live any more.
     #[inline(always)]
-    fn visit<const MODE: u8, T: LaneTest>(&mut self, pk: &mut RayPacket8, test: &mut T) -> bool {
+    fn visit<const MODE: u8, const SKIP: bool, T: LaneTest>(
+        &mut self,
+        pk: &mut RayPacket8,
+        test: &mut T,
+    ) -> bool {
         let ia = self.v.idx.to_array();
         let mut cells = [0u8; LANES];
         let mut oob = 0u8;
         let mut any = 0u8;
         for ((slot, &i), &bit) in cells.iter_mut().zip(ia.iter()).zip(BIT.iter()) {
-            match self.plane.get(index_of(i)) {
-                Some(&c) => {
+            match cell_at::<SKIP>(self.plane, self.lines, index_of(i)) {
+                Some(c) => {
                     *slot = c;
                     any |= c;
                 }
@@ -432,6 +548,9 @@ impl Walker<'_, '_> {
                 return false;
             }
         }
+        if SKIP {
+            self.cur = cells;
+        }
         if MODE == ADAPTIVE {
             self.prox = if any & cell::PROXIMITY == 0 {
                 0
@@ -452,12 +571,12 @@ impl Walker<'_, '_> {
     /// that would pass their exit end instead. Returns false when no lane is
     /// live any more.
     #[inline(always)]
-    fn advance<const MODE: u8, const BLEND: bool>(
+    fn advance<const MODE: u8, const SKIP: bool, const BLEND: bool>(
         &mut self,
         pk: &mut RayPacket8,
         stepping: u8,
     ) -> bool {
-        let s = match MODE {
+        let mut s = match MODE {
             // Where no lane is near a surface (or owes a tie), every lane of
             // an Adaptive walk takes a 26-step: the cheaper TwentySix step,
             // with e3 kept.
@@ -466,6 +585,27 @@ impl Walker<'_, '_> {
             }
             _ => step::<MODE>(&self.v, &self.k, self.tie, self.prox),
         };
+        if SKIP && MODE != SIX {
+            // The lanes taking a 26-step, far enough from every
+            // non-transparent voxel, jump as their scalar rays do.
+            let runs = match MODE {
+                ADAPTIVE => stepping & !rules::takes_six(self.tie, self.prox),
+                _ => stepping,
+            } & self.live;
+            let [ra, _, _] = self.v.rem;
+            let ra = ra.to_array();
+            let mut ks = [0u32; LANES];
+            let mut jumping = 0u8;
+            for (((k, &c), &r), &bit) in ks.iter_mut().zip(&self.cur).zip(&ra).zip(&BIT) {
+                *k = skip::skip_count(c, rem_of(r));
+                if *k > 1 && runs & bit != 0 {
+                    jumping |= bit;
+                }
+            }
+            if jumping != 0 {
+                jump_lanes::<MODE>(pk, &mut self.by_a, &self.v, &mut s, jumping, &ks);
+            }
+        }
         let exits = s.exits & stepping;
         if exits != 0 {
             // Written back before the step, with the old moves and ties.
@@ -515,9 +655,10 @@ impl Walker<'_, '_> {
 
 /// Walks the packet from its lanes' states; see [`RayPacket8::walk`].
 #[inline(always)]
-pub(super) fn run<const MODE: u8, T: LaneTest>(
+pub(super) fn run<const MODE: u8, const SKIP: bool, T: LaneTest>(
     pk: &mut RayPacket8,
     plane: &[u8],
+    lines: &[u8],
     budget: u32,
     test: &mut T,
 ) -> PacketEnd {
@@ -533,6 +674,7 @@ pub(super) fn run<const MODE: u8, T: LaneTest>(
         fresh: 0,
     };
     let mut prox = 0u8;
+    let mut cur = [0u8; LANES];
     let mut e = [[0i64; LANES]; 3];
     let mut rem = [[0i64; LANES]; 3];
     let mut idx = [0i64; LANES];
@@ -552,11 +694,14 @@ pub(super) fn run<const MODE: u8, T: LaneTest>(
             }
             book.fresh |= bit;
         } else {
-            let Some(&c) = plane.get(s.index) else {
+            let Some(c) = cell_at::<SKIP>(plane, lines, s.index) else {
                 ray.set_state(State { done: true, ..s });
                 end.exit |= bit;
                 continue;
             };
+            if let Some(slot) = cur.get_mut(lane) {
+                *slot = c;
+            }
             if budget == 0 {
                 end.budget |= bit;
                 continue;
@@ -602,6 +747,9 @@ pub(super) fn run<const MODE: u8, T: LaneTest>(
     let tie = book.tie;
     let mut w = Walker {
         plane,
+        lines,
+        cur,
+        by_a: [None; LANES],
         v: Lanes {
             e: e.map(I64x8::new),
             rem: rem.map(I64x8::new),
@@ -630,13 +778,13 @@ pub(super) fn run<const MODE: u8, T: LaneTest>(
     let going = if stepping == 0 {
         true
     } else if stepping == live {
-        w.advance::<MODE, false>(pk, stepping)
+        w.advance::<MODE, SKIP, false>(pk, stepping)
     } else {
-        w.advance::<MODE, true>(pk, stepping)
+        w.advance::<MODE, SKIP, true>(pk, stepping)
     };
-    if going && w.visit::<MODE, T>(pk, test) {
+    if going && w.visit::<MODE, SKIP, T>(pk, test) {
         // Every live lane steps in every further iteration.
-        while w.advance::<MODE, false>(pk, w.live) && w.visit::<MODE, T>(pk, test) {}
+        while w.advance::<MODE, SKIP, false>(pk, w.live) && w.visit::<MODE, SKIP, T>(pk, test) {}
     }
     w.end
 }

@@ -8,8 +8,8 @@ use super::lanes::{I64x8, Mask8};
 use super::*;
 use crate::check_packet::{Walk, check_packet, check_packet_script};
 use crate::fixed::{VOXEL, voxel_centre};
-use crate::proximity::flag_neighbourhood;
-use crate::raster::RasterMut;
+use crate::proximity::{distance_field, flag_neighbourhood, line_distances};
+use crate::raster::{RasterMut, line_count};
 use crate::testkit::Rng;
 
 #[track_caller]
@@ -166,6 +166,7 @@ fn lanes_in_different_states_resume_like_their_scalar_rays() {
                 mode: Connectivity::ALL[rng.below(3) as usize],
                 budget: [0, 1, 2, 5, u32::MAX][rng.below(5) as usize],
                 hit_bits: [0, cell::OPAQUE, cell::PROXIMITY][rng.below(3) as usize],
+                skip: rng.chance(1, 2),
             })
             .collect();
         if let Err(v) = check_packet_script(&r, &p, &script) {
@@ -228,4 +229,91 @@ fn small_random_packets_match_their_scalar_rays() {
         let p = RayPacket8::new(e, origins, dirs).unwrap();
         check(&r, &p, &std::format!("seed {seed}"));
     }
+}
+
+/// A sparse plane with its distance field (jumps of up to `DISTANCE_LIMIT`
+/// voxels), its line level, and some cells disturbed so that the field is
+/// no longer exact: lanes must still equal their scalar skipping walks.
+fn skipping_plane(e: Extent, rng: &mut Rng, per_mille: u64, disturb: bool) -> (Vec<u8>, Vec<u8>) {
+    let mut plane: Vec<u8> = (0..e.len())
+        .map(|_| {
+            if rng.below(1000) < per_mille {
+                cell::OPAQUE
+            } else {
+                0
+            }
+        })
+        .collect();
+    distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+    let mut lines = vec![0u8; line_count(plane.len())];
+    line_distances(&Raster::new(e, &plane).unwrap(), &mut lines).unwrap();
+    if disturb {
+        for c in plane.iter_mut() {
+            if rng.chance(1, 50) {
+                *c = rng.next_u64().to_le_bytes()[0];
+            }
+        }
+    }
+    (plane, lines)
+}
+
+#[test]
+fn skipping_packets_match_their_scalar_skipping_walks() {
+    for seed in 0..120u64 {
+        let mut rng = Rng(seed ^ 0x5_1DE);
+        let dims = [0; 3].map(|_| 1 + rng.below(90) as u32);
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let per_mille = rng.below(4);
+        let (plane, lines) = skipping_plane(e, &mut rng, per_mille, seed % 3 == 0);
+        let plain = Raster::new(e, &plane).unwrap();
+        let with_lines = plain.with_lines(&lines).unwrap();
+        // A camera-like block: one origin, nearby directions.
+        let eye = [0, 1, 2]
+            .map(|k| rng.range(-i64::from(dims[k]) * VOXEL, 2 * i64::from(dims[k]) * VOXEL));
+        let aim = [0, 1, 2].map(|k| rng.range(0, i64::from(dims[k]) * VOXEL) - eye[k]);
+        let m = aim.iter().map(|v| v.unsigned_abs()).max().unwrap().max(1);
+        let d = aim.map(|v| (i128::from(v) * (1 << 28) / i128::from(m)) as i32);
+        let dirs = core::array::from_fn(|l| {
+            let (px, py) = ((l % 4) as i32, (l / 4) as i32);
+            [d[0] + px * 40_000, d[1] + py * 40_000, d[2] - px * 9_000]
+        });
+        let p = RayPacket8::new(e, [eye; LANES], dirs).unwrap();
+        for r in [&plain, &with_lines] {
+            check(r, &p, &std::format!("seed {seed}"));
+        }
+    }
+}
+
+/// Skipping lanes really jump: a camera block through empty space visits
+/// few voxels, each lane as many as its scalar skipping walk.
+#[test]
+fn skipping_lanes_jump() {
+    let e = Extent::cube(96).unwrap();
+    let mut plane = vec![cell::EMPTY; e.len()];
+    for y in 40..56 {
+        for z in 40..56 {
+            plane[e.index([90, y, z]).unwrap()] = cell::OPAQUE;
+        }
+    }
+    distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+    let r = Raster::new(e, &plane).unwrap();
+    let origin = [0, voxel_centre(47), voxel_centre(47)];
+    let dirs = core::array::from_fn(|l| [1 << 28, (l as i32 - 4) << 20, 3 << 18]);
+    let mut p = RayPacket8::new(e, [origin; LANES], dirs).unwrap();
+    for mode in Connectivity::ALL {
+        let mut q = p.clone();
+        assert_eq!(q.first_hit_skipping(&r, mode).unwrap(), 0xff, "{mode:?}");
+        for (lane, dir) in dirs.iter().enumerate() {
+            let mut ray = DiscreteRay::new(e, origin, *dir).unwrap().unwrap();
+            let hit = ray.first_hit_skipping(&r, mode).unwrap().unwrap();
+            assert_eq!(q.hit(lane), Some(hit));
+            assert_eq!(q.lane_ray(lane), Some(ray));
+            if mode != Connectivity::Six {
+                assert!(hit.steps < 30, "{mode:?} lane {lane}: {} steps", hit.steps);
+            }
+        }
+    }
+    check(&r, &p, "wall");
+    assert_eq!(p.first_hit(&r, Connectivity::TwentySix).unwrap(), 0xff);
+    assert_eq!(p.hit(0).unwrap().steps, 91);
 }

@@ -62,7 +62,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "T", default_value_t = 0, value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: usize,
     /// Walk primary rays in 8-ray packets (4×2 pixel blocks) instead of
-    /// one by one with empty-space skipping; the image is the same.
+    /// one by one (both skip empty space); the image is the same.
     #[arg(long)]
     pub packets: bool,
     /// View overrides.

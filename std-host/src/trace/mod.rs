@@ -238,11 +238,10 @@ pub struct TraceOptions {
     /// shadow rays (those of the light pass by default).
     pub light: LightParams,
     /// Walk primary rays eight at a time in a
-    /// [`RayPacket8`](rrt_core::packet::RayPacket8) instead of one by one
-    /// with empty-space skipping. Both give the same image (the packet is
-    /// bit-identical to the scalar walk); the packet does not skip empty
-    /// space, and the scalar walk, the faster of the two where it was
-    /// measured, is the default.
+    /// [`RayPacket8`](rrt_core::packet::RayPacket8) instead of one by one.
+    /// Both skip empty space and give the same image (each lane is
+    /// bit-identical to the scalar skipping walk); the scalar walk, the
+    /// faster of the two where it was measured, is the default.
     pub packets: bool,
     /// Before an exact shadow ray walks, try the object that last blocked
     /// a shadow ray towards the same light in the tile

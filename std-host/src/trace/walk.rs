@@ -147,8 +147,9 @@ impl Tracer<'_> {
     }
 
     /// Stage one for eight rays at once: a [`RayPacket8`] walks every lane
-    /// to its first non-transparent voxel; each lane's ray is left exactly
-    /// as the scalar [`Tracer::first_walk`] leaves it.
+    /// to its first non-transparent voxel, skipping empty space; each
+    /// lane's ray and step count are exactly those the scalar
+    /// [`Tracer::first_walk`] leaves.
     pub(super) fn first_walks_packet(
         &self,
         rays: &[Option<Ray>; BLOCK],
@@ -158,7 +159,9 @@ impl Tracer<'_> {
         let hits = RayPacket8::from_rays(self.extent, lanes)
             .ok()
             .and_then(|mut p| {
-                let hits = p.first_hit(&self.raster, self.opts.connectivity).ok()?;
+                let hits = p
+                    .first_hit_skipping(&self.raster, self.opts.connectivity)
+                    .ok()?;
                 Some((p, hits))
             });
         let Some((packet, hits)) = hits else {
