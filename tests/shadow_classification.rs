@@ -2,12 +2,13 @@
 //! scenes of small and overlapping spheres, triangles and cones, with
 //! lights inside and outside the raster, every voxel classified *lit* for
 //! a light has nothing but its own objects between any of its points and
-//! the light; and the exact mode's image with the classification is the
-//! image with an exact shadow ray for every light.
+//! the light; the classification computed on demand is the pass's; and
+//! the exact mode's image with the classification (from the records or
+//! on demand) is the image with an exact shadow ray for every light.
 
 use glam::DVec3;
 use indicatif::ProgressBar;
-use rrt_core::light::ExactRecords;
+use rrt_core::light::{ExactRecords, classify_voxel};
 use rrt_core::voxel::LightVisibility;
 use rrt_host::render::camera::Camera;
 use rrt_host::render::{Image, RenderOptions, render};
@@ -181,16 +182,62 @@ fn classified_shadows_render_as_exact_shadow_rays() {
         let nff = random_scene(seed, 40, 0.05);
         let vs = exact(&nff, 40, ExactRecords::Classify);
         let rays_only = exact(&nff, 40, ExactRecords::Skip);
+        let without = TraceOptions {
+            classify_on_demand: false,
+            ..TraceOptions::default()
+        };
+        // The pass's classification, the one computed on demand, and an
+        // exact shadow ray for every light of every hit.
         let (a, sa) = draw(&vs, TraceOptions::default(), 48);
         let (b, sb) = draw(&rays_only, TraceOptions::default(), 48);
-        assert_eq!(a.rgb, b.rgb, "seed {seed}");
-        assert_eq!(a.linear, b.linear, "seed {seed}");
+        let (c, sc) = draw(&rays_only, without, 48);
+        for (img, name) in [(&b, "on demand"), (&c, "shadow rays")] {
+            assert_eq!(a.rgb, img.rgb, "seed {seed}: {name}");
+            assert_eq!(a.linear, img.linear, "seed {seed}: {name}");
+        }
         assert!(
-            sa.classified > 0 && sb.classified == 0,
+            sa.classified > 0 && sc.classified == 0,
             "seed {seed}: {sa:?}"
         );
-        assert_eq!(sa.classified + sa.shadow, sb.shadow, "seed {seed}");
+        // The same function of (voxel, light) either way.
+        assert_eq!(sa.classified, sb.classified, "seed {seed}");
+        assert_eq!(sa.shadow, sb.shadow, "seed {seed}");
+        assert_eq!(sa.classified + sa.shadow, sc.shadow, "seed {seed}");
     }
+}
+
+/// The classification computed on demand is the pass's: for every record
+/// of exact objects and every light, [`classify_voxel`] gives the bits the
+/// pass stored.
+#[test]
+fn on_demand_classification_is_the_pass_classification() {
+    let mut compared = 0;
+    for seed in 40..46u64 {
+        let nff = random_scene(seed, 50, 0.05);
+        let vs = exact(&nff, 40, ExactRecords::Classify);
+        let raster = vs.raster().unwrap();
+        let store = vs.store().unwrap();
+        let lights: Vec<[i64; 3]> = vs
+            .lights
+            .iter()
+            .map(|l| vs.frame.to_fixed(l.position).unwrap())
+            .collect();
+        for (v, rec) in store.iter() {
+            if !store
+                .objects(rec)
+                .iter()
+                .all(|&o| vs.objects[o as usize].shape.is_exact())
+            {
+                continue;
+            }
+            for (k, &light) in lights.iter().enumerate() {
+                let got = classify_voxel(&raster, &store, v, rec, light).unwrap();
+                assert_eq!(got, rec.light(k), "seed {seed}: voxel {v:?}, light {k}");
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 5_000, "{compared} (voxel, light) pairs");
 }
 
 #[test]

@@ -139,8 +139,9 @@ pub enum ExactRecords {
     /// ray decides) elsewhere.
     Classify,
     /// No rays: every light [`LightVisibility::Translucent`], for a
-    /// renderer that decides every light of a verified hit with an exact
-    /// shadow ray.
+    /// renderer that decides every light of a verified hit itself: with an
+    /// exact shadow ray, or with the classification computed for the
+    /// voxels its hits need ([`classify_voxel`]).
     Skip,
 }
 
@@ -503,6 +504,43 @@ fn blocks<const N: usize>(
     true
 }
 
+/// The shadow classification of the voxel `v` holding record `rec` for a
+/// light at `light` (fixed units), as the light pass computes it for a
+/// record all of whose objects have exact geometry
+/// ([`ExactRecords::Classify`], module docs, *Shadow classification*):
+/// [`LightVisibility::Visible`] when only `rec`'s own objects can stand
+/// between any point of the voxel's closed cube and the light,
+/// [`LightVisibility::Translucent`] (undecided) otherwise. A renderer that
+/// skipped the classification in the pass ([`ExactRecords::Skip`]) computes
+/// it here for the voxels its hits need; the answer depends on nothing but
+/// the raster, the store, `v` and the light, so it may be memoized and
+/// computed in any order. The caller checks that the objects are exact.
+///
+/// Work: one walk of the segment's tube, bounded by the raster's size.
+///
+/// # Errors
+/// [`LightError::ExtentMismatch`] if `raster` and `store` differ in size;
+/// [`LightError::Ray`] for a light beyond the fixed-point range.
+pub fn classify_voxel(
+    raster: &Raster<'_>,
+    store: &RecordStore<'_>,
+    v: [u32; 3],
+    rec: &VoxelRecord,
+    light: [i64; 3],
+) -> Result<LightVisibility, LightError> {
+    if store.extent() != raster.extent() {
+        return Err(LightError::ExtentMismatch);
+    }
+    classify(
+        raster,
+        store,
+        v,
+        store.objects(rec),
+        v.map(voxel_centre),
+        light,
+    )
+}
+
 /// The shadow classification of voxel `v` (centre `c0`, objects `own`)
 /// for a light at `light` (module docs, *Shadow classification*):
 /// [`LightVisibility::Visible`] when every non-transparent voxel within
@@ -520,33 +558,46 @@ fn classify(
 ) -> Result<LightVisibility, LightError> {
     let extent = raster.extent();
     let plane = raster.plane();
-    // The last voxels found to hold only `own` objects: neighbouring path
-    // voxels share most of their neighbourhoods.
-    const PASSED: usize = 16;
-    let mut passed = [usize::MAX; PASSED];
-    let mut next = 0usize;
+    // The voxel tested last: when the walk moves to a face neighbour of
+    // it, only the new face of the neighbourhood needs a look (the rest
+    // was found to hold only `own` objects). A voxel of the path between
+    // two tested voxels that are not neighbours is not within 1 of an
+    // opaque voxel, so every opaque voxel near the path is looked up once.
+    let mut last: Option<[u32; 3]> = None;
+    let [_, sy, sz] = extent.strides().map(usize::cast_signed);
+    let own_index = extent.index(v);
     let mut foreign = |index: usize, _: u8| -> bool {
         let Some(u) = extent.coord(index) else {
             return true;
         };
-        for w in neighbourhood(extent, u) {
-            let Some(wi) = extent.index(w) else {
-                continue;
-            };
-            let c = plane.get(wi).copied().unwrap_or(0);
-            if c & cell::OPAQUE == 0 || w == v || passed.contains(&wi) {
-                continue;
+        let from = last.and_then(|p| face_step(p, u));
+        last = Some(u);
+        let [xs, ys, zs] = neighbour_offsets(extent, u, from);
+        for dz in zs {
+            for dy in ys.clone() {
+                for dx in xs.clone() {
+                    // Inside the raster by the offsets' ranges.
+                    let wi = index
+                        .wrapping_add_signed(isize::from(dz).wrapping_mul(sz))
+                        .wrapping_add_signed(isize::from(dy).wrapping_mul(sy))
+                        .wrapping_add_signed(isize::from(dx));
+                    let c = plane.get(wi).copied().unwrap_or(0);
+                    if c & cell::OPAQUE == 0 || Some(wi) == own_index {
+                        continue;
+                    }
+                    let w = [
+                        u[0].wrapping_add_signed(i32::from(dx)),
+                        u[1].wrapping_add_signed(i32::from(dy)),
+                        u[2].wrapping_add_signed(i32::from(dz)),
+                    ];
+                    let Some(rec) = view.get_hinted(w, c) else {
+                        return true;
+                    };
+                    if !view.objects(rec).iter().all(|o| own.contains(o)) {
+                        return true;
+                    }
+                }
             }
-            let Some(rec) = view.get_hinted(w, c) else {
-                return true;
-            };
-            if !view.objects(rec).iter().all(|o| own.contains(o)) {
-                return true;
-            }
-            if let Some(slot) = passed.get_mut(next) {
-                *slot = wi;
-            }
-            next = next.wrapping_add(1) & (PASSED - 1);
         }
         false
     };
@@ -565,17 +616,51 @@ fn classify(
     })
 }
 
-/// The voxels within chessboard distance 1 of `u` inside `extent` (`u`
-/// among them).
-fn neighbourhood(extent: Extent, u: [u32; 3]) -> impl Iterator<Item = [u32; 3]> {
-    let [nx, ny, nz] = extent.dims();
-    let span = |c: u32, n: u32| c.saturating_sub(1)..=c.saturating_add(1).min(n.saturating_sub(1));
-    let (xs, ys, zs) = (span(u[0], nx), span(u[1], ny), span(u[2], nz));
-    zs.flat_map(move |z| {
-        let xs = xs.clone();
-        ys.clone()
-            .flat_map(move |y| xs.clone().map(move |x| [x, y, z]))
+/// The offsets (per axis, each in −1..=1) of the voxels within chessboard
+/// distance 1 of `u` inside `extent` (`u` among them); with
+/// `from = Some((axis, up))`, for `u` entered from its face neighbour
+/// below (`up`) or above on `axis`, only of those not within distance 1 of
+/// that neighbour: the nine on `u`'s far side.
+fn neighbour_offsets(
+    extent: Extent,
+    u: [u32; 3],
+    from: Option<(usize, bool)>,
+) -> [core::ops::RangeInclusive<i8>; 3] {
+    let dims = extent.dims();
+    core::array::from_fn(|k| {
+        let (c, n) = (u[k], dims[k]);
+        let lo: i8 = if c > 0 { -1 } else { 0 };
+        let hi: i8 = if c.saturating_add(1) < n { 1 } else { 0 };
+        // The far side only, which is empty where `u` lies on the
+        // raster's face (then `0..=-1` or `1..=0`).
+        match from {
+            Some((axis, true)) if axis == k => hi..=hi.wrapping_mul(2).wrapping_sub(1),
+            Some((axis, false)) if axis == k => lo.wrapping_mul(2).wrapping_add(1)..=lo,
+            _ => lo..=hi,
+        }
     })
+}
+
+/// The axis and direction (`true`: up) of the step from voxel `p` to `u`
+/// when they are face neighbours.
+fn face_step(p: [u32; 3], u: [u32; 3]) -> Option<(usize, bool)> {
+    let mut step = None;
+    for (k, (&a, &b)) in p.iter().zip(u.iter()).enumerate() {
+        if a == b {
+            continue;
+        }
+        if step.is_some() {
+            return None;
+        }
+        if b == a.wrapping_add(1) {
+            step = Some((k, true));
+        } else if a == b.wrapping_add(1) {
+            step = Some((k, false));
+        } else {
+            return None;
+        }
+    }
+    step
 }
 
 /// The acne rule of the module docs, for any ray that leaves a surface

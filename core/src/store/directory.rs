@@ -228,8 +228,16 @@ impl<'a> RecordStore<'a> {
     /// The same result as `get_voxel` whatever `c` holds.
     #[must_use]
     pub fn get_hinted(&self, v: [u32; 3], c: u8) -> Option<&'a VoxelRecord> {
-        let i = find(self.extent, self.dir, self.records, v, cell_hint(c))?;
-        self.records.get(i)
+        self.records.get(self.index_hinted(v, c)?)
+    }
+
+    /// The position in [`records`](Self::records) of voxel `v`'s record
+    /// (`None` for a transparent or outside voxel), found as
+    /// [`get_hinted`](Self::get_hinted) finds it: a host keeps per-record
+    /// data beside the store under this index.
+    #[must_use]
+    pub fn index_hinted(&self, v: [u32; 3], c: u8) -> Option<usize> {
+        find(self.extent, self.dir, self.records, v, cell_hint(c))
     }
 
     /// The raster's dimensions.

@@ -148,6 +148,10 @@ pub mod shading;
 pub mod verify;
 pub mod walk;
 
+use std::fmt;
+use std::sync::Arc;
+use std::sync::atomic::AtomicU16;
+
 use glam::DVec3;
 use rrt_core::discrete_ray::Connectivity;
 use rrt_core::light::{ExactRecords, LeavingSurface, LightParams};
@@ -248,6 +252,15 @@ pub struct TraceOptions {
     /// ([`RayStats::blockers`]). On by default; the image is the same
     /// without it (every shadow ray then walks).
     pub last_blocker: bool,
+    /// On a raster whose light pass left the records of exact objects
+    /// unclassified ([`ExactRecords::Skip`], what `rrt render SCENE`
+    /// builds), compute the shadow classification of a hit's voxel for a
+    /// light when a hit first needs it and keep it for the render
+    /// ([`rrt_core::light::classify_voxel`]): a voxel proven lit is then
+    /// lit for every later hit in it without a shadow ray. On by default;
+    /// the image is the same without it (every light of every hit then
+    /// fires an exact shadow ray).
+    pub classify_on_demand: bool,
 }
 
 impl Default for TraceOptions {
@@ -259,6 +272,7 @@ impl Default for TraceOptions {
             light: LightParams::default(),
             packets: false,
             last_blocker: true,
+            classify_on_demand: true,
         }
     }
 }
@@ -428,16 +442,63 @@ pub struct Tracer<'s> {
     lights_fx: Vec<Option<[i64; 3]>>,
     /// The volumes rendered directly, by object id.
     direct: &'s [crate::voxelize::direct::DirectVolume],
-    /// The records of exact objects hold the shadow classification, and
+    /// Where the shadow classification of exact records comes from, when
     /// the shadow segments stay close enough to the ones it covers
     /// ([`Tracer::exact_light`]) to use it.
-    classified: bool,
+    classification: Classification,
     /// How far rays leaving a verified hit start off the surface
     /// ([`Tracer::leaving`]).
     offset: f64,
     background: DVec3,
     intensity: f64,
     opts: TraceOptions,
+}
+
+/// The source of the shadow classification of a render
+/// ([`Tracer::exact_light`]). Clones share what was computed.
+#[derive(Clone)]
+enum Classification {
+    /// None: every light of a verified hit fires an exact shadow ray.
+    Unavailable,
+    /// The records' light bits hold it ([`ExactRecords::Classify`]).
+    Records,
+    /// Computed when a hit first needs it, per record and light, and kept:
+    /// two bits per light and record (index as in
+    /// [`RecordStore::records`]), [`Classification::UNKNOWN`],
+    /// [`Classification::LIT`] or [`Classification::UNDECIDED`]. The
+    /// answer is a function of the record and the light alone, so the
+    /// order in which threads fill it in changes nothing.
+    OnDemand(Arc<[AtomicU16]>),
+}
+
+impl fmt::Debug for Classification {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Unavailable => f.write_str("Unavailable"),
+            Self::Records => f.write_str("Records"),
+            Self::OnDemand(memo) => write!(f, "OnDemand({} records)", memo.len()),
+        }
+    }
+}
+
+impl Classification {
+    const UNKNOWN: u16 = 0;
+    const LIT: u16 = 1;
+    const UNDECIDED: u16 = 2;
+
+    /// The classification a tracer over `scene` with `opts` can use.
+    fn of(scene: &VoxelScene, store: &RecordStore<'_>, opts: &TraceOptions) -> Self {
+        if !scene.exact || surface_offset(&scene.frame) >= scene.frame.voxel_size / 8.0 {
+            return Self::Unavailable;
+        }
+        match scene.exact_records {
+            ExactRecords::Classify => Self::Records,
+            ExactRecords::Skip if opts.classify_on_demand && opts.mode.exact_shadows() => {
+                Self::OnDemand((0..store.len()).map(|_| AtomicU16::new(0)).collect())
+            }
+            _ => Self::Unavailable,
+        }
+    }
 }
 
 /// Why a tracer cannot be set up.
@@ -501,9 +562,7 @@ impl<'s> Tracer<'s> {
             lights: &scene.lights,
             lights_fx,
             direct: &scene.direct,
-            classified: scene.exact
-                && scene.exact_records == ExactRecords::Classify
-                && surface_offset(&scene.frame) < scene.frame.voxel_size / 8.0,
+            classification: Classification::of(scene, &store, &opts),
             offset: surface_offset(&scene.frame),
             background: scene.background,
             intensity: scene.intensity(),

@@ -4,16 +4,18 @@
 //! refracted rays, which leave the surface by the acne rule (module docs
 //! of [`crate::trace`]).
 
+use std::sync::atomic::Ordering;
+
 use glam::DVec3;
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
-use rrt_core::light::LeavingSurface;
+use rrt_core::light::{LeavingSurface, classify_voxel};
 use rrt_core::raster::cell;
 use rrt_core::voxel::LightVisibility;
 use rrt_core::voxelize::NORMAL_ONE;
 
 use super::verify::Mailbox;
 use super::walk::surface_voxel;
-use super::{RayStats, SurfaceHit, Tracer, shading};
+use super::{Classification, RayStats, SurfaceHit, Tracer, shading};
 use crate::frame::unit_to_fixed;
 use crate::scene::Material;
 use crate::world::Ray;
@@ -203,10 +205,12 @@ impl Tracer<'_> {
     /// the exact mode, with `embree_nff`'s shadow ray: from `origin`
     /// ([`Tracer::leaving_point`], ε off the surface) in the direction
     /// from the hit to the light, ending `2ε` short of the light's
-    /// distance. Where the record of the voxel holding `origin` has the
-    /// shadow classification's *lit* for the light (only the voxel's own
-    /// objects can stand between any of its points and the light,
-    /// [`rrt_core::light`]), those objects are intersected with the
+    /// distance. Where the voxel holding `origin` has the shadow
+    /// classification's *lit* for the light (only the voxel's own objects
+    /// can stand between any of its points and the light,
+    /// [`rrt_core::light`]; from its record's bits, or computed on demand
+    /// and kept, [`TraceOptions::classify_on_demand`](super::TraceOptions::classify_on_demand)),
+    /// those objects are intersected with the
     /// segment and nothing is walked; otherwise an exact shadow ray
     /// decides ([`Tracer::exact_shadow`]). Both give the exact answer: the
     /// segment stays within 3ε of the one from `origin` to the light,
@@ -251,10 +255,11 @@ impl Tracer<'_> {
 
     /// The objects of the voxel holding world point `p`, when the shadow
     /// classification says it is lit for light `k`: every object of the
-    /// voxel has exact geometry and its record's bits for the light say
-    /// [`LightVisibility::Visible`] on a classified raster.
+    /// voxel has exact geometry and the classification (its record's bits
+    /// for the light, or the one computed on demand and kept) is
+    /// [`LightVisibility::Visible`].
     fn classified_lit(&self, p: DVec3, k: usize) -> Option<&[u32]> {
-        if !self.classified {
+        if matches!(self.classification, Classification::Unavailable) {
             return None;
         }
         let r = self.frame.world_to_raster(p).floor();
@@ -272,19 +277,48 @@ impl Tracer<'_> {
         if c & cell::OPAQUE == 0 {
             return None;
         }
-        let rec = self.store.get_hinted(v, c)?;
-        if rec.light(k) != LightVisibility::Visible {
-            return None;
-        }
+        let at = self.store.index_hinted(v, c)?;
+        let rec = self.store.records().get(at)?;
         let own = self.store.objects(rec);
-        own.iter()
-            .all(|&id| {
+        let exact = || {
+            own.iter().all(|&id| {
                 usize::try_from(id)
                     .ok()
                     .and_then(|i| self.objects.get(i))
                     .is_some_and(|o| o.shape.is_exact())
             })
-            .then_some(own)
+        };
+        let lit = match &self.classification {
+            Classification::Unavailable => false,
+            Classification::Records => rec.light(k) == LightVisibility::Visible && exact(),
+            Classification::OnDemand(memo) => {
+                let (Some(slot), Some(Some(light)), Ok(shift)) =
+                    (memo.get(at), self.lights_fx.get(k), u32::try_from(2 * k))
+                else {
+                    return None;
+                };
+                if shift >= 16 {
+                    return None;
+                }
+                let known = (slot.load(Ordering::Relaxed) >> shift) & 3;
+                let answer = if known == Classification::UNKNOWN {
+                    let lit = exact()
+                        && classify_voxel(&self.raster, &self.store, v, rec, *light)
+                            == Ok(LightVisibility::Visible);
+                    let answer = if lit {
+                        Classification::LIT
+                    } else {
+                        Classification::UNDECIDED
+                    };
+                    slot.fetch_or(answer << shift, Ordering::Relaxed);
+                    answer
+                } else {
+                    known
+                };
+                answer == Classification::LIT
+            }
+        };
+        lit.then_some(own)
     }
 
     /// Whether a ray leaving verified hit `h` towards the side `n` can
