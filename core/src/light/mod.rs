@@ -563,15 +563,19 @@ fn classify(
     // was found to hold only `own` objects). A voxel of the path between
     // two tested voxels that are not neighbours is not within 1 of an
     // opaque voxel, so every opaque voxel near the path is looked up once.
-    let mut last: Option<[u32; 3]> = None;
-    let [_, sy, sz] = extent.strides().map(usize::cast_signed);
+    let mut last: Option<(usize, [u32; 3])> = None;
+    let strides = extent.strides();
+    let [_, sy, sz] = strides.map(usize::cast_signed);
     let own_index = extent.index(v);
     let mut foreign = |index: usize, _: u8| -> bool {
-        let Some(u) = extent.coord(index) else {
-            return true;
+        let (u, from) = match last.and_then(|(at, p)| face_step(extent, strides, at, p, index)) {
+            Some((u, step)) => (u, Some(step)),
+            None => match extent.coord(index) {
+                Some(u) => (u, None),
+                None => return true,
+            },
         };
-        let from = last.and_then(|p| face_step(p, u));
-        last = Some(u);
+        last = Some((index, u));
         let [xs, ys, zs] = neighbour_offsets(extent, u, from);
         for dz in zs {
             for dy in ys.clone() {
@@ -641,26 +645,35 @@ fn neighbour_offsets(
     })
 }
 
-/// The axis and direction (`true`: up) of the step from voxel `p` to `u`
-/// when they are face neighbours.
-fn face_step(p: [u32; 3], u: [u32; 3]) -> Option<(usize, bool)> {
-    let mut step = None;
-    for (k, (&a, &b)) in p.iter().zip(u.iter()).enumerate() {
-        if a == b {
-            continue;
-        }
-        if step.is_some() {
-            return None;
-        }
-        if b == a.wrapping_add(1) {
-            step = Some((k, true));
-        } else if a == b.wrapping_add(1) {
-            step = Some((k, false));
+/// The voxel at `index` with the axis and direction (`true`: up) of the
+/// step to it from voxel `p` (at index `at`), when they are face
+/// neighbours; found from the index difference, without a division (a
+/// voxel inside the raster whose index is `index` is the voxel at `index`).
+fn face_step(
+    extent: Extent,
+    strides: [usize; 3],
+    at: usize,
+    p: [u32; 3],
+    index: usize,
+) -> Option<([u32; 3], (usize, bool))> {
+    let d = index.wrapping_sub(at);
+    let dims = extent.dims();
+    (0..3).find_map(|k| {
+        let (stride, c, n) = (*strides.get(k)?, *p.get(k)?, *dims.get(k)?);
+        let (c, up) = if d == stride {
+            (c.checked_add(1)?, true)
+        } else if d == stride.wrapping_neg() {
+            (c.checked_sub(1)?, false)
         } else {
             return None;
+        };
+        if c >= n {
+            return None;
         }
-    }
-    step
+        let mut u = p;
+        *u.get_mut(k)? = c;
+        Some((u, (k, up)))
+    })
 }
 
 /// The acne rule of the module docs, for any ray that leaves a surface
