@@ -565,8 +565,15 @@ fn classify(
     // opaque voxel, so every opaque voxel near the path is looked up once.
     let mut last: Option<(usize, [u32; 3])> = None;
     let strides = extent.strides();
-    let [_, sy, sz] = strides.map(usize::cast_signed);
+    let signed = strides.map(usize::cast_signed);
+    let dims = extent.dims();
     let own_index = extent.index(v);
+    // Whether the opaque voxel `w` (cell `c`) holds an object not in
+    // `own`, or has no record.
+    let holds_foreign = |w: [u32; 3], c: u8| -> bool {
+        view.get_hinted(w, c)
+            .is_none_or(|rec| !view.objects(rec).iter().all(|o| own.contains(o)))
+    };
     let mut foreign = |index: usize, _: u8| -> bool {
         let (u, from) = match last.and_then(|(at, p)| face_step(extent, strides, at, p, index)) {
             Some((u, step)) => (u, Some(step)),
@@ -576,14 +583,57 @@ fn classify(
             },
         };
         last = Some((index, u));
+        let interior = (0..3).all(|k| u[k] > 0 && u[k].saturating_add(1) < dims[k]);
+        if interior {
+            // Every neighbour is inside the raster: counted loops over
+            // the offsets, no clipping.
+            // The neighbours at offsets `lo..hi` on axis `k` and −1..2 on
+            // the other two.
+            let scan = |k: usize, lo: i8, hi: i8| -> bool {
+                let k = k.min(2);
+                let (j1, j2) = match k {
+                    0 => (1, 2),
+                    1 => (0, 2),
+                    _ => (0, 1),
+                };
+                for a in lo..hi {
+                    let ka = isize::from(a).wrapping_mul(signed[k]);
+                    for b in -1i8..2 {
+                        let jb = ka.wrapping_add(isize::from(b).wrapping_mul(signed[j1]));
+                        for d in -1i8..2 {
+                            let wi = index
+                                .wrapping_add_signed(jb)
+                                .wrapping_add_signed(isize::from(d).wrapping_mul(signed[j2]));
+                            let c = plane.get(wi).copied().unwrap_or(0);
+                            if c & cell::OPAQUE == 0 || Some(wi) == own_index {
+                                continue;
+                            }
+                            let mut w = u;
+                            w[k] = w[k].wrapping_add_signed(i32::from(a));
+                            w[j1] = w[j1].wrapping_add_signed(i32::from(b));
+                            w[j2] = w[j2].wrapping_add_signed(i32::from(d));
+                            if holds_foreign(w, c) {
+                                return true;
+                            }
+                        }
+                    }
+                }
+                false
+            };
+            return match from {
+                Some((k, true)) => scan(k, 1, 2),
+                Some((k, false)) => scan(k, -1, 0),
+                None => scan(2, -1, 2),
+            };
+        }
         let [xs, ys, zs] = neighbour_offsets(extent, u, from);
         for dz in zs {
             for dy in ys.clone() {
                 for dx in xs.clone() {
                     // Inside the raster by the offsets' ranges.
                     let wi = index
-                        .wrapping_add_signed(isize::from(dz).wrapping_mul(sz))
-                        .wrapping_add_signed(isize::from(dy).wrapping_mul(sy))
+                        .wrapping_add_signed(isize::from(dz).wrapping_mul(signed[2]))
+                        .wrapping_add_signed(isize::from(dy).wrapping_mul(signed[1]))
                         .wrapping_add_signed(isize::from(dx));
                     let c = plane.get(wi).copied().unwrap_or(0);
                     if c & cell::OPAQUE == 0 || Some(wi) == own_index {
@@ -594,10 +644,7 @@ fn classify(
                         u[1].wrapping_add_signed(i32::from(dy)),
                         u[2].wrapping_add_signed(i32::from(dz)),
                     ];
-                    let Some(rec) = view.get_hinted(w, c) else {
-                        return true;
-                    };
-                    if !view.objects(rec).iter().all(|o| own.contains(o)) {
+                    if holds_foreign(w, c) {
                         return true;
                     }
                 }
