@@ -53,14 +53,16 @@ impl Run {
     }
 }
 
-/// Runs `cmd` under `/usr/bin/time` (wall time and peak memory) when it
-/// exists, else timed here.
+/// Runs `cmd`, timed here (the wall time from spawning to exit, to the
+/// clock's resolution), under `/usr/bin/time` for its peak memory when
+/// that exists (its own wall time has only 10 ms steps, too coarse for
+/// processes of a tenth of a second).
 fn run(cmd: &Path, args: &[String]) -> Res<Run> {
     let time = Path::new("/usr/bin/time");
     let t = Instant::now();
     let o = if time.is_file() {
         Command::new(time)
-            .args(["-f", "TIME %e %M"])
+            .args(["-f", "TIME %M"])
             .arg(cmd)
             .args(args)
             .output()?
@@ -73,16 +75,11 @@ fn run(cmd: &Path, args: &[String]) -> Res<Run> {
     if !o.status.success() {
         return Err(format!("{} {}: {out}", cmd.display(), args.join(" ")).into());
     }
-    let (wall, rss) = out
+    let rss = out
         .lines()
         .find_map(|l| l.strip_prefix("TIME "))
-        .and_then(|l| {
-            let mut it = l.split_whitespace();
-            let w: f64 = it.next()?.parse().ok()?;
-            let kb: f64 = it.next()?.parse().ok()?;
-            Some((w, kb / 1024.0))
-        })
-        .unwrap_or((wall, f64::NAN));
+        .and_then(|l| l.trim().parse::<f64>().ok())
+        .map_or(f64::NAN, |kb| kb / 1024.0);
     Ok(Run { wall, rss, out })
 }
 
@@ -410,8 +407,9 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
     let md = &mut ctx.md;
     md.h2("The whole job against Embree");
     md.para(&format!(
-        "Whole processes, {0}×{0}, depth 3, every run of one configuration interleaved with the \
-         others round by round (medians of {1}). **rrt**: `rrt render SCENE -o x.png --linear \
+        "Whole processes, {0}×{0}, depth 3, each timed by the bench from its start to its exit, \
+         every run of one configuration interleaved with the others round by round (medians of \
+         {1}). **rrt**: `rrt render SCENE -o x.png --linear \
          --width {0} --height {0} --threads T` with every other setting at its default: the \
          exact mode and the raster fitted to the scene and the image. **Embree**: `embree_nff -w \
          {0} -h {0} -d 3 -T -t T` ({how}; `-T` traces refraction, which only scenes with T > 0 \
