@@ -10,7 +10,7 @@ use glam::DVec3;
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use rrt_core::light::{LeavingSurface, classify_voxel};
 use rrt_core::raster::cell;
-use rrt_core::voxel::LightVisibility;
+use rrt_core::voxel::{LightVisibility, VoxelRecord};
 use rrt_core::voxelize::NORMAL_ONE;
 
 use super::verify::Mailbox;
@@ -74,6 +74,9 @@ impl Tracer<'_> {
         let p = h.point;
         // Shadow and reflected rays leave towards the viewer's side.
         let (origin, tmin) = self.leaving_point(h, n);
+        // The voxel holding `origin`, looked up for the first light that
+        // asks the shadow classification.
+        let mut origin_voxel = None;
         for (k, light) in self.lights.iter().enumerate() {
             let to = light.position - p;
             let dist = to.length();
@@ -88,7 +91,7 @@ impl Tracer<'_> {
             let vis = h.rec.light(k);
             let exact = self.opts.mode.exact_shadows() && h.verified;
             let att = match vis {
-                _ if exact => self.exact_light(h, n, origin, k, stats),
+                _ if exact => self.exact_light(h, n, origin, &mut origin_voxel, k, stats),
                 LightVisibility::Visible => 1.0,
                 LightVisibility::Translucent => {
                     stats.shadow += 1;
@@ -217,11 +220,12 @@ impl Tracer<'_> {
     /// and the classification's tube covers that much and more while 3ε
     /// is under half a voxel (the tracer uses it only where ε is under an
     /// eighth of a voxel: rasters up to about 7,000 voxels across).
-    fn exact_light(
-        &self,
+    fn exact_light<'s>(
+        &'s self,
         h: &SurfaceHit,
         n: DVec3,
         origin: DVec3,
+        origin_voxel: &mut Option<Option<OriginVoxel<'s>>>,
         k: usize,
         stats: &mut RayStats,
     ) -> f64 {
@@ -235,7 +239,8 @@ impl Tracer<'_> {
         }
         let segment = Ray::new(origin, to / dist);
         let tmax = dist - 2.0 * self.offset;
-        if let Some(own) = self.classified_lit(origin, k) {
+        let voxel = *origin_voxel.get_or_insert_with(|| self.origin_voxel(origin));
+        if let Some(own) = voxel.and_then(|v| self.classified_lit(&v, k)) {
             stats.classified += 1;
             let mut att = 1.0;
             let skip = (!self.meets_itself(h, n)).then_some(h.object);
@@ -253,12 +258,52 @@ impl Tracer<'_> {
         self.exact_shadow(h, n, &segment, tmax, k, stats)
     }
 
-    /// The objects of the voxel holding world point `p`, when the shadow
-    /// classification says it is lit for light `k`: every object of the
-    /// voxel has exact geometry and the classification (its record's bits
-    /// for the light, or the one computed on demand and kept) is
-    /// [`LightVisibility::Visible`].
-    fn classified_lit(&self, p: DVec3, k: usize) -> Option<&[u32]> {
+    /// The objects of voxel `o` (the one holding a shadow ray's origin,
+    /// [`Tracer::origin_voxel`]), when the shadow classification says it
+    /// is lit for light `k`: every object of the voxel has exact geometry
+    /// and the classification (its record's bits for the light, or the one
+    /// computed on demand and kept) is [`LightVisibility::Visible`].
+    fn classified_lit<'v>(&self, o: &OriginVoxel<'v>, k: usize) -> Option<&'v [u32]> {
+        if !o.exact {
+            return None;
+        }
+        let lit = match &self.classification {
+            Classification::Unavailable => false,
+            Classification::Records => o.rec.light(k) == LightVisibility::Visible,
+            Classification::OnDemand(memo) => {
+                let (Some(slot), Some(Some(light)), Ok(shift)) =
+                    (memo.get(o.at), self.lights_fx.get(k), u32::try_from(2 * k))
+                else {
+                    return None;
+                };
+                if shift >= 16 {
+                    return None;
+                }
+                let known = (slot.load(Ordering::Relaxed) >> shift) & 3;
+                let answer = if known == Classification::UNKNOWN {
+                    let lit = classify_voxel(&self.raster, &self.store, o.voxel, o.rec, *light)
+                        == Ok(LightVisibility::Visible);
+                    let answer = if lit {
+                        Classification::LIT
+                    } else {
+                        Classification::UNDECIDED
+                    };
+                    slot.fetch_or(answer << shift, Ordering::Relaxed);
+                    answer
+                } else {
+                    known
+                };
+                answer == Classification::LIT
+            }
+        };
+        lit.then_some(o.own)
+    }
+
+    /// The opaque voxel holding world point `p` with its record, for the
+    /// shadow classification ([`Tracer::classified_lit`]); `None` where
+    /// there is no classification, or `p` lies outside the raster or in a
+    /// transparent voxel or one without a record.
+    fn origin_voxel(&self, p: DVec3) -> Option<OriginVoxel<'_>> {
         if matches!(self.classification, Classification::Unavailable) {
             return None;
         }
@@ -280,45 +325,19 @@ impl Tracer<'_> {
         let at = self.store.index_hinted(v, c)?;
         let rec = self.store.records().get(at)?;
         let own = self.store.objects(rec);
-        let exact = || {
-            own.iter().all(|&id| {
-                usize::try_from(id)
-                    .ok()
-                    .and_then(|i| self.objects.get(i))
-                    .is_some_and(|o| o.shape.is_exact())
-            })
-        };
-        let lit = match &self.classification {
-            Classification::Unavailable => false,
-            Classification::Records => rec.light(k) == LightVisibility::Visible && exact(),
-            Classification::OnDemand(memo) => {
-                let (Some(slot), Some(Some(light)), Ok(shift)) =
-                    (memo.get(at), self.lights_fx.get(k), u32::try_from(2 * k))
-                else {
-                    return None;
-                };
-                if shift >= 16 {
-                    return None;
-                }
-                let known = (slot.load(Ordering::Relaxed) >> shift) & 3;
-                let answer = if known == Classification::UNKNOWN {
-                    let lit = exact()
-                        && classify_voxel(&self.raster, &self.store, v, rec, *light)
-                            == Ok(LightVisibility::Visible);
-                    let answer = if lit {
-                        Classification::LIT
-                    } else {
-                        Classification::UNDECIDED
-                    };
-                    slot.fetch_or(answer << shift, Ordering::Relaxed);
-                    answer
-                } else {
-                    known
-                };
-                answer == Classification::LIT
-            }
-        };
-        lit.then_some(own)
+        let exact = own.iter().all(|&id| {
+            usize::try_from(id)
+                .ok()
+                .and_then(|i| self.objects.get(i))
+                .is_some_and(|o| o.shape.is_exact())
+        });
+        Some(OriginVoxel {
+            voxel: v,
+            at,
+            rec,
+            own,
+            exact,
+        })
     }
 
     /// Whether a ray leaving verified hit `h` towards the side `n` can
@@ -474,4 +493,21 @@ impl Tracer<'_> {
         let dims = self.extent.dims();
         (0..3).all(|a| r[a] > 0.0 && r[a] < f64::from(dims[a]))
     }
+}
+
+/// The voxel holding a hit's shadow-ray origin, looked up once for all
+/// the lights of the hit ([`Tracer::origin_voxel`]).
+#[derive(Clone, Copy, Debug)]
+struct OriginVoxel<'a> {
+    /// Its coordinates.
+    voxel: [u32; 3],
+    /// Its record's position in the store (the memo's index).
+    at: usize,
+    /// Its record.
+    rec: &'a VoxelRecord,
+    /// Its objects.
+    own: &'a [u32],
+    /// Whether every one of them has exact geometry (else no
+    /// classification applies).
+    exact: bool,
 }
