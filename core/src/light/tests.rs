@@ -9,7 +9,7 @@ use crate::fixed::VOXEL;
 use crate::geometry::{Cuboid, Sphere, Torus, Triangle};
 use crate::object_table::{Light, Material, Object, SCALAR_ONE, Shape};
 use crate::store::{Limits, ObjectAttrs, RecordStore, RecordStoreMut};
-use crate::testkit::{self, Scene};
+use crate::testkit::{self, Scene, Voxelize};
 use crate::voxelize::{Separation, VoxelSink};
 
 /// An object-table entry of material 0 that no shadow ray can meet (a
@@ -511,4 +511,113 @@ fn runs_in_any_order_equal_the_serial_pass() {
     assert_eq!(out, serial);
     assert_eq!(report, serial_report);
     assert!(report.translucent > 0 && report.visible > 0);
+}
+
+/// The tube rule of the module docs (*Shadow classification*), written
+/// out: `Visible` exactly when no voxel within chessboard distance 1 of a
+/// voxel of the 6-connected segment from `v`'s centre to `light`
+/// (clipped to the raster) is opaque and holds an object not among `v`'s
+/// own or has no record.
+fn tube_rule(raster: &Raster<'_>, store: &RecordStore<'_>, v: [u32; 3], light: [i64; 3]) -> bool {
+    let e = raster.extent();
+    let own = store.objects(store.get_voxel(v).unwrap());
+    let Some(ray) = DiscreteRay::segment(e, v.map(voxel_centre), light).unwrap() else {
+        return true;
+    };
+    for p in ray.voxels(raster, Connectivity::Six).unwrap() {
+        let p = e.coord(p.index).unwrap();
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let w = [
+                        p[0].wrapping_add_signed(dx),
+                        p[1].wrapping_add_signed(dy),
+                        p[2].wrapping_add_signed(dz),
+                    ];
+                    if !e.contains(w) || w == v || raster.cell(w).unwrap() & cell::OPAQUE == 0 {
+                        continue;
+                    }
+                    match store.get_voxel(w) {
+                        Some(r) if store.objects(r).iter().all(|o| own.contains(o)) => {}
+                        _ => return false,
+                    }
+                }
+            }
+        }
+    }
+    true
+}
+
+/// [`classify_voxel`] is the tube rule, on random overlapping balls cut by
+/// the faces of small rasters (voxels on the faces, where the walk's test
+/// clips the neighbourhood, and inside), with lights inside the raster and
+/// outside it.
+#[test]
+fn classification_is_the_tube_rule() {
+    let mut rng = testkit::Rng(0x5eed_c1a5_5f1e);
+    let (mut lit, mut undecided) = (0u32, 0u32);
+    for _ in 0..30 {
+        let dims = [0; 3].map(|_| 4 + rng.below_u32(14));
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let balls: Vec<([i64; 3], i64)> = (0..2 + rng.below(4))
+            .map(|_| {
+                let c = dims.map(|n| rng.range(-VOXEL, i64::from(n) * VOXEL + VOXEL));
+                (c, rng.range(VOXEL / 2, 4 * VOXEL))
+            })
+            .collect();
+        let shapes: Vec<_> = balls
+            .iter()
+            .map(|&(c, r)| {
+                move |s: &mut dyn VoxelSink| testkit::sphere(e, c, r, Separation::TwentySix, s)
+            })
+            .collect();
+        let objects: Vec<Voxelize<'_>> = shapes
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (attrs(i as u32, 0), f as &dyn Fn(&mut dyn VoxelSink)))
+            .collect();
+        let mut scene = testkit::build(e, &objects, LIM);
+        crate::proximity::distance_field(
+            &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
+        );
+        let raster = Raster::new(e, &scene.plane).unwrap();
+        let store = scene.store();
+        let lights: Vec<[i64; 3]> = (0..3)
+            .map(|_| {
+                // Inside the raster, or up to twice its size away.
+                dims.map(|n| {
+                    let n = i64::from(n) * VOXEL;
+                    rng.range(-2 * n, 3 * n)
+                })
+            })
+            .collect();
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let v = [x, y, z];
+                    let Some(rec) = store.get_voxel(v) else {
+                        continue;
+                    };
+                    for &light in &lights {
+                        let got = classify_voxel(&raster, &store, v, rec, light).unwrap();
+                        let want = tube_rule(&raster, &store, v, light);
+                        assert_eq!(
+                            got == LightVisibility::Visible,
+                            want,
+                            "{dims:?} {balls:?} voxel {v:?} light {light:?}"
+                        );
+                        if want {
+                            lit += 1;
+                        } else {
+                            undecided += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        lit > 1000 && undecided > 1000,
+        "{lit} lit, {undecided} undecided"
+    );
 }
