@@ -10,7 +10,7 @@ use crate::geometry::{Cuboid, Sphere, Torus, Triangle};
 use crate::object_table::{Light, Material, Object, SCALAR_ONE, Shape};
 use crate::store::{Limits, ObjectAttrs, RecordStore, RecordStoreMut};
 use crate::testkit::{self, Scene, Voxelize};
-use crate::voxelize::{Separation, VoxelSink};
+use crate::voxelize::{Separation, Surfel, VoxelSink};
 
 /// An object-table entry of material 0 that no shadow ray can meet (a
 /// degenerate triangle): for objects whose own surface does not matter.
@@ -619,5 +619,99 @@ fn classification_is_the_tube_rule() {
     assert!(
         lit > 1000 && undecided > 1000,
         "{lit} lit, {undecided} undecided"
+    );
+}
+
+/// On a finished plane (proximity flags and distances set) adaptive shadow
+/// rays, which take 26-steps and skip empty space away from surfaces,
+/// give the light bits of 6-connected ones ([`LightParams::mode`]):
+/// random overlapping opaque and translucent balls and scattered single
+/// voxels (which a 26-step could pass between), lights inside and outside
+/// the raster.
+#[test]
+fn adaptive_shadow_rays_on_a_finished_plane_are_six_connected_ones() {
+    let mut rng = testkit::Rng(0xada9_71fe);
+    let mut compared = 0usize;
+    let mut total = LightReport::default();
+    for _ in 0..40 {
+        let dims = [0; 3].map(|_| 12 + rng.below_u32(40));
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let balls: Vec<([i64; 3], i64)> = (0..3 + rng.below(6))
+            .map(|_| {
+                let c = dims.map(|n| rng.range(0, i64::from(n) * VOXEL));
+                (c, rng.range(VOXEL, 6 * VOXEL))
+            })
+            .collect();
+        let shapes: Vec<_> = balls
+            .iter()
+            .map(|&(c, r)| {
+                move |s: &mut dyn VoxelSink| testkit::sphere(e, c, r, Separation::Six, s)
+            })
+            .collect();
+        let dust: Vec<[u32; 3]> = (0..e.len() / 1000)
+            .map(|_| dims.map(|n| rng.below_u32(n)))
+            .collect();
+        let scatter = |s: &mut dyn VoxelSink| {
+            for &v in &dust {
+                s.offer(
+                    v,
+                    Surfel {
+                        normal: [0, 0, crate::voxelize::NORMAL_ONE],
+                        distance: 0,
+                    },
+                );
+            }
+        };
+        let mut objects: Vec<Voxelize<'_>> = shapes
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let m = u16::from(i % 3 == 2);
+                (attrs(i as u32, m), f as &dyn Fn(&mut dyn VoxelSink))
+            })
+            .collect();
+        objects.push((attrs(balls.len() as u32, 0), &scatter));
+        let mut scene = testkit::build(e, &objects, LIM);
+        crate::proximity::distance_field(
+            &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
+        );
+        let lights: Vec<[i64; 3]> = (0..2)
+            .map(|_| {
+                dims.map(|n| {
+                    let n = i64::from(n) * VOXEL;
+                    rng.range(-2 * n, 3 * n)
+                })
+            })
+            .collect();
+        let mut w = World::new(&lights);
+        for (i, &(c, r)) in balls.iter().enumerate() {
+            w.objects.push(Object {
+                shape: Shape::Sphere(Sphere {
+                    centre: c,
+                    radius: r,
+                }),
+                material: u16::from(i % 3 == 2),
+            });
+        }
+        w.objects.push(NOWHERE);
+        let unlit = scene.records.clone();
+        let six = w.run(&mut scene);
+        let by_six = core::mem::replace(&mut scene.records, unlit);
+        let adaptive = w.run_with(
+            &mut scene,
+            &LightParams {
+                mode: Connectivity::Adaptive,
+                ..LightParams::default()
+            },
+        );
+        assert_eq!(scene.records, by_six, "{dims:?} {balls:?} {lights:?}");
+        assert_eq!(adaptive, six);
+        compared += by_six.len();
+        total.add(&six);
+    }
+    assert!(compared > 15_000, "{compared}");
+    assert!(
+        total.occluded > 100 && total.visible > 100 && total.translucent > 100,
+        "{total:?}"
     );
 }
