@@ -41,7 +41,8 @@
 
 use super::error::VoxelizeError;
 use super::fixmath::{
-    H, bounds, centre, check_coord, check_point, dist_u32, dot, isqrt, sub, sub_along, unit,
+    H, bounds, centre, check_coord, check_point, dist_u32, div_trunc, dot, isqrt, sub, sub_along,
+    unit,
 };
 use super::tessellate::{Emitter, circle, frame, quarter_segments, ring_point};
 use super::triangle::Tri;
@@ -139,10 +140,10 @@ impl Geo {
             .saturating_mul(gt)
             .saturating_add(rho.saturating_sub(self.r0).saturating_mul(gr))
             .clamp(0, g2);
-        let qt = gt.saturating_mul(s).checked_div(g2).unwrap_or(0);
+        let qt = div_trunc(gt.saturating_mul(s), g2).unwrap_or(0);
         let qr = self
             .r0
-            .saturating_add(gr.saturating_mul(s).checked_div(g2).unwrap_or(0));
+            .saturating_add(div_trunc(gr.saturating_mul(s), g2).unwrap_or(0));
         let (dt, dr) = (t.saturating_sub(qt), rho.saturating_sub(qr));
         let mut best_d = isqrt(dt.saturating_mul(dt).saturating_add(dr.saturating_mul(dr)));
         // Outward generator normal: (−gr, gt) in (t, rho).

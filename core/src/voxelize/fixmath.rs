@@ -327,7 +327,43 @@ pub(crate) fn round_div(n: i128, d: i128) -> i128 {
     if d <= 0 {
         return 0;
     }
-    n.saturating_add(d >> 1).checked_div_euclid(d).unwrap_or(0)
+    div_euclid(n.saturating_add(d >> 1), d).unwrap_or(0)
+}
+
+/// `n.checked_div_euclid(d)`, in 64 bits when both fit (a 128-bit
+/// division is a library call many times slower; the result is the same).
+#[inline]
+pub(crate) fn div_euclid(n: i128, d: i128) -> Option<i128> {
+    if let (Ok(a), Ok(b)) = (i64::try_from(n), i64::try_from(d))
+        && let Some(q) = a.checked_div_euclid(b)
+    {
+        return Some(i128::from(q));
+    }
+    n.checked_div_euclid(d)
+}
+
+/// `(n.checked_div_euclid(d), n.checked_rem_euclid(d))`, in 64 bits when
+/// both fit ([`div_euclid`]).
+#[inline]
+pub(crate) fn div_rem_euclid(n: i128, d: i128) -> Option<(i128, i128)> {
+    if let (Ok(a), Ok(b)) = (i64::try_from(n), i64::try_from(d))
+        && let (Some(q), Some(r)) = (a.checked_div_euclid(b), a.checked_rem_euclid(b))
+    {
+        return Some((i128::from(q), i128::from(r)));
+    }
+    Some((n.checked_div_euclid(d)?, n.checked_rem_euclid(d)?))
+}
+
+/// `n.checked_div(d)` (truncating), in 64 bits when both fit
+/// ([`div_euclid`]).
+#[inline]
+pub(crate) fn div_trunc(n: i128, d: i128) -> Option<i128> {
+    if let (Ok(a), Ok(b)) = (i64::try_from(n), i64::try_from(d))
+        && let Some(q) = a.checked_div(b)
+    {
+        return Some(i128::from(q));
+    }
+    n.checked_div(d)
 }
 
 /// Counts offers; saturating, so it never overflows.
@@ -344,6 +380,47 @@ impl Counter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The 64-bit fast paths divide exactly as `i128` does, at the edges
+    /// of `i64` (where its division overflows) and beyond them.
+    #[test]
+    fn fast_divisions_are_the_i128_ones() {
+        let m = i128::from(i64::MAX);
+        let edges = [
+            0,
+            1,
+            -1,
+            2,
+            -2,
+            7,
+            -7,
+            V,
+            -V,
+            m,
+            -m,
+            m + 1,
+            -m - 1,
+            -m - 2,
+            m * 3,
+            -m * 5,
+            i128::MAX,
+            i128::MIN,
+        ];
+        let mut rng = crate::testkit::Rng(0xd1f1);
+        let mut values: std::vec::Vec<i128> = edges.to_vec();
+        for _ in 0..200 {
+            let x = rng.next_u64() as i64;
+            values.push(i128::from(x >> (x as u64 % 64)));
+        }
+        for &n in &values {
+            for &d in &values {
+                assert_eq!(div_euclid(n, d), n.checked_div_euclid(d), "{n} {d}");
+                assert_eq!(div_trunc(n, d), n.checked_div(d), "{n} {d}");
+                let want = n.checked_div_euclid(d).zip(n.checked_rem_euclid(d));
+                assert_eq!(div_rem_euclid(n, d), want, "{n} {d}");
+            }
+        }
+    }
 
     #[test]
     fn cell_ranges() {
@@ -421,7 +498,7 @@ pub(crate) fn floor_div(n: i128, d: i128) -> Option<i128> {
     if d <= 0 {
         return None;
     }
-    n.checked_div_euclid(d)
+    div_euclid(n, d)
 }
 
 /// `ceil(n / d)` for `d > 0`.
@@ -450,13 +527,9 @@ impl IncDiv {
         if d <= 0 {
             return None;
         }
-        Some(Self {
-            q: n0.checked_div_euclid(d)?,
-            r: n0.checked_rem_euclid(d)?,
-            dq: dn.checked_div_euclid(d)?,
-            dr: dn.checked_rem_euclid(d)?,
-            d,
-        })
+        let (q, r) = div_rem_euclid(n0, d)?;
+        let (dq, dr) = div_rem_euclid(dn, d)?;
+        Some(Self { q, r, dq, dr, d })
     }
 
     /// Advances to the next `j`.

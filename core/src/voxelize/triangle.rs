@@ -75,7 +75,7 @@
 use super::error::VoxelizeError;
 use super::fixmath::{
     Counter, H, IncDiv, V, ceil_div, centre, check_point, checked_cross, checked_dot, clip,
-    dist_u32, dot, floor_div, isqrt, low, sub, unit, window,
+    dist_u32, div_trunc, dot, floor_div, isqrt, low, sub, unit, window,
 };
 use super::sphere::{pick, place};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
@@ -734,7 +734,7 @@ impl Tri {
             let den = dot(e, e).max(1);
             let num = num.min(den);
             let foot = [0, 1, 2].map(|j| {
-                self.v[p][j].saturating_add(e[j].saturating_mul(num).checked_div(den).unwrap_or(0))
+                self.v[p][j].saturating_add(div_trunc(e[j].saturating_mul(num), den).unwrap_or(0))
             });
             let d = sub(c, foot);
             let d2 = dot(d, d);
