@@ -39,6 +39,8 @@
 //! circle (coarser for cones wider than about 2^23 voxels). Work is a
 //! constant per chord plus the triangles' voxels.
 
+use core::cell::Cell;
+
 use super::error::VoxelizeError;
 use super::fixmath::{
     H, bounds, centre, check_coord, check_point, dist_u32, div_trunc, dot, isqrt, sub, sub_along,
@@ -177,6 +179,11 @@ impl Geo {
     }
 }
 
+/// Bits of the number of surfels [`run`] keeps.
+const MEMO_BITS: u32 = 8;
+/// Surfels [`run`] keeps.
+const MEMO: usize = 1 << MEMO_BITS;
+
 fn run<S: VoxelSink + ?Sized>(
     cone: &Cone,
     sep: Separation,
@@ -193,7 +200,29 @@ fn run<S: VoxelSink + ?Sized>(
     if em.culled(lo, hi, reach) {
         return Ok(0);
     }
-    let f = |_: &Tri, v: [u32; 3]| g.surfel(v);
+    // A voxel near a generator or the rim is offered by each triangle that
+    // reaches it, and its surfel depends on the voxel alone: the last few
+    // hundred are kept (direct-mapped; a key outside any raster marks an
+    // empty slot).
+    let memo: [Cell<([u32; 3], Surfel)>; MEMO] =
+        core::array::from_fn(|_| Cell::new(([u32::MAX; 3], Surfel::NONE)));
+    let f = |_: &Tri, v: [u32; 3]| {
+        let slot = v[0]
+            .wrapping_mul(0x9e37_79b1)
+            .wrapping_add(v[1].wrapping_mul(0x85eb_ca77))
+            .wrapping_add(v[2].wrapping_mul(0xc2b2_ae3d))
+            >> (32 - MEMO_BITS);
+        let Some(cell) = memo.get(crate::raster::to_usize(slot)) else {
+            return g.surfel(v);
+        };
+        let (key, kept) = cell.get();
+        if key == v {
+            return kept;
+        }
+        let s = g.surfel(v);
+        cell.set((v, s));
+        s
+    };
     let total = m.saturating_mul(4);
     for j in 0..total {
         let j1 = if j.saturating_add(1) == total {
