@@ -522,13 +522,24 @@ pub(crate) struct IncDiv {
 }
 
 impl IncDiv {
-    /// `None` for `d <= 0` or out-of-range operands.
-    pub(crate) fn new(n0: i128, dn: i128, d: i128) -> Option<Self> {
+    /// The per-step quotient and remainder of `dn / d`, for
+    /// [`IncDiv::with_step`]: computed once for many divisions with the
+    /// same `dn` and `d`. `None` for `d <= 0` or out-of-range operands.
+    pub(crate) fn step_of(dn: i128, d: i128) -> Option<(i128, i128)> {
+        if d <= 0 {
+            return None;
+        }
+        div_rem_euclid(dn, d)
+    }
+
+    /// `floor((n0 + j·dn) / d)` from `j = 0`, the step of `dn` given as
+    /// [`IncDiv::step_of`]`(dn, d)`. `None` for `d <= 0` or out-of-range
+    /// operands.
+    pub(crate) fn with_step(n0: i128, (dq, dr): (i128, i128), d: i128) -> Option<Self> {
         if d <= 0 {
             return None;
         }
         let (q, r) = div_rem_euclid(n0, d)?;
-        let (dq, dr) = div_rem_euclid(dn, d)?;
         Some(Self { q, r, dq, dr, d })
     }
 

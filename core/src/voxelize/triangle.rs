@@ -354,6 +354,37 @@ struct Axis {
     hi: i128,
 }
 
+/// What a walk along the columns of a row needs of a column axis
+/// `α = (α_a, α_b, α_k)` ([`Tri::columns`]), the same for every row: the
+/// divisor `α_k·V`, the probe's reach `α_k·H`, and the per-column steps of
+/// the two incremental quotients, `(∓α_a·V) / (α_k·V)`.
+#[derive(Clone, Copy, Debug)]
+struct ColumnStep {
+    d: i128,
+    kh: i128,
+    /// Step of the upper bound's quotient ([`IncDiv::step_of`] of `−α_a·V`).
+    down: (i128, i128),
+    /// Step of the lower bound's quotient (of `α_a·V`).
+    up: (i128, i128),
+}
+
+impl ColumnStep {
+    /// `None` when a product overflows or `α_k ≤ 0` (the walk then refuses
+    /// the triangle, as it would on its first row).
+    fn of(ax: &Axis) -> Option<Self> {
+        let [pa, _, pk] = ax.alpha;
+        let d = pk.checked_mul(V)?;
+        let kh = pk.checked_mul(H)?;
+        let dq = pa.checked_mul(V)?;
+        Some(Self {
+            d,
+            kh,
+            down: IncDiv::step_of(dq.checked_neg()?, d)?,
+            up: IncDiv::step_of(dq, d)?,
+        })
+    }
+}
+
 /// A validated triangle.
 pub(crate) struct Tri {
     v: [[i128; 3]; 3],
@@ -560,6 +591,12 @@ impl Tri {
         })?;
         let rows = rows.get(..nr).unwrap_or(&[]);
         let cols = cols.get(..nc).unwrap_or(&[]);
+        // What every row's walk along the columns needs of each column axis.
+        let mut steps = [None::<ColumnStep>; 32];
+        for (ax, st) in cols.iter().zip(steps.iter_mut()) {
+            *st = ColumnStep::of(ax);
+        }
+        let steps = steps.get(..nc).unwrap_or(&[]);
 
         // Rows: the b-axis bounds (axes with only a b component).
         let (mut b_lo, mut b_hi) = (i128::MIN, i128::MAX);
@@ -603,16 +640,19 @@ impl Tri {
                     (l.max(i128::from(a0)), h.min(i128::from(a1)))
                 });
             let whole = (i128::from(a0), i128::from(a1));
+            let (all, plane_only) = (cols.len(), cols.len().min(1));
             let runs = if i0 > i1 {
-                [(whole, cols), ((1, 0), cols), ((1, 0), cols)]
+                [(whole, all), ((1, 0), all), ((1, 0), all)]
             } else {
                 [
-                    ((whole.0, i0.saturating_sub(1)), cols),
-                    ((i0, i1), cols.get(..1).unwrap_or(cols)),
-                    ((i1.saturating_add(1), whole.1), cols),
+                    ((whole.0, i0.saturating_sub(1)), all),
+                    ((i0, i1), plane_only),
+                    ((i1.saturating_add(1), whole.1), all),
                 ]
             };
-            for (run, ((lo, hi), axes)) in runs.into_iter().enumerate() {
+            for (run, ((lo, hi), used)) in runs.into_iter().enumerate() {
+                let axes = cols.get(..used).unwrap_or(cols);
+                let axis_steps = steps.get(..used).unwrap_or(steps);
                 let (Ok(lo), Ok(hi)) = (u32::try_from(lo), u32::try_from(hi)) else {
                     continue;
                 };
@@ -620,7 +660,7 @@ impl Tri {
                     continue;
                 }
                 let plane = plane_surfels && run == 1;
-                self.columns(k, (lo, hi), bi, axes, nk, &mut |v| {
+                self.columns(k, (lo, hi), bi, axes, axis_steps, nk, &mut |v| {
                     let s = match (reads, plane) {
                         (false, _) => Surfel::NONE,
                         (true, true) => self.plane_surfel(v),
@@ -639,12 +679,14 @@ impl Tri {
     /// floor((hi − q − α_k·H) / (α_k·V)) and floor((q + α_k·H − lo) /
     /// (α_k·V)) (= −ceil of the low bound), with q = α_a·c_a + α_b·c_b
     /// stepping by α_a·V per column.
+    #[allow(clippy::too_many_arguments)] // one row's context
     fn columns(
         &self,
         k: usize,
         (a0, a1): (u32, u32),
         bi: u32,
         axes: &[Axis],
+        steps: &[Option<ColumnStep>],
         nk: (u32, u32),
         offer: &mut impl FnMut([u32; 3]),
     ) -> Result<(), VoxelizeError> {
@@ -652,24 +694,26 @@ impl Tri {
         let mut his = [None::<IncDiv>; 32];
         let mut los = [None::<IncDiv>; 32];
         let ca0 = centre(a0);
-        for ((ax, hi), lo) in axes.iter().zip(his.iter_mut()).zip(los.iter_mut()) {
-            let [pa, pb, pk] = ax.alpha;
+        for (((ax, st), hi), lo) in axes
+            .iter()
+            .zip(steps)
+            .zip(his.iter_mut())
+            .zip(los.iter_mut())
+        {
+            let [pa, pb, _] = ax.alpha;
             let q = pa
                 .checked_mul(ca0)
                 .and_then(|x| x.checked_add(pb.checked_mul(cb)?));
-            let d = pk.checked_mul(V);
-            let kh = pk.checked_mul(H);
-            let dq = pa.checked_mul(V);
-            let (Some(q), Some(d), Some(kh), Some(dq)) = (q, d, kh, dq) else {
+            let (Some(q), Some(st)) = (q, st) else {
                 return Err(VoxelizeError::Arithmetic);
             };
-            let nhi = ax.hi.checked_sub(q).and_then(|x| x.checked_sub(kh));
-            let nlo = q.checked_add(kh).and_then(|x| x.checked_sub(ax.lo));
-            let (Some(nhi), Some(nlo), Some(ndq)) = (nhi, nlo, dq.checked_neg()) else {
+            let nhi = ax.hi.checked_sub(q).and_then(|x| x.checked_sub(st.kh));
+            let nlo = q.checked_add(st.kh).and_then(|x| x.checked_sub(ax.lo));
+            let (Some(nhi), Some(nlo)) = (nhi, nlo) else {
                 return Err(VoxelizeError::Arithmetic);
             };
-            *hi = Some(IncDiv::new(nhi, ndq, d).ok_or(VoxelizeError::Arithmetic)?);
-            *lo = Some(IncDiv::new(nlo, dq, d).ok_or(VoxelizeError::Arithmetic)?);
+            *hi = Some(IncDiv::with_step(nhi, st.down, st.d).ok_or(VoxelizeError::Arithmetic)?);
+            *lo = Some(IncDiv::with_step(nlo, st.up, st.d).ok_or(VoxelizeError::Arithmetic)?);
         }
         let m = axes.len();
         for ai in a0..=a1 {
