@@ -241,6 +241,69 @@ fn transmitting_material_and_patch() {
     );
 }
 
+/// The fan of a non-convex polygon folds back where the outline turns
+/// clockwise as seen from vertex 0 (as the teeth of the SPD gears do);
+/// every fan triangle still winds like the polygon, so refraction enters
+/// and leaves the same way on all of it, and the triangles cover the fan's
+/// points (vertex 0, `t + 1`, `t + 2`) with the patch normals swapped
+/// along with their vertices.
+#[test]
+fn fan_triangles_wind_like_their_polygon() {
+    // A comb in the plane z = 0, counter-clockwise from above (+z): the
+    // fan from vertex 0 folds at the notches.
+    let outline = [
+        (0.0, 0.0),
+        (4.0, 0.0),
+        (4.0, 3.0),
+        (3.0, 3.0),
+        (3.0, 1.0),
+        (2.0, 1.0),
+        (2.0, 3.0),
+        (1.0, 3.0),
+        (1.0, 1.0),
+        (0.5, 1.0),
+        (0.5, 3.0),
+        (0.0, 3.0),
+    ];
+    for patch in [false, true] {
+        let mut src = format!("{HEAD}f 1 1 1 0.2 0.3 20 0.7 1.5\n");
+        src += &format!("{} {}\n", if patch { "pp" } else { "p" }, outline.len());
+        for (k, (x, y)) in outline.iter().enumerate() {
+            if patch {
+                // Normal k's x records which vertex it belongs to.
+                src += &format!("{x} {y} 0 {k} 0 1\n");
+            } else {
+                src += &format!("{x} {y} 0\n");
+            }
+        }
+        let s = ok(&src);
+        let p = &s.polygons[0];
+        let v = s.polygon_vertices(p);
+        let tris: Vec<_> = s.polygon_triangles(p).collect();
+        assert_eq!(tris.len(), outline.len() - 2);
+        let mut swapped = 0;
+        for (t, tri) in tris.iter().enumerate() {
+            let [a, b, c] = tri.vertices;
+            assert!((b - a).cross(c - a).z > 0.0, "triangle {t} winds clockwise");
+            assert_eq!(a, v[0]);
+            let fan = [v[t + 1], v[t + 2]];
+            if [b, c] != fan {
+                assert_eq!([c, b], fan, "triangle {t}: not the fan's points");
+                swapped += 1;
+            }
+            if let Some(n) = tri.normals {
+                for (vertex, normal) in tri.vertices.iter().zip(n) {
+                    let k = v.iter().position(|w| w == vertex).unwrap();
+                    assert_eq!(normal.x, k as f64, "triangle {t}: normal not its vertex's");
+                }
+            } else {
+                assert!(!patch);
+            }
+        }
+        assert!(swapped > 0, "the comb's fan folds back somewhere");
+    }
+}
+
 // ------------------------------------------------------------- bad input
 
 #[test]

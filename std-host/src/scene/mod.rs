@@ -395,11 +395,21 @@ impl Scene {
 
     /// The triangles of `polygon`'s fan: vertices 0, `t + 1`, `t + 2` for
     /// each `t`, with the patch's vertex normals (as written) for a `pp`.
+    /// Each triangle winds like the polygon (its normal on the side of the
+    /// polygon's Newell normal): where the fan of a non-convex polygon
+    /// folds back, the triangle's last two vertices are swapped, so every
+    /// triangle of one polygon has the polygon's orientation, which decides
+    /// whether a refracted ray enters or leaves.
     pub fn polygon_triangles(&self, polygon: &Polygon) -> impl Iterator<Item = Triangle> + '_ {
         let v = self.polygon_vertices(polygon);
         let n = self.polygon_normals(polygon);
+        let newell = newell_normal(v);
         (0..v.len().saturating_sub(2)).map(move |t| {
-            let idx = [0, t + 1, t + 2];
+            let mut idx = [0, t + 1, t + 2];
+            let [a, b, c] = idx.map(|k| v[k]);
+            if (b - a).cross(c - a).dot(newell) < 0.0 {
+                idx.swap(1, 2);
+            }
             Triangle {
                 vertices: idx.map(|k| v[k]),
                 normals: n.and_then(|n| Some([*n.get(idx[0])?, *n.get(idx[1])?, *n.get(idx[2])?])),
@@ -472,4 +482,20 @@ impl Scene {
         }
         b
     }
+}
+
+/// The polygon's normal by Newell's method (twice its area vector): the
+/// side its vertices wind counter-clockwise about, for a non-convex
+/// polygon too; zero for a polygon without area.
+fn newell_normal(v: &[DVec3]) -> DVec3 {
+    v.iter()
+        .zip(v.iter().cycle().skip(1))
+        .map(|(a, b)| {
+            DVec3::new(
+                (a.y - b.y) * (a.z + b.z),
+                (a.z - b.z) * (a.x + b.x),
+                (a.x - b.x) * (a.y + b.y),
+            )
+        })
+        .sum()
 }
