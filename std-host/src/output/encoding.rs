@@ -63,19 +63,64 @@ pub fn quantize(v: f32, linear: bool, max: u16) -> u16 {
     (e * f64::from(max) + 0.5) as u16
 }
 
+/// [`quantize`]`(v, false, 255)`: the 8-bit sRGB code of `v`, found among
+/// the 255 smallest values of each code ([`srgb8_thresholds`]) by a
+/// binary search instead of a power per value.
+///
+/// ```
+/// use rrt_host::output::encoding::{quantize, srgb8};
+/// for v in [0.0, 0.002, 0.18, 0.5, 0.99, 1.0, 3.0, -1.0, f32::NAN] {
+///     assert_eq!(u16::from(srgb8(v)), quantize(v, false, 255));
+/// }
+/// ```
+#[must_use]
+pub fn srgb8(v: f32) -> u8 {
+    // No threshold is ≤ NaN or below the first: code 0; all are ≤ 1.
+    let above = srgb8_thresholds().partition_point(|&t| t <= v);
+    u8::try_from(above).unwrap_or(u8::MAX)
+}
+
+/// For each code `c` in 1..=255, the smallest `f32` that [`quantize`]
+/// encodes as sRGB code `c` or above (8 bits): started at the exact
+/// decision boundary (the inverse transfer function of `(c − ½)/255`) and
+/// moved by single steps of `f32` to where [`quantize`] changes, so the
+/// table agrees with it at every boundary.
+#[must_use]
+pub fn srgb8_thresholds() -> &'static [f32; 255] {
+    static TABLE: std::sync::OnceLock<[f32; 255]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let code = |v: f32| quantize(v, false, 255);
+        std::array::from_fn(|i| {
+            let c = u16::try_from(i + 1).unwrap_or(u16::MAX);
+            let y = (f64::from(c) - 0.5) / 255.0;
+            let x = if y <= 0.040_45 {
+                y / 12.92
+            } else {
+                ((y + 0.055) / 1.055).powf(2.4)
+            };
+            let mut t = x as f32;
+            // A few steps at most: the boundary is exact to within rounding.
+            for _ in 0..64 {
+                if code(t) < c {
+                    t = f32::from_bits(t.to_bits() + 1);
+                } else if t > 0.0 && code(f32::from_bits(t.to_bits() - 1)) >= c {
+                    t = f32::from_bits(t.to_bits() - 1);
+                } else {
+                    break;
+                }
+            }
+            t
+        })
+    })
+}
+
 /// The image's samples as 8-bit codes (`linear` 8-bit: [`Image::rgb`]
 /// exactly) or 16-bit codes, row by row.
 #[must_use]
 pub fn codes(image: &Image, enc: Encoding) -> Codes {
     match (enc.bits, enc.linear) {
         (8, true) => Codes::Eight(image.rgb.clone()),
-        (8, false) => Codes::Eight(
-            image
-                .linear
-                .iter()
-                .map(|&v| quantize(v, false, 255) as u8)
-                .collect(),
-        ),
+        (8, false) => Codes::Eight(image.linear.iter().map(|&v| srgb8(v)).collect()),
         _ => Codes::Sixteen(
             image
                 .linear
@@ -275,6 +320,38 @@ mod tests {
             let c = quantize(i as f32 / 4096.0, false, u16::MAX);
             assert!(c >= last);
             last = c;
+        }
+    }
+
+    /// The table's codes are `quantize`'s: on both sides of every
+    /// threshold (eight `f32` steps each way), at every threshold's
+    /// exact code, and on random values and random bit patterns (NaN,
+    /// infinities and subnormals among them).
+    #[test]
+    fn srgb8_is_quantize() {
+        let t = srgb8_thresholds();
+        for (i, &x) in t.iter().enumerate() {
+            assert_eq!(usize::from(srgb8(x)), i + 1, "threshold {i}");
+            for k in 1..=8u32 {
+                for v in [
+                    f32::from_bits(x.to_bits() + k),
+                    f32::from_bits(x.to_bits().saturating_sub(k)),
+                ] {
+                    assert_eq!(u16::from(srgb8(v)), quantize(v, false, 255), "{v:e}");
+                }
+            }
+        }
+        assert!(t.windows(2).all(|w| w[0] < w[1]));
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..200_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let unit = (s >> 40) as f32 / (1u64 << 24) as f32 * 1.2 - 0.1;
+            let bits = f32::from_bits((s >> 8) as u32);
+            for v in [unit, bits] {
+                assert_eq!(u16::from(srgb8(v)), quantize(v, false, 255), "{v:e}");
+            }
         }
     }
 }
