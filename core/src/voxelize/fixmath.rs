@@ -535,6 +535,7 @@ impl IncDiv {
     /// `floor((n0 + j·dn) / d)` from `j = 0`, the step of `dn` given as
     /// [`IncDiv::step_of`]`(dn, d)`. `None` for `d <= 0` or out-of-range
     /// operands.
+    #[inline]
     pub(crate) fn with_step(n0: i128, (dq, dr): (i128, i128), d: i128) -> Option<Self> {
         if d <= 0 {
             return None;
