@@ -88,10 +88,9 @@ impl Surface for Triangle {
         let e2 = v2 - v0;
         let p = ray.dir.cross(e2);
         let det = e1.dot(p);
-        let scale = e1.length() * e2.length() * ray.dir.length();
-        if !(det.abs() > 1e-14 * scale) {
-            return None;
-        }
+        // A ray in the plane (|det| ≤ 1e-14·|e1|·|e2|·|dir|) misses; that
+        // test's square roots are taken last, for rays that pass the others
+        // (with det = 0 the barycentric tests below fail on NaN or ∞).
         let inv = 1.0 / det;
         let s = ray.origin - v0;
         let u = s.dot(p) * inv;
@@ -105,6 +104,10 @@ impl Surface for Triangle {
         }
         let t = e2.dot(q) * inv;
         if !(t > tmin && t < tmax) {
+            return None;
+        }
+        let scale = e1.length() * e2.length() * ray.dir.length();
+        if !(det.abs() > 1e-14 * scale) {
             return None;
         }
         let face = e1.cross(e2).normalize_or(DVec3::Z);
