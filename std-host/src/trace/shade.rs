@@ -404,11 +404,6 @@ impl Tracer<'_> {
         let o_r = self.frame.world_to_raster(segment.origin);
         let mut att = 1.0;
         let mut mail = Mailbox::default();
-        // The surface left, where it cannot meet the ray again, is tested
-        // already.
-        if let Some(id) = skip {
-            mail.tested(id);
-        }
         let mut blocker = None;
         // Translucent objects already counted (each attenuates once).
         let mut seen: Vec<u32> = Vec::new();
@@ -442,8 +437,12 @@ impl Tracer<'_> {
                         else {
                             continue;
                         };
+                        // The surface left, where it cannot meet the
+                        // segment again, is never tested.
                         let blocks = if obj.shape.is_exact() {
-                            !mail.tested(id) && obj.shape.intersect(segment, tmin, tmax).is_some()
+                            Some(id) != skip
+                                && !mail.tested(id)
+                                && obj.shape.intersect(segment, tmin, tmax).is_some()
                         } else {
                             !rule.ignores(&store, index, b)
                         };

@@ -114,34 +114,48 @@ const NEIGHBOURS_BY_DISTANCE: [[i32; 3]; 26] = {
 
 /// Objects one ray has already been tested against: its *mailbox*. A ray
 /// meets an object in many voxels; each exact object is intersected once
-/// per ray. It holds the last [`MAILBOX`] objects tested: a ray meeting
-/// more objects than that may test one again, which costs time, never
-/// changes the answer (the nearest candidate is kept apart).
-#[derive(Clone, Copy, Debug, Default)]
+/// per ray. It is a direct-mapped table of [`MAILBOX`] slots indexed by
+/// the object id's low bits, so that a ray crossing voxels that share long
+/// object lists (up to [`MAILBOX`] objects of neighbouring ids) tests each
+/// once. An object whose slot another object took since may be tested
+/// again, which costs time, never changes the answer (the nearest
+/// candidate is kept apart).
+#[derive(Clone, Copy, Debug)]
 pub(super) struct Mailbox {
-    /// Each tested object's id plus one; 0 in a slot not used yet.
-    keys: [u64; MAILBOX],
-    /// The slot the next object takes.
-    next: usize,
+    /// The id of the object last recorded in each slot.
+    keys: [u32; MAILBOX],
+    /// Which slots hold an id (bit `s % 64` of word `s / 64`).
+    used: [u64; MAILBOX / 64],
 }
 
-/// Objects a [`Mailbox`] holds.
-pub const MAILBOX: usize = 16;
+/// Slots of a [`Mailbox`].
+pub const MAILBOX: usize = 128;
+
+impl Default for Mailbox {
+    fn default() -> Self {
+        Self {
+            keys: [0; MAILBOX],
+            used: [0; MAILBOX / 64],
+        }
+    }
+}
 
 impl Mailbox {
     /// Whether `id` was tested on this ray; if not, it is now recorded as
-    /// tested (the oldest entry giving way when full).
+    /// tested (in its slot, in place of any object there).
     #[inline]
     pub(super) fn tested(&mut self, id: u32) -> bool {
-        // Every slot is compared (no early exit), so the scan vectorizes.
-        let key = u64::from(id) + 1;
-        if self.keys.iter().fold(false, |seen, &x| seen | (x == key)) {
+        let slot = id as usize % MAILBOX;
+        let bit = 1u64 << (slot % 64);
+        let (Some(word), Some(key)) = (self.used.get_mut(slot / 64), self.keys.get_mut(slot))
+        else {
+            return false;
+        };
+        if *word & bit != 0 && *key == id {
             return true;
         }
-        if let Some(slot) = self.keys.get_mut(self.next) {
-            *slot = key;
-        }
-        self.next = (self.next + 1) % MAILBOX;
+        *key = id;
+        *word |= bit;
         false
     }
 }
@@ -413,5 +427,43 @@ impl Tracer<'_> {
             stats.shared_hits += 1;
         }
         self.candidate_hit(ray, c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{MAILBOX, Mailbox};
+    use std::collections::HashSet;
+
+    #[test]
+    fn mailbox_never_claims_an_untested_object() {
+        // Ids spread over a few neighbourhoods and colliding slots, in a
+        // fixed pseudo-random order.
+        let mut mail = Mailbox::default();
+        let mut seen = HashSet::new();
+        let mut x = 0x2545_f491_u32;
+        for _ in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let id = (x % 700).wrapping_mul(if x & 1 == 0 { 1 } else { MAILBOX as u32 + 1 });
+            let claimed = mail.tested(id);
+            assert!(!claimed || seen.contains(&id), "{id} claimed untested");
+            seen.insert(id);
+        }
+        assert!(!Mailbox::default().tested(0));
+        assert!(!Mailbox::default().tested(u32::MAX));
+    }
+
+    #[test]
+    fn mailbox_keeps_a_long_list_of_neighbouring_ids() {
+        // A ray crossing voxels that share one long object list tests each
+        // object once.
+        let mut mail = Mailbox::default();
+        let ids = 1000..1000 + MAILBOX as u32;
+        assert!(ids.clone().all(|id| !mail.tested(id)));
+        for _ in 0..3 {
+            assert!(ids.clone().all(|id| mail.tested(id)));
+        }
     }
 }
