@@ -167,21 +167,23 @@ fn rasters_and_saved_files_are_identical_for_every_thread_count() {
     let path = dir.join("scene.toml");
     std::fs::write(&path, SCENE).unwrap();
     let scene = Scene::load(&path).unwrap();
-    // Several brick layers high (the last one partial), so 2 and 3
-    // threads cut the raster into slabs.
+    // Several brick layers high (the last one partial), so 2, 3 and 8
+    // threads cut the raster into slabs, and fewer than the pieces they
+    // want, so the slabs into bands of brick rows too.
     for (what, opts) in [
         ("exact", BuildOptions::new(120)),
         ("paper", BuildOptions::paper(120)),
     ] {
         let one = build_on(&scene, opts, 1);
         assert!(one.extent().dims()[2] > 3 * 8, "{:?}", one.extent());
+        assert!(one.extent().dims()[2] <= 2 * 8 * 8, "{:?}", one.extent());
         assert_eq!(one.exact, what == "exact");
         if one.exact {
             assert!(!one.lists.is_empty(), "overlapping objects have lists");
         }
         assert_same_cells(&one, what);
         let want = bytes(&one, &dir, &format!("{what}-1"));
-        for threads in [2, 3] {
+        for threads in [2, 3, 8] {
             let vs = build_on(&scene, opts, threads);
             let got = bytes(&vs, &dir, &format!("{what}-{threads}"));
             // Field by field, for a readable failure.
@@ -203,7 +205,8 @@ fn rasters_and_saved_files_are_identical_for_every_thread_count() {
 
 #[test]
 fn an_spd_scene_is_identical_for_every_thread_count() {
-    // Many small objects over a floor, the paper's raster.
+    // Many small objects over a floor (a flat raster: its two brick
+    // layers are cut into bands), the paper's raster and the exact one.
     let scene = Scene::load(data("balls1.nff")).unwrap();
     let dir = fresh_dir("rrt-build-threads", "balls1");
     for opts in [BuildOptions::paper(200), BuildOptions::new(200)] {

@@ -12,8 +12,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 /// What a phase counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Unit {
-    /// Objects voxelized into slabs of the raster: each object counts
-    /// once per slab.
+    /// Objects voxelized into pieces of the raster: each object counts
+    /// once per piece it reaches.
     SlabObjects,
     /// Surface voxels (records).
     Voxels,
@@ -30,7 +30,7 @@ impl Unit {
                 "{msg:26} [{bar:32}] {binary_bytes}/{binary_total_bytes} ({binary_bytes_per_sec}) {elapsed} eta {eta}"
             }
             Self::SlabObjects => {
-                "{msg:26} [{bar:32}] {human_pos}/{human_len} objects×slabs {elapsed} eta {eta}"
+                "{msg:26} [{bar:32}] {human_pos}/{human_len} objects×pieces {elapsed} eta {eta}"
             }
             Self::Voxels => {
                 "{msg:26} [{bar:32}] {human_pos}/{human_len} voxels {elapsed} eta {eta}"

@@ -562,6 +562,12 @@ pub trait CsgSink {
     fn layers(&self) -> Range<u32> {
         0..u32::MAX
     }
+
+    /// The rows whose voxels the sink keeps, as [`VoxelSink::rows`]:
+    /// [`voxelize`] classifies only those.
+    fn rows(&self) -> Range<u32> {
+        0..u32::MAX
+    }
 }
 
 /// Adapts any [`VoxelSink`] (a [`crate::store::Counter`], a test set) to
@@ -576,6 +582,10 @@ impl<S: VoxelSink> CsgSink for IgnoreLeaf<'_, S> {
 
     fn layers(&self) -> Range<u32> {
         self.0.layers()
+    }
+
+    fn rows(&self) -> Range<u32> {
+        self.0.rows()
     }
 }
 
@@ -631,6 +641,10 @@ impl CsgSink for LeafFill<'_, '_, '_, '_> {
     fn layers(&self) -> Range<u32> {
         self.filler.layers()
     }
+
+    fn rows(&self) -> Range<u32> {
+        self.filler.rows()
+    }
 }
 
 /// What [`voxelize`] did.
@@ -672,9 +686,11 @@ pub fn voxelize(tree: &CsgTree<'_>, extent: Extent, sink: &mut impl CsgSink) -> 
         return report;
     };
     let [nx, ny, nz] = extent.dims();
-    let layers = sink.layers();
-    let z_end = layers.end.min(nz);
-    let win = [(0, nx), (0, ny), (layers.start.min(z_end), z_end)];
+    let within = |r: Range<u32>, n: u32| {
+        let end = r.end.min(n);
+        (r.start.min(end), end)
+    };
+    let win = [(0, nx), within(sink.rows(), ny), within(sink.layers(), nz)];
     let mut range = [(0u32, 0u32); 3];
     for k in 0..3 {
         let (Some(a), Some(b), Some(n), Some(slot)) =

@@ -72,7 +72,7 @@ pub struct Counter<'p, 'd> {
     raster: RasterMut<'p>,
     dir: &'d mut [u32],
     report: CountReport,
-    slab: Option<u32>,
+    slab: Option<Origin>,
 }
 
 /// Sets every element of `s` to zero unless all already are (a fresh
@@ -117,7 +117,7 @@ impl<'p, 'd> Counter<'p, 'd> {
         if !z0.is_multiple_of(BRICK) {
             return Err(BuildError::SlabOrigin { z0 });
         }
-        Self::start(raster, dir, Some(z0), true)
+        Self::start(raster, dir, Some([0, z0]), true)
     }
 
     /// [`Counter::slab`] over a plane part and a directory that are all
@@ -136,13 +136,39 @@ impl<'p, 'd> Counter<'p, 'd> {
         if !z0.is_multiple_of(BRICK) {
             return Err(BuildError::SlabOrigin { z0 });
         }
-        Self::start(raster, dir, Some(z0), false)
+        Self::start(raster, dir, Some([0, z0]), false)
+    }
+
+    /// Starts one *band* of a scene: the rows `y0 .. y0 + ny` of the layers
+    /// `z0 .. z0 + nz` (at most one brick layer, `nz ≤ 8`) of a larger
+    /// raster, where `raster` is the band's own plane (`nx × ny × nz`,
+    /// cleared here) and `dir` its own directory, as [`Counter::slab`]
+    /// otherwise. Within one brick layer bricks are numbered row by row,
+    /// so a band's bricks, records and object lists are contiguous parts
+    /// of the larger raster's, in the same order, and bands join as slabs
+    /// do; the caller copies the band's plane into the larger plane.
+    /// Splitting a flat raster (few brick layers) into bands gives
+    /// threads more, smaller pieces.
+    ///
+    /// # Errors
+    /// [`BuildError::BandShape`] unless `y0` and `z0` are multiples of 8
+    /// and `nz ≤ 8`, and as [`Counter::new`].
+    pub fn band(
+        raster: RasterMut<'p>,
+        dir: &'d mut [u32],
+        [y0, z0]: [u32; 2],
+    ) -> Result<Self, BuildError> {
+        let layers = raster.extent().dims()[2];
+        if !y0.is_multiple_of(BRICK) || !z0.is_multiple_of(BRICK) || layers > BRICK {
+            return Err(BuildError::BandShape { y0, z0, layers });
+        }
+        Self::start(raster, dir, Some([y0, z0]), true)
     }
 
     fn start(
         mut raster: RasterMut<'p>,
         dir: &'d mut [u32],
-        slab: Option<u32>,
+        slab: Option<Origin>,
         clearing: bool,
     ) -> Result<Self, BuildError> {
         let expected = directory_len(raster.extent()).unwrap_or(usize::MAX);
@@ -192,23 +218,31 @@ impl<'p, 'd> Counter<'p, 'd> {
     }
 }
 
-/// `voxel` of the larger raster in a slab starting at layer `z0`, or `None`
-/// below it.
+/// Where a slab or band lies in the larger raster: its first row and its
+/// first layer.
+type Origin = [u32; 2];
+
+/// `voxel` of the larger raster in a slab or band starting at `origin`,
+/// or `None` before it.
 #[inline]
-fn local(voxel: [u32; 3], slab: Option<u32>) -> Option<[u32; 3]> {
-    match slab {
+fn local(voxel: [u32; 3], origin: Option<Origin>) -> Option<[u32; 3]> {
+    match origin {
         None => Some(voxel),
-        Some(z0) => Some([voxel[0], voxel[1], voxel[2].checked_sub(z0)?]),
+        Some([y0, z0]) => Some([
+            voxel[0],
+            voxel[1].checked_sub(y0)?,
+            voxel[2].checked_sub(z0)?,
+        ]),
     }
 }
 
-/// The cell of `voxel` (of the larger raster, in a slab starting at layer
-/// `slab`) in `raster`, with the voxel's local coordinates and its brick;
-/// `None`, counted in `outside`, for a voxel outside the raster.
+/// The cell of `voxel` (of the larger raster, in a slab or band starting
+/// at `slab`) in `raster`, with the voxel's local coordinates and its
+/// brick; `None`, counted in `outside`, for a voxel outside the raster.
 #[inline]
 fn cell_of<'r>(
     raster: &'r mut RasterMut<'_>,
-    slab: Option<u32>,
+    slab: Option<Origin>,
     voxel: [u32; 3],
     outside: &mut u64,
 ) -> Option<([u32; 3], usize, &'r mut u8)> {
@@ -224,15 +258,26 @@ fn cell_of<'r>(
 }
 
 /// The layers of the larger raster that a raster of `extent` holds as a
-/// slab starting at layer `slab` (all of it for a whole raster).
-fn layers_of(extent: Extent, slab: Option<u32>) -> Range<u32> {
-    let z0 = slab.unwrap_or(0);
+/// slab or band starting at `slab` (all of it for a whole raster).
+fn layers_of(extent: Extent, slab: Option<Origin>) -> Range<u32> {
+    let z0 = slab.map_or(0, |[_, z0]| z0);
     z0..z0.saturating_add(extent.dims()[2])
+}
+
+/// The rows of the larger raster that a raster of `extent` holds as a
+/// slab or band starting at `slab`.
+fn rows_of(extent: Extent, slab: Option<Origin>) -> Range<u32> {
+    let y0 = slab.map_or(0, |[y0, _]| y0);
+    y0..y0.saturating_add(extent.dims()[1])
 }
 
 impl VoxelSink for Counter<'_, '_> {
     fn layers(&self) -> Range<u32> {
         layers_of(self.raster.extent(), self.slab)
+    }
+
+    fn rows(&self) -> Range<u32> {
+        rows_of(self.raster.extent(), self.slab)
     }
 
     fn reads_surfels(&self) -> bool {
@@ -271,7 +316,7 @@ pub struct Sizing<'p, 'd> {
     dir: &'d mut [u32],
     total: usize,
     report: CountReport,
-    slab: Option<u32>,
+    slab: Option<Origin>,
 }
 
 impl<'p, 'd> Sizing<'p, 'd> {
@@ -424,7 +469,7 @@ pub struct Filler<'p, 'd, 'r> {
     /// Whether voxels several objects offer get object lists
     /// ([`Sizing::fill_with_lists`]) or keep their owner only.
     listing: bool,
-    slab: Option<u32>,
+    slab: Option<Origin>,
     /// The largest object id begun so far.
     last_object: Option<u32>,
     /// Whether objects have been begun in increasing id order (repeats of
@@ -904,6 +949,10 @@ impl VoxelSink for Filler<'_, '_, '_> {
     fn layers(&self) -> Range<u32> {
         layers_of(self.raster.extent(), self.slab)
     }
+
+    fn rows(&self) -> Range<u32> {
+        rows_of(self.raster.extent(), self.slab)
+    }
 }
 
 /// A fill-pass sink that colours voxels with a [`Texture`]
@@ -922,6 +971,10 @@ impl<T: Texture> VoxelSink for Textured<'_, '_, '_, '_, T> {
     fn layers(&self) -> Range<u32> {
         self.filler.layers()
     }
+
+    fn rows(&self) -> Range<u32> {
+        self.filler.rows()
+    }
 }
 
 /// A built scene: the plane (with OPAQUE, the rank hints and, for a whole
@@ -933,7 +986,7 @@ pub struct Built<'p, 'd, 'r> {
     records: &'r mut [VoxelRecord],
     lists: &'r [u32],
     report: FillReport,
-    slab: Option<u32>,
+    slab: Option<Origin>,
 }
 
 impl<'p, 'd, 'r> Built<'p, 'd, 'r> {
@@ -961,11 +1014,14 @@ impl<'p, 'd, 'r> Built<'p, 'd, 'r> {
         self.lists
     }
 
-    /// For a slab ([`Counter::slab`]), its first layer in the larger
-    /// raster; `None` for a whole raster.
+    /// For a slab ([`Counter::slab`]) or band ([`Counter::band`]), its
+    /// first layer in the larger raster; `None` for a whole raster.
     #[must_use]
     pub const fn slab(&self) -> Option<u32> {
-        self.slab
+        match self.slab {
+            Some([_, z0]) => Some(z0),
+            None => None,
+        }
     }
 
     /// The raster and a writable store at once (for the light pass).

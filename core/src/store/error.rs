@@ -166,6 +166,16 @@ pub enum BuildError {
         /// The first layer given.
         z0: u32,
     },
+    /// A band's first row or layer is not a multiple of the brick edge
+    /// (8), or it holds more than one brick layer.
+    BandShape {
+        /// The first row given.
+        y0: u32,
+        /// The first layer given.
+        z0: u32,
+        /// The layers the band's raster holds.
+        layers: u32,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -208,6 +218,11 @@ impl fmt::Display for BuildError {
             Self::SlabOrigin { z0 } => write!(
                 f,
                 "a slab starts at layer {z0}, not at a multiple of the brick edge 8"
+            ),
+            Self::BandShape { y0, z0, layers } => write!(
+                f,
+                "a band starts at row {y0} and layer {z0} and holds {layers} layers: \
+                 it must start at multiples of the brick edge 8 and hold at most 8 layers"
             ),
         }
     }

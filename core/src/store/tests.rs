@@ -1,5 +1,6 @@
 //! Unit tests of the record store and the two-pass builder.
 
+use core::ops::Range;
 use std::collections::HashMap;
 use std::vec;
 use std::vec::Vec;
@@ -858,8 +859,22 @@ fn object_lists_do_not_depend_on_the_order_objects_are_begun_in() {
 /// first 0) and joins them as a caller does: directory entries moved up by
 /// the records before, list indices by the list entries before.
 fn build_in_slabs(extent: Extent, script: &Script, starts: &[u32]) -> Scene {
-    let [nx, ny, nz] = extent.dims();
-    let slice = (nx * ny) as usize;
+    let [_, ny, nz] = extent.dims();
+    let pieces: Vec<_> = starts
+        .iter()
+        .enumerate()
+        .map(|(i, &z0)| (0..ny, z0..starts.get(i + 1).copied().unwrap_or(nz)))
+        .collect();
+    build_in_pieces(extent, script, &pieces)
+}
+
+/// Builds `script` in `pieces` (rows, layers), in raster order: slabs of
+/// every row, or bands of one brick layer, starting on multiples of 8; a
+/// band builds its own plane, copied into the raster's after its fill
+/// pass. Joined as [`build_in_slabs`].
+fn build_in_pieces(extent: Extent, script: &Script, pieces: &[(Range<u32>, Range<u32>)]) -> Scene {
+    let [nx, ny, _] = extent.dims();
+    let (row, slice) = (nx as usize, (nx * ny) as usize);
     let mut plane = vec![0u8; extent.len()];
     let mut dir = vec![0u32; 1];
     let mut records = Vec::new();
@@ -868,19 +883,28 @@ fn build_in_slabs(extent: Extent, script: &Script, starts: &[u32]) -> Scene {
         objects: script.len() as u32,
         materials: 1,
     };
-    for (i, &z0) in starts.iter().enumerate() {
-        let z1 = starts.get(i + 1).copied().unwrap_or(nz);
-        let e = Extent::new(nx, ny, z1 - z0).unwrap();
-        let part = &mut plane[z0 as usize * slice..z1 as usize * slice];
+    for (i, (rows, layers)) in pieces.iter().enumerate() {
+        let (y0, z0) = (rows.start, layers.start);
+        let band = *rows != (0..ny);
+        let e = Extent::new(nx, rows.end - y0, layers.end - z0).unwrap();
+        let mut own = vec![0u8; if band { e.len() } else { 0 }];
+        let part = if band {
+            &mut own[..]
+        } else {
+            &mut plane[z0 as usize * slice..layers.end as usize * slice]
+        };
         let mut sdir = vec![0u32; directory_len(e).unwrap()];
         let raster = RasterMut::new(e, part).unwrap();
         // Fresh zeros: the unchecked start (every other slab checks).
-        let mut counter = if i % 2 == 0 {
+        let mut counter = if band {
+            Counter::band(raster, &mut sdir, [y0, z0]).unwrap()
+        } else if i % 2 == 0 {
             Counter::slab_zeroed(raster, &mut sdir, z0).unwrap()
         } else {
             Counter::slab(raster, &mut sdir, z0).unwrap()
         };
-        assert_eq!(counter.layers(), z0..z1);
+        assert_eq!(counter.layers(), layers.clone());
+        assert_eq!(counter.rows(), rows.clone());
         for obj in script {
             for &(v, d) in obj {
                 counter.offer(v, surfel(d));
@@ -892,6 +916,7 @@ fn build_in_slabs(extent: Extent, script: &Script, starts: &[u32]) -> Scene {
         let mut filler = sizing
             .fill_with_lists(&mut srec, &mut slists, limits)
             .unwrap();
+        assert_eq!(filler.rows(), rows.clone());
         for (id, obj) in script.iter().enumerate() {
             filler
                 .begin_object(ObjectAttrs {
@@ -907,6 +932,13 @@ fn build_in_slabs(extent: Extent, script: &Script, starts: &[u32]) -> Scene {
         let built = filler.finish().unwrap();
         assert_eq!(built.slab(), Some(z0));
         let used = built.lists().len();
+        if band {
+            let n = (rows.end - y0) as usize * row;
+            for (z, layer) in layers.clone().zip(own.chunks_exact(n)) {
+                let at = z as usize * slice + y0 as usize * row;
+                plane[at..at + n].copy_from_slice(layer);
+            }
+        }
         let base = records.len() as u32;
         dir.pop();
         dir.extend(sdir.iter().map(|d| d + base));
@@ -922,6 +954,80 @@ fn build_in_slabs(extent: Extent, script: &Script, starts: &[u32]) -> Scene {
         count: CountReport::default(),
         fill: FillReport::default(),
     }
+}
+
+#[test]
+fn bands_joined_are_the_whole_scene() {
+    let mut rng = Rng(0xba4d_0001);
+    for case in 0..30u64 {
+        let extent = Extent::new(
+            1 + rng.below_u32(13),
+            1 + rng.below_u32(40),
+            1 + rng.below_u32(20),
+        )
+        .unwrap();
+        let [_, ny, nz] = extent.dims();
+        let script = random_script(extent, 2 + case as usize % 6, 40, case);
+        let whole = build(extent, &script).unwrap();
+        // Each brick layer a slab or cut into bands at random brick rows.
+        let mut pieces = Vec::new();
+        for z0 in (0..nz).step_by(8) {
+            let layers = z0..(z0 + 8).min(nz);
+            let mut y0 = 0;
+            while y0 < ny {
+                let y1 = if rng.below_u32(3) == 0 {
+                    ny
+                } else {
+                    (y0 + 8 * (1 + rng.below_u32(2))).min(ny)
+                };
+                pieces.push((y0..y1, layers.clone()));
+                y0 = y1;
+            }
+        }
+        let banded = build_in_pieces(extent, &script, &pieces);
+        assert_eq!(banded.dir, whole.dir, "case {case} {pieces:?}");
+        assert_eq!(banded.records, whole.records, "case {case}");
+        assert_eq!(banded.lists, whole.lists, "case {case}");
+        let unflagged = |p: &[u8]| p.iter().map(|c| c & !cell::PROXIMITY).collect::<Vec<_>>();
+        assert_eq!(
+            unflagged(&banded.plane),
+            unflagged(&whole.plane),
+            "case {case}"
+        );
+    }
+}
+
+#[test]
+fn a_band_starts_on_bricks_and_holds_one_brick_layer() {
+    let mut plane = vec![0u8; 16 * 16 * 9];
+    let e = Extent::new(16, 16, 9).unwrap();
+    let mut dir = vec![0u32; directory_len(e).unwrap()];
+    let err = Counter::band(RasterMut::new(e, &mut plane).unwrap(), &mut dir, [0, 0]).unwrap_err();
+    assert_eq!(
+        err,
+        BuildError::BandShape {
+            y0: 0,
+            z0: 0,
+            layers: 9
+        }
+    );
+    let e = Extent::new(16, 16, 8).unwrap();
+    let mut plane = vec![0u8; e.len()];
+    let mut dir = vec![0u32; directory_len(e).unwrap()];
+    for origin in [[4, 0], [0, 4], [8, 12]] {
+        let raster = RasterMut::new(e, &mut plane).unwrap();
+        let err = Counter::band(raster, &mut dir, origin).unwrap_err();
+        assert_eq!(
+            err,
+            BuildError::BandShape {
+                y0: origin[0],
+                z0: origin[1],
+                layers: 8
+            }
+        );
+    }
+    let raster = RasterMut::new(e, &mut plane).unwrap();
+    assert!(Counter::band(raster, &mut dir, [8, 16]).is_ok());
 }
 
 #[test]

@@ -79,7 +79,7 @@ fn scan<S: VoxelSink + ?Sized>(
 ) -> Result<u64, VoxelizeError> {
     let bx = BoxTies::new(b)?;
     let (lo, hi) = (bx.lo, bx.hi);
-    let win = window(extent, sink.layers());
+    let win = window(extent, sink);
     let reads = sink.reads_surfels();
     let mut n = Counter::default();
     // Candidate cells along one axis: TwentySix exactly (half-open per the

@@ -76,12 +76,16 @@ pub(crate) const fn centres_within(a: i128, b: i128) -> (i128, i128) {
 }
 
 /// The cells a voxelizer scans along each axis, `start .. end`: the
-/// raster's, along z only the layers the sink keeps
-/// ([`VoxelSink::layers`](super::VoxelSink::layers)).
-pub(crate) fn window(extent: Extent, layers: Range<u32>) -> [(u32, u32); 3] {
+/// raster's, along y only the rows and along z only the layers the sink
+/// keeps ([`VoxelSink::rows`](super::VoxelSink::rows),
+/// [`VoxelSink::layers`](super::VoxelSink::layers)).
+pub(crate) fn window<S: super::VoxelSink + ?Sized>(extent: Extent, sink: &S) -> [(u32, u32); 3] {
     let [nx, ny, nz] = extent.dims();
-    let end = layers.end.min(nz);
-    [(0, nx), (0, ny), (layers.start.min(end), end)]
+    let within = |r: Range<u32>, n: u32| {
+        let end = r.end.min(n);
+        (r.start.min(end), end)
+    };
+    [(0, nx), within(sink.rows(), ny), within(sink.layers(), nz)]
 }
 
 /// Intersects the cell range `lo ..= hi` with the cells `start .. end` of
@@ -434,10 +438,34 @@ mod tests {
         assert_eq!(clip(-5, 3, (0, 2)), Some((0, 1)));
         assert_eq!(clip(4, 9, (0, 2)), None);
         assert_eq!(clip(-5, 9, (3, 5)), Some((3, 4)));
+        // A sink keeping the rows and layers `.0`.
+        struct Keep([core::ops::Range<u32>; 2]);
+        impl crate::voxelize::VoxelSink for Keep {
+            fn offer(&mut self, _: [u32; 3], _: crate::voxelize::Surfel) {}
+            fn rows(&self) -> core::ops::Range<u32> {
+                self.0[0].clone()
+            }
+            fn layers(&self) -> core::ops::Range<u32> {
+                self.0[1].clone()
+            }
+        }
         let e = Extent::new(4, 5, 6).unwrap();
-        assert_eq!(window(e, 0..u32::MAX), [(0, 4), (0, 5), (0, 6)]);
-        assert_eq!(window(e, 2..4), [(0, 4), (0, 5), (2, 4)]);
-        assert_eq!(clip(0, 9, window(e, 8..16)[2]), None);
+        let all = 0..u32::MAX;
+        assert_eq!(
+            window(e, &Keep([all.clone(), all.clone()])),
+            [(0, 4), (0, 5), (0, 6)]
+        );
+        assert_eq!(
+            window(e, &Keep([all.clone(), 2..4])),
+            [(0, 4), (0, 5), (2, 4)]
+        );
+        assert_eq!(window(e, &Keep([1..3, 2..4])), [(0, 4), (1, 3), (2, 4)]);
+        assert_eq!(
+            window(e, &Keep([3..9, all.clone()])),
+            [(0, 4), (3, 5), (0, 6)]
+        );
+        assert_eq!(clip(0, 9, window(e, &Keep([all.clone(), 8..16]))[2]), None);
+        assert_eq!(clip(0, 9, window(e, &Keep([7..9, all]))[1]), None);
     }
 
     #[test]

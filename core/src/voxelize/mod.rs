@@ -42,16 +42,17 @@
 //! (plus a term linear in the object's extent along one axis), never in the
 //! raster volume or the object's bounding-box volume.
 //!
-//! # Layers
+//! # Layers and rows
 //! A sink may keep only some layers of the raster ([`VoxelSink::layers`]:
-//! a builder working on one z-slab of it). Every voxelizer then offers the
-//! voxels of those layers exactly as it would without the hint, in the
-//! same order, and the spheres, triangles, meshes, tessellated surfaces
-//! (cones, tori, patches), boxes, volumes and CSG trees
-//! ([`crate::csg::voxelize`]) skip the work for the other layers, so that
-//! cutting a raster into slabs costs about what the whole raster does.
-//! Other voxelizers may still offer voxels outside the layers, which the
-//! sink drops.
+//! a builder working on one z-slab of it), and of those only some rows
+//! ([`VoxelSink::rows`]: a band of a slab). Every voxelizer then offers the
+//! voxels of those rows and layers exactly as it would without the hint,
+//! in the same order, and the spheres, triangles, meshes, tessellated
+//! surfaces (cones, tori, patches), boxes, volumes and CSG trees
+//! ([`crate::csg::voxelize`]) skip the work for the other rows and layers,
+//! so that cutting a raster into slabs and bands costs about what the
+//! whole raster does. Other voxelizers may still offer voxels outside
+//! them, which the sink drops.
 
 use core::ops::Range;
 
@@ -119,10 +120,18 @@ pub trait VoxelSink {
 
     /// The layers (z coordinates) whose voxels the sink keeps; every layer
     /// unless the sink says otherwise. A hint that lets a voxelizer skip
-    /// the work for the other layers (see *Layers* in the
+    /// the work for the other layers (see *Layers and rows* in the
     /// [module docs](self)): the offers inside them are the same, in the
     /// same order, as without it, and offers outside them may still come.
     fn layers(&self) -> Range<u32> {
+        0..u32::MAX
+    }
+
+    /// The rows (y coordinates) whose voxels the sink keeps; every row
+    /// unless the sink says otherwise. A hint, as [`VoxelSink::layers`]:
+    /// the offers inside them are the same, in the same order, as without
+    /// it, and offers outside them may still come.
+    fn rows(&self) -> Range<u32> {
         0..u32::MAX
     }
 

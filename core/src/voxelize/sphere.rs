@@ -108,7 +108,7 @@ fn shell<S: VoxelSink + ?Sized>(
     sink: &mut S,
     fill: bool,
 ) -> Result<u64, VoxelizeError> {
-    let b = Ball::new(sphere, window(extent, sink.layers()))?;
+    let b = Ball::new(sphere, window(extent, sink))?;
     let mut n = Counter::default();
     if b.outside_window() {
         return Ok(0);
@@ -559,7 +559,12 @@ mod tests {
             centre: [0; 3],
             radius: 3 * V as i64,
         };
-        let b = Ball::new(&s, window(Extent::cube(8).unwrap(), 0..u32::MAX)).unwrap();
+        // A sink keeping every voxel.
+        struct All;
+        impl VoxelSink for All {
+            fn offer(&mut self, _: [u32; 3], _: Surfel) {}
+        }
+        let b = Ball::new(&s, window(Extent::cube(8).unwrap(), &All)).unwrap();
         let sf = b.surfel([3, 0, 0]);
         assert!(sf.normal[0] > 1 << 29);
         // centre (3.5, .5, .5): |w| = sqrt(12.75) ≈ 3.5707 voxels

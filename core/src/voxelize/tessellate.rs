@@ -97,7 +97,7 @@ pub(crate) struct Emitter<'a, S: ?Sized> {
 
 impl<'a, S: VoxelSink + ?Sized> Emitter<'a, S> {
     pub(crate) fn new(sep: Separation, extent: Extent, sink: &'a mut S) -> Self {
-        let win = window(extent, sink.layers());
+        let win = window(extent, sink);
         Self {
             sep,
             extent,

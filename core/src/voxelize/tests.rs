@@ -1,8 +1,8 @@
-//! The hints of every voxelizer's sink: a sink that keeps some layers
-//! ([`VoxelSink::layers`]) gets exactly the offers of those layers that a
-//! sink keeping every layer gets, in the same order, and one that reads no
-//! surfels ([`VoxelSink::reads_surfels`]) the same voxels in the same
-//! order.
+//! The hints of every voxelizer's sink: a sink that keeps some rows and
+//! layers ([`VoxelSink::rows`], [`VoxelSink::layers`]) gets exactly the
+//! offers of those rows and layers that a sink keeping every voxel gets,
+//! in the same order, and one that reads no surfels
+//! ([`VoxelSink::reads_surfels`]) the same voxels in the same order.
 
 use core::ops::Range;
 use std::vec::Vec;
@@ -15,17 +15,19 @@ use crate::geometry::{BezierPatch, Cone, Cuboid, Point, Sphere, Torus, Triangle}
 use crate::raster::Extent;
 use crate::testkit::Rng;
 
-/// Every offer in order; keeps the layers `layers`, reads the surfels if
-/// `reads`.
+/// Every offer in order; keeps the rows `rows` of the layers `layers`,
+/// reads the surfels if `reads`.
 struct Sequence {
+    rows: Range<u32>,
     layers: Range<u32>,
     reads: bool,
     offers: Vec<(u16, [u32; 3], Surfel)>,
 }
 
 impl Sequence {
-    fn new(layers: Range<u32>) -> Self {
+    fn new([rows, layers]: [Range<u32>; 2]) -> Self {
         Self {
+            rows,
             layers,
             reads: true,
             offers: Vec::new(),
@@ -42,6 +44,10 @@ impl VoxelSink for Sequence {
         self.layers.clone()
     }
 
+    fn rows(&self) -> Range<u32> {
+        self.rows.clone()
+    }
+
     fn reads_surfels(&self) -> bool {
         self.reads
     }
@@ -55,28 +61,37 @@ impl CsgSink for Sequence {
     fn layers(&self) -> Range<u32> {
         self.layers.clone()
     }
+
+    fn rows(&self) -> Range<u32> {
+        self.rows.clone()
+    }
 }
 
-/// `run` with every layer and with `layers`: the offers of `layers` agree.
+/// `run` keeping every voxel and keeping the rows and layers of `keep`:
+/// the offers of those rows and layers agree.
 #[track_caller]
-fn assert_layers_kept(what: &str, layers: Range<u32>, run: impl Fn(&mut Sequence)) {
-    let mut all = Sequence::new(0..u32::MAX);
+fn assert_layers_kept(what: &str, keep: [Range<u32>; 2], run: impl Fn(&mut Sequence)) {
+    let mut all = Sequence::new([0..u32::MAX, 0..u32::MAX]);
     run(&mut all);
-    let mut some = Sequence::new(layers.clone());
+    let mut some = Sequence::new(keep.clone());
     run(&mut some);
-    let inside = |o: &&(u16, [u32; 3], Surfel)| layers.contains(&o.1[2]);
+    let [rows, layers] = &keep;
+    let inside = |o: &&(u16, [u32; 3], Surfel)| rows.contains(&o.1[1]) && layers.contains(&o.1[2]);
     let want: Vec<_> = all.offers.iter().filter(inside).collect();
     let got: Vec<_> = some.offers.iter().filter(inside).collect();
-    assert_eq!(got, want, "{what}, layers {layers:?}");
+    assert_eq!(got, want, "{what}, rows and layers {keep:?}");
     let mut counting = Sequence {
         reads: false,
-        ..Sequence::new(layers.clone())
+        ..Sequence::new(keep.clone())
     };
     run(&mut counting);
     let voxels = |o: &(u16, [u32; 3], Surfel)| (o.0, o.1);
     let want: Vec<_> = all.offers.iter().filter(inside).map(voxels).collect();
     let got: Vec<_> = counting.offers.iter().filter(inside).map(voxels).collect();
-    assert_eq!(got, want, "{what}, layers {layers:?}, surfels unread");
+    assert_eq!(
+        got, want,
+        "{what}, rows and layers {keep:?}, surfels unread"
+    );
 }
 
 /// A point near the raster of `n` voxels per axis, in fixed units.
@@ -85,7 +100,7 @@ fn point(rng: &mut Rng, n: i64) -> Point {
 }
 
 #[test]
-fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
+fn voxelizers_offer_the_same_voxels_in_the_rows_and_layers_a_sink_keeps() {
     let mut rng = Rng(0x5eed_1a7e_u64);
     let n = 24i64;
     let extent = Extent::new(20, 22, 24).unwrap();
@@ -97,12 +112,21 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
         };
         let z0 = rng.below_u32(26);
         let layers = z0..z0 + 1 + rng.below_u32(12);
+        // Every row in a third of the cases (a slab), some rows otherwise
+        // (a band).
+        let y0 = rng.below_u32(24);
+        let rows = if case % 3 == 0 {
+            0..u32::MAX
+        } else {
+            y0..y0 + 1 + rng.below_u32(12)
+        };
+        let keep = [rows, layers];
         let r = |rng: &mut Rng| rng.range(VOXEL / 3, 9 * VOXEL);
         let ball = Sphere {
             centre: point(&mut rng, n),
             radius: r(&mut rng),
         };
-        assert_layers_kept("sphere", layers.clone(), |s| {
+        assert_layers_kept("sphere", keep.clone(), |s| {
             sphere::surface(&ball, sep, extent, s).unwrap();
             sphere::solid(&ball, sep, extent, s).unwrap();
         });
@@ -110,15 +134,15 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
             vertices: [0; 3].map(|_| point(&mut rng, n)),
             normals: None,
         };
-        assert_layers_kept("triangle", layers.clone(), |s| {
+        assert_layers_kept("triangle", keep.clone(), |s| {
             let _ = triangle::triangle(&tri, sep, extent, s);
         });
         let poly: Vec<Point> = (0..5).map(|_| point(&mut rng, n)).collect();
-        assert_layers_kept("polygon", layers.clone(), |s| {
+        assert_layers_kept("polygon", keep.clone(), |s| {
             let _ = triangle::polygon(&poly, sep, extent, s);
         });
         let faces = [[0, 1, 2], [0, 2, 3], [1, 3, 4]];
-        assert_layers_kept("mesh", layers.clone(), |s| {
+        assert_layers_kept("mesh", keep.clone(), |s| {
             let _ = triangle::mesh(&poly, None, &faces, sep, extent, s);
         });
         let cone = Cone {
@@ -127,7 +151,7 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
             apex: point(&mut rng, n),
             apex_radius: r(&mut rng) / 2,
         };
-        assert_layers_kept("cone", layers.clone(), |s| {
+        assert_layers_kept("cone", keep.clone(), |s| {
             let _ = cone::surface(&cone, sep, extent, s);
             let _ = cone::capped(&cone, sep, extent, s);
         });
@@ -138,7 +162,7 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
             major: r(&mut rng),
             minor: r(&mut rng) / 3 + 1,
         };
-        assert_layers_kept("torus", layers.clone(), |s| {
+        assert_layers_kept("torus", keep.clone(), |s| {
             let _ = torus::surface(&ring, sep, extent, s);
         });
         let mut control = [[[0i64; 3]; 4]; 4];
@@ -148,7 +172,7 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
             }
         }
         let bezier = BezierPatch { control };
-        assert_layers_kept("patch", layers.clone(), |s| {
+        assert_layers_kept("patch", keep.clone(), |s| {
             let _ = patch::surface(&bezier, sep, extent, s);
         });
         let (a, b) = (point(&mut rng, n), point(&mut rng, n));
@@ -156,7 +180,7 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
             min: [0, 1, 2].map(|k| a[k].min(b[k])),
             max: [0, 1, 2].map(|k| a[k].max(b[k]) + 1),
         };
-        assert_layers_kept("cuboid", layers.clone(), |s| {
+        assert_layers_kept("cuboid", keep.clone(), |s| {
             let _ = cuboid::surface(&cube, sep, extent, s);
             let _ = cuboid::solid(&cube, sep, extent, s);
         });
@@ -169,7 +193,7 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
             dims,
             offset: [0; 3].map(|_| rng.range(-4, 16)),
         };
-        assert_layers_kept("volume", layers.clone(), |s| {
+        assert_layers_kept("volume", keep.clone(), |s| {
             volume::boundary(&block, 2, sep, extent, s).unwrap();
         });
         let nodes = [
@@ -179,7 +203,7 @@ fn voxelizers_offer_the_same_voxels_in_the_layers_a_sink_keeps() {
         ];
         let leaves: [&dyn csg::Solid; 2] = [&ball, &cube];
         let tree = CsgTree::new(&nodes, &leaves).unwrap();
-        assert_layers_kept("csg", layers.clone(), |s| {
+        assert_layers_kept("csg", keep.clone(), |s| {
             csg::voxelize(&tree, extent, s);
         });
     }

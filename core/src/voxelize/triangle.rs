@@ -552,7 +552,7 @@ impl Tri {
         let reads = sink.reads_surfels();
         // Quick reject: the probe reaches at most half a voxel beyond the
         // triangle's bounding box.
-        let win = window(extent, sink.layers());
+        let win = window(extent, sink);
         for (k, (start, end)) in win.iter().enumerate() {
             let lo = self.v.iter().map(|p| p[k]).min().unwrap_or(0);
             let hi = self.v.iter().map(|p| p[k]).max().unwrap_or(0);

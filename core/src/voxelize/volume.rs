@@ -105,7 +105,7 @@ where
     };
     // Block sample range that lands inside the raster (along z, inside
     // the sink's layers), per axis.
-    let win = window(extent, sink.layers());
+    let win = window(extent, sink);
     let mut lo = [0i64; 3];
     let mut hi = [0i64; 3];
     for k in 0..3 {

@@ -311,7 +311,7 @@ pub fn build(
         textures: &textures,
         exact: opts.exact,
     };
-    let layers = slabs::slab_layers(extent.dims()[2], pool.current_num_threads());
+    let pieces = slabs::pieces(extent.dims(), pool.current_num_threads());
     // Refused after the count pass, before the records are allocated: an
     // empty box, or more memory than the limit for the exact record count
     // (and the lists' working storage, the count pass's bound, see
@@ -328,6 +328,7 @@ pub fn build(
         let needed = u64::try_from(
             extent
                 .len()
+                .saturating_add(c.band_planes)
                 .saturating_add(c.directory.saturating_mul(size_of::<u32>()))
                 .saturating_add(c.records.saturating_mul(size_of::<VoxelRecord>()))
                 .saturating_add(c.list_entries.saturating_mul(size_of::<u32>())),
@@ -348,7 +349,7 @@ pub fn build(
         mut records,
         lists,
         offers,
-    } = passes.run(&mut plane, &layers, &pool, check, progress)?;
+    } = passes.run(&mut plane, &pieces, &pool, check, progress)?;
     let records_n = records.len();
     // The light pass changes no cell and no record's place: the plane can
     // be finished first, so that its walks read the distance field and

@@ -9,6 +9,8 @@
 //! voxel objects have no exact geometry: their world object is
 //! [`Shape::Voxels`], whose hits verification keeps.
 
+use rrt_core::fixed::FRAC_BITS;
+use rrt_core::geometry::Point;
 use rrt_core::object_table as table;
 use rrt_core::voxelize::Separation;
 
@@ -83,6 +85,44 @@ impl TableObject<'_> {
         }
     }
 
+    /// The cells, per axis and inclusive, outside which the object's
+    /// voxelizer offers nothing: its fixed-point geometry's box grown by
+    /// [`BOX_MARGIN`] voxels; `None` where that box is not known here
+    /// (volumes, voxel models, CSG trees, Bézier patches): every cell.
+    #[must_use]
+    pub fn cells(&self) -> Option<[(i64, i64); 3]> {
+        let Self::Primitive(o) = self else {
+            return None;
+        };
+        let (lo, hi) = match o.entry {
+            table::Shape::Sphere(s) => grown(&[s.centre], s.radius),
+            table::Shape::Triangle(t) => grown(&t.vertices, 0),
+            table::Shape::Cone(c) => grown(
+                &[c.base, c.apex],
+                c.base_radius
+                    .saturating_abs()
+                    .max(c.apex_radius.saturating_abs()),
+            ),
+            table::Shape::Cuboid(c) => grown(&[c.min, c.max], 0),
+            table::Shape::Torus(t) => grown(
+                &[t.centre],
+                t.major
+                    .saturating_abs()
+                    .saturating_add(t.minor.saturating_abs()),
+            ),
+            table::Shape::Patch(_) | table::Shape::Volume(_) | table::Shape::Voxels => {
+                return None;
+            }
+        };
+        let cell = |p: i64| p >> FRAC_BITS;
+        Some([0, 1, 2].map(|k| {
+            (
+                cell(lo[k]).saturating_sub(BOX_MARGIN),
+                cell(hi[k]).saturating_add(BOX_MARGIN),
+            )
+        }))
+    }
+
     /// Voxelizes the object into `pass`.
     ///
     /// # Errors
@@ -103,6 +143,25 @@ impl TableObject<'_> {
             Self::Csg(c) => csg::voxelize_object(c, frame, separation, pass),
         }
     }
+}
+
+/// Voxels beyond a primitive's fixed-point box that its voxelizer may
+/// still offer: the lattice-step probes reach half a voxel beyond the
+/// surface, a closed cell touching the box counts; two leave room.
+const BOX_MARGIN: i64 = 2;
+
+/// The box of `points` grown by `r` (≥ 0) on every side (saturating).
+fn grown(points: &[Point], r: i64) -> (Point, Point) {
+    let r = r.saturating_abs();
+    let mut lo = [i64::MAX; 3];
+    let mut hi = [i64::MIN; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k].saturating_sub(r));
+            hi[k] = hi[k].max(p[k].saturating_add(r));
+        }
+    }
+    (lo, hi)
 }
 
 /// Voxelizes a fitted primitive through its core voxelizer; in the fill

@@ -1,21 +1,34 @@
-//! The two voxelization passes on all cores: the raster cut into z-slabs
-//! of whole brick layers, each built on its own by the core's single-
-//! threaded builder ([`Counter::slab`]) on rayon's threads, and joined.
+//! The two voxelization passes on all cores: the raster cut into pieces,
+//! each built on its own by the core's single-threaded builder on rayon's
+//! threads, and joined. A piece is a *slab* of whole brick layers with
+//! every row ([`Counter::slab`]) or, where the raster has fewer brick
+//! layers than the threads want pieces (flat scenes), a *band* of whole
+//! brick rows of one brick layer ([`Counter::band`]).
 //!
-//! Every slab voxelizes every object, in object-id order, through a sink
-//! that keeps only the slab's layers ([`VoxelSink::layers`]): each voxel
-//! gets the offers it gets in a whole build, in the same order, so its
-//! record and object list are the same. Bricks are numbered z-major, so a
-//! slab's plane, bricks, records and lists are contiguous parts of the
-//! whole raster's, in the same order; joining them is arithmetic: each
-//! slab's directory entries move up by the records before it, its list
-//! indices by the list entries before it ([`shift_lists`]). The result is
-//! the same bytes whatever the number of slabs or threads.
+//! Every piece voxelizes, in object-id order, every object that can offer
+//! a voxel in it ([`TableObject::cells`]; an object whose box lies outside
+//! the raster goes to the nearest pieces, so that its voxelizer's refusal
+//! is still seen), through a sink that keeps only the piece's rows and
+//! layers ([`VoxelSink::rows`], [`VoxelSink::layers`]): each voxel gets
+//! the offers it gets in a whole build, in the same order, so its record
+//! and object list are the same. Bricks are numbered z-major and, within
+//! a brick layer, row by row, so the pieces' bricks, records and lists
+//! are contiguous parts of the whole raster's, in the same order; joining
+//! them is arithmetic: each piece's directory entries move up by the
+//! records before it, its list indices by the list entries before it
+//! ([`shift_lists`]). The result is the same bytes whatever the number of
+//! pieces or threads.
 //!
-//! Memory: the plane is cut in place, the records and lists are allocated
-//! once for all slabs (each slab fills its own range), and the slabs'
-//! directories are parts of one directory with one spare entry per slab,
-//! closed up when they are joined.
+//! Memory: a slab's plane is cut from the raster's plane in place, a band
+//! builds its plane apart (one brick layer's rows, copied in after the
+//! fill pass); the records and lists are allocated once for all pieces
+//! (each fills its own range), and the pieces' directories are parts of
+//! one directory with one spare entry per piece, closed up when they are
+//! joined.
+//!
+//! [`VoxelSink::rows`]: rrt_core::voxelize::VoxelSink::rows
+//! [`VoxelSink::layers`]: rrt_core::voxelize::VoxelSink::layers
+//! [`TableObject::cells`]: super::objects::TableObject::cells
 
 use std::ops::Range;
 use std::sync::Mutex;
@@ -37,30 +50,58 @@ use super::texture::MaterialTextures;
 use crate::frame::RasterFrame;
 use crate::progress::Unit;
 
-/// Slabs per thread: more slabs than threads, so that a thread whose slabs
-/// hold little finds more work.
-const SLABS_PER_THREAD: usize = 8;
+/// Pieces per thread: more pieces than threads, so that a thread whose
+/// pieces hold little finds more work.
+const PIECES_PER_THREAD: usize = 8;
 
-/// The layers of each slab for `threads` threads (at least 1): whole brick
-/// layers, about as many per slab; one slab for one thread.
+/// A part of the raster built on its own: the rows `rows` of the layers
+/// `layers`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Piece {
+    /// Layers (z): whole brick layers.
+    pub layers: Range<u32>,
+    /// Rows (y): every row (a slab), or whole brick rows of one brick
+    /// layer (a band).
+    pub rows: Range<u32>,
+}
+
+/// The pieces for `threads` threads (at least 1) over a raster of `dims`,
+/// in raster order: about [`PIECES_PER_THREAD`] per thread, slabs of about
+/// as many whole brick layers each; where the raster has fewer brick
+/// layers than that, each brick layer cut into bands of about as many
+/// whole brick rows. One slab for one thread.
 #[must_use]
-pub fn slab_layers(nz: u32, threads: usize) -> Vec<Range<u32>> {
+pub fn pieces(dims: [u32; 3], threads: usize) -> Vec<Piece> {
+    let [_, ny, nz] = dims;
     let brick_layers = nz.div_ceil(BRICK).max(1);
+    let brick_rows = ny.div_ceil(BRICK).max(1);
     let wanted = if threads <= 1 {
         1
     } else {
-        threads.saturating_mul(SLABS_PER_THREAD)
+        u32::try_from(threads.saturating_mul(PIECES_PER_THREAD)).unwrap_or(u32::MAX)
     };
-    let n = u32::try_from(wanted).unwrap_or(u32::MAX).min(brick_layers);
-    (0..n)
-        .map(|i| {
-            // Brick layer boundaries spread evenly: i·L/n (L < 2^14).
-            let at = |i: u32| (u64::from(i) * u64::from(brick_layers) / u64::from(n)) as u32;
-            let z0 = at(i) * BRICK;
-            let z1 = (at(i + 1) * BRICK).min(nz);
-            z0..z1
-        })
-        .collect()
+    let slabs = wanted.min(brick_layers);
+    let bands = if slabs < wanted {
+        wanted.div_ceil(slabs).min(brick_rows)
+    } else {
+        1
+    };
+    // Boundaries spread evenly over whole bricks: i·total/n (total < 2^29).
+    let at = |i: u32, total: u32, n: u32| (u64::from(i) * u64::from(total) / u64::from(n)) as u32;
+    let mut out = Vec::new();
+    for i in 0..slabs {
+        let layers =
+            at(i, brick_layers, slabs) * BRICK..(at(i + 1, brick_layers, slabs) * BRICK).min(nz);
+        for j in 0..bands {
+            let rows =
+                at(j, brick_rows, bands) * BRICK..(at(j + 1, brick_rows, bands) * BRICK).min(ny);
+            out.push(Piece {
+                layers: layers.clone(),
+                rows,
+            });
+        }
+    }
+    out
 }
 
 /// What the passes see of the scene.
@@ -87,8 +128,10 @@ pub(super) struct Counted {
     pub records: usize,
     /// Entries of list storage the fill pass needs (0 without lists).
     pub list_entries: usize,
-    /// Entries of the slabs' directories while they are built.
+    /// Entries of the pieces' directories while they are built.
     pub directory: usize,
+    /// Bytes of the bands' own planes while they are built.
+    pub band_planes: usize,
 }
 
 /// The joined result of both passes.
@@ -103,9 +146,13 @@ pub(super) struct Voxelized {
     pub offers: u64,
 }
 
-/// One slab's parts of the plane and of the (padded) directory.
-struct Part<'p, 'd> {
+/// One piece's plane, part of the (padded) directory and objects.
+struct Part<'p, 'd, 'm> {
     z0: u32,
+    /// A band's first row; `None` for a slab.
+    band: Option<u32>,
+    /// The ids of the objects the slab voxelizes, in order.
+    members: &'m [usize],
     extent: Extent,
     plane: &'p mut [u8],
     dir: &'d mut [u32],
@@ -169,9 +216,9 @@ fn first_error<T>(
 }
 
 impl Passes<'_> {
-    /// Runs both passes over `plane` (the whole raster, zero) in the slabs
-    /// of `layers`, on `pool`; `check` sees the count pass's sizes before
-    /// anything more is allocated and may refuse the scene.
+    /// Runs both passes over `plane` (the whole raster, zero) in the
+    /// `pieces` (of [`pieces`]), on `pool`; `check` sees the count pass's
+    /// sizes before anything more is allocated and may refuse the scene.
     ///
     /// # Errors
     /// `check`'s refusal, a voxelizer's (of the lowest object id), the
@@ -179,7 +226,7 @@ impl Passes<'_> {
     pub fn run(
         &self,
         plane: &mut [u8],
-        layers: &[Range<u32>],
+        pieces: &[Piece],
         pool: &ThreadPool,
         check: impl FnOnce(Counted) -> Result<(), BuildError>,
         progress: &ProgressBar,
@@ -189,34 +236,73 @@ impl Passes<'_> {
         let bad = || BuildError::Raster("slabs do not fit the raster".into());
         let dir_len = directory_len(extent).ok_or_else(bad)?;
         let padded = dir_len
-            .checked_add(layers.len().saturating_sub(1))
+            .checked_add(pieces.len().saturating_sub(1))
             .ok_or_else(bad)?;
         let mut directory = vec![0u32; padded];
+        let members = self.members(pieces);
+        let extents = pieces
+            .iter()
+            .map(|p| {
+                let len = |r: &Range<u32>| r.end.saturating_sub(r.start);
+                Extent::new(nx, len(&p.rows), len(&p.layers)).map_err(|_| bad())
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let is_band = |p: &Piece| p.rows != (0..ny);
+        // The bands' own planes.
+        let mut band_planes: Vec<Vec<u8>> = pieces
+            .iter()
+            .zip(&extents)
+            .map(|(p, e)| {
+                if is_band(p) {
+                    vec![0u8; e.len()]
+                } else {
+                    Vec::new()
+                }
+            })
+            .collect();
+        let band_bytes = band_planes.iter().map(Vec::len).sum::<usize>();
 
-        // Each slab's parts.
-        let mut parts = Vec::with_capacity(layers.len());
-        let (mut plane_rest, mut dir_rest) = (plane, &mut directory[..]);
-        for l in layers {
-            let e = Extent::new(nx, ny, l.end.saturating_sub(l.start)).map_err(|_| bad())?;
-            let (p, pr) = plane_rest.split_at_mut_checked(e.len()).ok_or_else(bad)?;
+        // Each piece's parts: a slab's plane cut from the raster's, a
+        // band's its own; the raster's layers of the bands are passed by.
+        let mut parts = Vec::with_capacity(pieces.len());
+        let (mut plane_rest, mut dir_rest) = (&mut *plane, &mut directory[..]);
+        for (((pc, m), &e), own) in pieces
+            .iter()
+            .zip(&members)
+            .zip(&extents)
+            .zip(&mut band_planes)
+        {
+            let cut = if !is_band(pc) {
+                e.len()
+            } else if pc.rows.end == ny {
+                // The last band of its layers: the raster's cells of those
+                // layers are passed by.
+                extent.len() / extent.dims()[2] as usize * e.dims()[2] as usize
+            } else {
+                0
+            };
+            let (p, pr) = plane_rest.split_at_mut_checked(cut).ok_or_else(bad)?;
+            plane_rest = pr;
+            let p = if is_band(pc) { &mut own[..] } else { p };
             let d_len = directory_len(e).ok_or_else(bad)?;
             let (d, dr) = dir_rest.split_at_mut_checked(d_len).ok_or_else(bad)?;
             parts.push(Part {
-                z0: l.start,
+                z0: pc.layers.start,
+                band: is_band(pc).then_some(pc.rows.start),
+                members: m,
                 extent: e,
                 plane: p,
                 dir: d,
             });
-            (plane_rest, dir_rest) = (pr, dr);
+            dir_rest = dr;
         }
-        let slabs = parts.len() as u64;
-        let objects = self.objects.len() as u64;
+        let visits = members.iter().map(|m| m.len() as u64).sum::<u64>();
 
         crate::progress::phase(
             progress,
             "voxelizing (count pass)",
             Unit::SlabObjects,
-            objects.saturating_mul(slabs),
+            visits,
         );
         // Slabs in order: nothing says yet which hold more.
         let counted = heaviest_first(
@@ -245,6 +331,7 @@ impl Passes<'_> {
             records: records_n,
             list_entries: list_n,
             directory: padded,
+            band_planes: band_bytes,
         })?;
         let offers = sizings.iter().map(|(_, o)| *o).sum();
 
@@ -260,26 +347,43 @@ impl Passes<'_> {
         let record_counts: Vec<usize> = sizings.iter().map(|(s, _)| s.records()).collect();
         let mut jobs = Vec::with_capacity(sizings.len());
         let (mut rec_rest, mut list_rest) = (&mut records[..], &mut lists[..]);
-        for ((sizing, _), &l) in sizings.into_iter().zip(&list_sizes) {
+        for (((sizing, _), &l), m) in sizings.into_iter().zip(&list_sizes).zip(&members) {
             let (r, rr) = rec_rest.split_at_mut(sizing.records());
             let (s, sr) = list_rest.split_at_mut(l);
-            jobs.push((sizing, r, s));
+            jobs.push((sizing, r, s, &m[..]));
             (rec_rest, list_rest) = (rr, sr);
         }
         crate::progress::phase(
             progress,
             "voxelizing (fill pass)",
             Unit::SlabObjects,
-            objects.saturating_mul(slabs),
+            visits,
         );
         // The slabs with the most records first.
         let filled = heaviest_first(
             pool,
             jobs,
-            |(_, r, _), _| r.len() as u64,
-            |(sizing, r, s)| self.fill(sizing, r, s, progress),
+            |(_, r, _, _), _| r.len() as u64,
+            |(sizing, r, s, m)| self.fill(sizing, r, s, m, progress),
         );
         let lists_used = first_error(filled)?;
+
+        // The bands' planes into the raster's.
+        let row = nx as usize;
+        for (pc, own) in pieces.iter().zip(&band_planes) {
+            if !is_band(pc) {
+                continue;
+            }
+            let rows = pc.rows.end.saturating_sub(pc.rows.start) as usize;
+            for (z, layer) in pc.layers.clone().zip(own.chunks_exact(row * rows)) {
+                let at = (z as usize * ny as usize + pc.rows.start as usize) * row;
+                plane
+                    .get_mut(at..at + layer.len())
+                    .ok_or_else(bad)?
+                    .copy_from_slice(layer);
+            }
+        }
+        drop(band_planes);
 
         // Join: directory entries up by the records before, lists closed up
         // and their indices shifted by the entries before.
@@ -288,13 +392,12 @@ impl Passes<'_> {
         let mut base = 0usize;
         let mut list_from = 0usize;
         let mut list_to = 0usize;
-        for (((l, &n), &bound), &used) in layers
+        for (((&e, &n), &bound), &used) in extents
             .iter()
             .zip(&record_counts)
             .zip(&list_sizes)
             .zip(&lists_used)
         {
-            let e = Extent::new(nx, ny, l.end.saturating_sub(l.start)).map_err(|_| bad())?;
             let bricks = brick_count(e).ok_or_else(bad)?;
             let offset = u32::try_from(base).map_err(|_| bad())?;
             for k in 0..bricks {
@@ -322,18 +425,49 @@ impl Passes<'_> {
         })
     }
 
-    /// The count pass of one slab: its sizing and the offers inside it.
+    /// The ids of the objects each of `pieces` voxelizes, in order: those
+    /// whose cells ([`TableObject::cells`], clamped to the raster) meet the
+    /// piece. Every object is in at least one piece.
+    fn members(&self, pieces: &[Piece]) -> Vec<Vec<usize>> {
+        let [_, ny, nz] = self.frame.extent.dims();
+        let top = |n: u32| i64::from(n).saturating_sub(1).max(0);
+        let (ty, tz) = (top(ny), top(nz));
+        let meets = |(lo, hi): (i64, i64), r: &Range<u32>| {
+            lo < i64::from(r.end) && hi >= i64::from(r.start)
+        };
+        let mut members = vec![Vec::new(); pieces.len()];
+        for (id, o) in self.objects.iter().enumerate() {
+            let (y, z) = o.cells().map_or(((0, ty), (0, tz)), |[_, y, z]| {
+                (
+                    (y.0.clamp(0, ty), y.1.clamp(0, ty)),
+                    (z.0.clamp(0, tz), z.1.clamp(0, tz)),
+                )
+            });
+            for (m, p) in members.iter_mut().zip(pieces) {
+                if meets(y, &p.rows) && meets(z, &p.layers) {
+                    m.push(id);
+                }
+            }
+        }
+        members
+    }
+
+    /// The count pass of one piece: its sizing and the offers inside it.
     fn count<'p, 'd>(
         &self,
-        part: Part<'p, 'd>,
+        part: Part<'p, 'd, '_>,
         progress: &ProgressBar,
     ) -> Result<(Sizing<'p, 'd>, u64), (usize, BuildError)> {
         let raster = RasterMut::new(part.extent, part.plane)
             .map_err(|e| (0, BuildError::Raster(e.to_string())))?;
-        // The plane is a fresh zeroed map, the directory fresh zeros.
-        let mut counter =
-            Counter::slab_zeroed(raster, part.dir, part.z0).map_err(|e| (0, e.into()))?;
-        for (id, o) in self.objects.iter().enumerate() {
+        // The plane is fresh zeroed memory, the directory fresh zeros.
+        let counter = match part.band {
+            None => Counter::slab_zeroed(raster, part.dir, part.z0),
+            Some(y0) => Counter::band(raster, part.dir, [y0, part.z0]),
+        };
+        let mut counter = counter.map_err(|e| (0, e.into()))?;
+        for &id in part.members {
+            let o = &self.objects[id];
             o.voxelize(self.frame, self.separation, Pass::Count(&mut counter))
                 .map_err(|e| (id, e))?;
             progress.inc(1);
@@ -345,13 +479,14 @@ impl Passes<'_> {
         Ok((sizing, r.offers.saturating_sub(r.outside)))
     }
 
-    /// The fill pass of one slab into its records and list storage:
+    /// The fill pass of one piece into its records and list storage:
     /// the list entries its finished lists take.
     fn fill(
         &self,
         sizing: Sizing<'_, '_>,
         records: &mut [VoxelRecord],
         lists: &mut [u32],
+        members: &[usize],
         progress: &ProgressBar,
     ) -> Result<usize, (usize, BuildError)> {
         let limits = Limits {
@@ -364,7 +499,8 @@ impl Passes<'_> {
             sizing.fill(records, limits)
         };
         let mut filler = started.map_err(|e| (0, e.into()))?;
-        for (id, o) in self.objects.iter().enumerate() {
+        for &id in members {
+            let o = &self.objects[id];
             let m = o.material();
             let pass = Pass::Fill {
                 filler: &mut filler,
@@ -391,27 +527,72 @@ mod tests {
     use super::*;
 
     #[test]
-    fn slabs_are_whole_brick_layers_covering_the_raster() {
-        for (nz, threads) in [
-            (1, 1),
-            (61, 2),
-            (64, 2),
-            (1024, 2),
-            (20, 8),
-            (9, 3),
-            (1000, 3),
+    fn pieces_cover_the_raster_in_brick_order() {
+        for (dims, threads) in [
+            ([5, 5, 1], 1),
+            ([100, 90, 61], 2),
+            ([64, 64, 64], 2),
+            ([10, 10, 1024], 2),
+            ([517, 517, 21], 2),
+            ([1024, 1024, 61], 2),
+            ([30, 20, 20], 8),
+            ([9, 9, 9], 3),
+            ([40, 1000, 8], 16),
+            ([40, 3, 1000], 3),
         ] {
-            let s = slab_layers(nz, threads);
-            assert_eq!(s.first().map(|l| l.start), Some(0), "{nz} {threads}");
-            assert_eq!(s.last().map(|l| l.end), Some(nz), "{nz} {threads}");
-            for w in s.windows(2) {
-                assert_eq!(w[0].end, w[1].start);
-                assert_eq!(w[0].end % BRICK, 0);
-            }
-            assert!(s.iter().all(|l| l.start < l.end), "{nz} {threads}: {s:?}");
+            let [_, ny, nz] = dims;
+            let p = pieces(dims, threads);
+            let what = format!("{dims:?} {threads}: {p:?}");
             if threads == 1 {
-                assert_eq!(s.len(), 1);
+                assert_eq!(
+                    p,
+                    [Piece {
+                        layers: 0..nz,
+                        rows: 0..ny
+                    }],
+                    "{what}"
+                );
             }
+            let mut at = (0, 0);
+            for piece in &p {
+                // Next in raster order, starting on a brick boundary.
+                if piece.rows.start == 0 {
+                    assert_eq!(piece.layers.start, at.1, "{what}");
+                } else {
+                    assert_eq!((piece.rows.start, piece.layers.start), at, "{what}");
+                }
+                assert!(piece.layers.start < piece.layers.end, "{what}");
+                assert!(piece.rows.start < piece.rows.end, "{what}");
+                assert_eq!(piece.layers.start % BRICK, 0, "{what}");
+                assert_eq!(piece.rows.start % BRICK, 0, "{what}");
+                assert!(
+                    piece.layers.end == nz || piece.layers.end % BRICK == 0,
+                    "{what}"
+                );
+                assert!(
+                    piece.rows.end == ny || piece.rows.end % BRICK == 0,
+                    "{what}"
+                );
+                // A band lies in one brick layer.
+                if piece.rows != (0..ny) {
+                    assert!(piece.layers.end - piece.layers.start <= BRICK, "{what}");
+                }
+                at = if piece.rows.end == ny {
+                    (0, piece.layers.end)
+                } else {
+                    (piece.rows.end, piece.layers.start)
+                };
+            }
+            assert_eq!(at, (0, nz), "{what}");
+            // Flat rasters are cut into bands when the threads want more
+            // pieces than there are brick layers.
+            let wanted = if threads > 1 {
+                threads * PIECES_PER_THREAD
+            } else {
+                1
+            };
+            let most = (ny.div_ceil(BRICK) * nz.div_ceil(BRICK)) as usize;
+            assert!(p.len() >= wanted.min(most), "{what}");
         }
     }
 }

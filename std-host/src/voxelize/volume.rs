@@ -310,6 +310,10 @@ impl PlacedVolume<'_> {
                 self.0.layers()
             }
 
+            fn rows(&self) -> Range<u32> {
+                self.0.rows()
+            }
+
             fn reads_surfels(&self) -> bool {
                 self.0.reads_surfels()
             }
@@ -423,6 +427,10 @@ impl<S: VoxelSink + ?Sized> VoxelSink for ClipZ<'_, S> {
         let l = self.sink.layers();
         let end = l.end.min(self.z.end);
         l.start.max(self.z.start).min(end)..end
+    }
+
+    fn rows(&self) -> Range<u32> {
+        self.sink.rows()
     }
 }
 
