@@ -174,11 +174,25 @@ pub(crate) fn unit(v: [i128; 3]) -> Option<[i32; 3]> {
 /// Unit vector of `w` with every `|w_k| < 2^31`.
 #[inline]
 fn normalize64(w: [i64; 3]) -> Option<[i32; 3]> {
+    normalize64_len(w).1
+}
+
+/// `floor(|w|)` and the unit vector of `w` ([`normalize64`]), for every
+/// `|w_k| < 2^31`.
+#[inline]
+fn normalize64_len(w: [i64; 3]) -> (i64, Option<[i32; 3]>) {
     // |w_k| < 2^31: squares < 2^62, their sum < 2^64.
     let len2 = w.iter().fold(0u64, |acc, c| {
         acc.wrapping_add(c.unsigned_abs().wrapping_mul(c.unsigned_abs()))
     });
-    let len = i64::try_from(len2.isqrt()).ok()?;
+    let len = i64::try_from(len2.isqrt()).unwrap_or(i64::MAX);
+    (len, unit_of_len(w, len))
+}
+
+/// `w·2^30 / len` per component (truncated), for `|w_k| ≤ len < 2^31`;
+/// `None` for `len = 0`.
+#[inline]
+fn unit_of_len(w: [i64; 3], len: i64) -> Option<[i32; 3]> {
     if len == 0 {
         return None;
     }
@@ -193,10 +207,20 @@ fn normalize64(w: [i64; 3]) -> Option<[i32; 3]> {
 
 /// Length `floor(sqrt(v·v))` and unit direction of `v`. Vectors with a
 /// component in `[2^20, 2^31)` (the common case: more than 1/64 voxel) take
-/// one 64-bit square root for both; others go through [`unit()`].
+/// one 64-bit square root for both; shorter ones too, scaled as [`unit()`]
+/// scales them (the root of the scaled length, shifted back, is the
+/// floored length: `⌊⌊2^s·x⌋ / 2^s⌋ = ⌊x⌋`); longer ones go through
+/// [`length`] and [`unit()`].
 #[inline]
 pub(crate) fn radial(v: [i128; 3]) -> (i128, Option<[i32; 3]>) {
     let m = v.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+    if (1..1 << 20).contains(&m) {
+        // As `unit`: the largest component scaled to 30 bits.
+        let s = 30u32.saturating_sub(128u32.saturating_sub(m.leading_zeros()));
+        let w = v.map(|c| i64::try_from(c << s).unwrap_or(0));
+        let (len, u) = normalize64_len(w);
+        return (i128::from(len >> s), u);
+    }
     if (1 << 20..1 << 31).contains(&m) {
         let w = v.map(|c| i64::try_from(c).unwrap_or(0));
         let len2 = w.iter().fold(0u64, |acc, c| {
@@ -516,6 +540,29 @@ mod tests {
                     "{v:?} {u:?}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn radial_is_length_and_unit() {
+        // Below 2^20 the very numbers of `length` and `unit`; above, the
+        // length and a unit vector from it (within 2^-20).
+        let mut rng = crate::testkit::Rng(0x4ad1_a100);
+        let check = |v: [i128; 3]| {
+            let (len, u) = radial(v);
+            assert_eq!(len, length(v), "{v:?}");
+            if v.iter().all(|c| c.unsigned_abs() < 1 << 20) {
+                assert_eq!(u, unit(v), "{v:?}");
+            }
+        };
+        check([0; 3]);
+        for bits in 0..40u32 {
+            for _ in 0..200 {
+                let mut c = || i128::from(rng.range(-(1i64 << bits), 1i64 << bits));
+                check([c(), c(), c()]);
+            }
+            check([1i128 << bits, 0, 0]);
+            check([(1i128 << bits) - 1, -((1i128 << bits) - 1), 1]);
         }
     }
 }
