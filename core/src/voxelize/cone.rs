@@ -224,16 +224,16 @@ fn run<S: VoxelSink + ?Sized>(
         s
     };
     let total = m.saturating_mul(4);
+    // Each rim point once: a chord's end is the next chord's start.
+    let (first_b, first_a) = (g.ring(g.b, g.r0, 0, m), g.ring(g.a, g.r1, 0, m));
+    let (mut b0, mut a0) = (first_b, first_a);
     for j in 0..total {
-        let j1 = if j.saturating_add(1) == total {
-            0
+        let j1 = j.saturating_add(1);
+        let (b1, a1) = if j1 == total {
+            (first_b, first_a)
         } else {
-            j.saturating_add(1)
+            (g.ring(g.b, g.r0, j1, m), g.ring(g.a, g.r1, j1, m))
         };
-        let b0 = g.ring(g.b, g.r0, j, m);
-        let b1 = g.ring(g.b, g.r0, j1, m);
-        let a0 = g.ring(g.a, g.r1, j, m);
-        let a1 = g.ring(g.a, g.r1, j1, m);
         em.quad([b0, b1, a1, a0], None, &f)?;
         if caps {
             if g.r0 > 0 {
@@ -243,6 +243,7 @@ fn run<S: VoxelSink + ?Sized>(
                 em.tri([g.a, a0, a1], None, &f)?;
             }
         }
+        (b0, a0) = (b1, a1);
     }
     Ok(em.n.0)
 }

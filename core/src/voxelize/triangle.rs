@@ -74,8 +74,8 @@
 
 use super::error::VoxelizeError;
 use super::fixmath::{
-    Counter, H, IncDiv, V, ceil_div, centre, check_point, checked_cross, checked_dot, clip,
-    dist_u32, div_trunc, dot, floor_div, isqrt, low, sub, unit, window,
+    Counter, H, IncDiv, V, ceil_div, centre, centres_within, check_point, checked_cross,
+    checked_dot, clip, dist_u32, div_trunc, dot, floor_div, isqrt, low, sub, unit, window,
 };
 use super::sphere::{pick, place};
 use super::{NORMAL_ONE, Separation, Surfel, VoxelSink};
@@ -354,6 +354,10 @@ struct Axis {
     hi: i128,
 }
 
+/// Most cells a triangle's probes may reach for [`Tri::scan_with`] to
+/// test each instead of setting up its rows and columns.
+const FEW_CELLS: u64 = 27;
+
 /// What a walk along the columns of a row needs of a column axis
 /// `α = (α_a, α_b, α_k)` ([`Tri::columns`]), the same for every row: the
 /// divisor `α_k·V`, the probe's reach `α_k·H`, and the per-column steps of
@@ -591,6 +595,35 @@ impl Tri {
         })?;
         let rows = rows.get(..nr).unwrap_or(&[]);
         let cols = cols.get(..nc).unwrap_or(&[]);
+        // A triangle whose probes reach only a few cells (the tessellation
+        // of a thin cylinder, a small disc): each cell's centre against
+        // every axis, in the scan's order, instead of the rows' and
+        // columns' set-up. The cells are the scan's: those whose centre
+        // meets every axis. (Not for a plain flat triangle, whose scan
+        // gives the cells inside its outline the plane's surfel.)
+        if !(plain && self.normals.is_none())
+            && let Some(cells) = self.few_cells(k, win)
+        {
+            let [(a0, a1), (b0, b1), (k0, k1)] = cells;
+            for bi in b0..=b1 {
+                for ai in a0..=a1 {
+                    for ki in k0..=k1 {
+                        let c = [centre(ai), centre(bi), centre(ki)];
+                        let inside = rows.iter().chain(cols).all(|ax| {
+                            let p = dot(ax.alpha, c);
+                            ax.lo <= p && p <= ax.hi
+                        });
+                        if inside {
+                            let v = place(k, ai, bi, ki);
+                            let s = if reads { surfel(self, v) } else { Surfel::NONE };
+                            sink.offer(v, s);
+                            n.bump();
+                        }
+                    }
+                }
+            }
+            return Ok(());
+        }
         // What every row's walk along the columns needs of each column axis.
         let mut steps = [None::<ColumnStep>; 32];
         for (ax, st) in cols.iter().zip(steps.iter_mut()) {
@@ -672,6 +705,36 @@ impl Tri {
             }
         }
         Ok(())
+    }
+
+    /// The cells, in `(a, b, k)` order of the columns along `k`, whose
+    /// centres lie within half a voxel of the triangle's bounding box and
+    /// in the window `win`, when there are at most [`FEW_CELLS`] of them
+    /// (every cell of the triangle is one: the axis-aligned axes bound each
+    /// probe to that box); `None` when there are more. An empty box gives
+    /// an empty range (`(1, 0)`) on some axis.
+    fn few_cells(&self, k: usize, win: [(u32, u32); 3]) -> Option<[(u32, u32); 3]> {
+        let (wa, wb, wk) = pick(k, win);
+        let mut out = [(1u32, 0u32); 3];
+        let mut count = 1u64;
+        for (j, (slot, w)) in out.iter_mut().zip([wa, wb, wk]).enumerate() {
+            let axis = match j {
+                0 => pick(k, [0, 1, 2]).0,
+                1 => pick(k, [0, 1, 2]).1,
+                _ => k,
+            };
+            let lo = self.v.iter().map(|p| p[axis]).min().unwrap_or(0);
+            let hi = self.v.iter().map(|p| p[axis]).max().unwrap_or(0);
+            let (l, h) = centres_within(lo.saturating_sub(H), hi.saturating_add(H));
+            match clip(l, h, w) {
+                Some((l, h)) => {
+                    *slot = (l, h);
+                    count = count.saturating_mul(u64::from(h.saturating_sub(l)).saturating_add(1));
+                }
+                None => return Some([(1, 0); 3]),
+            }
+        }
+        (count <= FEW_CELLS).then_some(out)
     }
 
     /// Offers the cells of columns `a0 ..= a1` of row `bi` (along `k`, up
@@ -914,6 +977,57 @@ mod tests {
     use crate::testkit::{Offers, Rng, assert_offers_are, voxelized};
     use std::format;
     use std::vec::Vec;
+
+    #[test]
+    fn few_cells_and_scan_offer_the_members_in_scan_order() {
+        // Every offer in order.
+        struct Seq(Vec<[u32; 3]>);
+        impl VoxelSink for Seq {
+            fn offer(&mut self, v: [u32; 3], _: Surfel) {
+                self.0.push(v);
+            }
+        }
+        let e = Extent::new(9, 10, 11).unwrap();
+        let mut rng = Rng(0xfe_ce11);
+        let mut few = 0;
+        for case in 0..400 {
+            // Small triangles (a few cells) and large ones.
+            let reach = if case % 2 == 0 { 2 * 65536 } else { 9 * 65536 };
+            let base = [0; 3].map(|_| rng.range(-65536, 9 * 65536));
+            let vs = [0; 3].map(|_| base.map(|b| b + rng.range(0, reach)));
+            let t = Triangle {
+                vertices: vs,
+                normals: None,
+            };
+            let Ok(tri) = Tri::new(&t) else {
+                continue;
+            };
+            let k = dominant(tri.n);
+            for sep in [Separation::Six, Separation::TwentySix] {
+                let mut got = Seq(Vec::new());
+                let mut n = Counter::default();
+                tri.scan_with(sep, e, &mut got, &mut n, &|t: &Tri, v| t.surfel(v), false)
+                    .unwrap();
+                let win = window(e, &got);
+                few += usize::from(tri.few_cells(k, win).is_some());
+                let (na, nb, nk) = pick(k, [e.dims()[0], e.dims()[1], e.dims()[2]]);
+                let mut want = Vec::new();
+                for bi in 0..nb {
+                    for ai in 0..na {
+                        for ki in 0..nk {
+                            let v = place(k, ai, bi, ki);
+                            if contains(&t, sep, v).unwrap() {
+                                want.push(v);
+                            }
+                        }
+                    }
+                }
+                assert_eq!(got.0, want, "case {case} {sep:?} {t:?}");
+                assert_eq!(n.0, want.len() as u64);
+            }
+        }
+        assert!(few > 100, "{few} triangles took the few cells' path");
+    }
 
     #[test]
     fn scan_matches_membership() {
