@@ -168,8 +168,8 @@ fn rasters_and_saved_files_are_identical_for_every_thread_count() {
     std::fs::write(&path, SCENE).unwrap();
     let scene = Scene::load(&path).unwrap();
     // Several brick layers high (the last one partial), so 2, 3 and 8
-    // threads cut the raster into slabs, and fewer than the pieces they
-    // want, so the slabs into bands of brick rows too.
+    // threads cut the raster into slabs, and fewer than half the pieces 8
+    // threads want, so then the slabs into bands of brick rows too.
     for (what, opts) in [
         ("exact", BuildOptions::new(120)),
         ("paper", BuildOptions::paper(120)),

@@ -67,8 +67,8 @@ pub struct Piece {
 
 /// The pieces for `threads` threads (at least 1) over a raster of `dims`,
 /// in raster order: about [`PIECES_PER_THREAD`] per thread, slabs of about
-/// as many whole brick layers each; where the raster has fewer brick
-/// layers than that, each brick layer cut into bands of about as many
+/// as many whole brick layers each; where the raster has no more than half
+/// as many brick layers, each brick layer cut into bands of about as many
 /// whole brick rows. One slab for one thread.
 #[must_use]
 pub fn pieces(dims: [u32; 3], threads: usize) -> Vec<Piece> {
@@ -81,7 +81,11 @@ pub fn pieces(dims: [u32; 3], threads: usize) -> Vec<Piece> {
         u32::try_from(threads.saturating_mul(PIECES_PER_THREAD)).unwrap_or(u32::MAX)
     };
     let slabs = wanted.min(brick_layers);
-    let bands = if slabs < wanted {
+    // Bands where whole layers give at most half the pieces wanted:
+    // cutting each brick layer in two or more pays only then (a band
+    // re-visits the objects it shares with its neighbours, and its plane
+    // is copied in).
+    let bands = if slabs.saturating_mul(2) <= wanted {
         wanted.div_ceil(slabs).min(brick_rows)
     } else {
         1
@@ -584,15 +588,20 @@ mod tests {
                 };
             }
             assert_eq!(at, (0, nz), "{what}");
-            // Flat rasters are cut into bands when the threads want more
-            // pieces than there are brick layers.
+            // Flat rasters are cut into bands when the threads want at
+            // least twice as many pieces as there are brick layers.
             let wanted = if threads > 1 {
                 threads * PIECES_PER_THREAD
             } else {
                 1
             };
-            let most = (ny.div_ceil(BRICK) * nz.div_ceil(BRICK)) as usize;
-            assert!(p.len() >= wanted.min(most), "{what}");
+            let layers = nz.div_ceil(BRICK) as usize;
+            let most = (ny.div_ceil(BRICK) as usize) * layers;
+            if 2 * layers <= wanted {
+                assert!(p.len() >= wanted.min(most), "{what}");
+            } else {
+                assert_eq!(p.len(), wanted.min(layers), "{what}");
+            }
         }
     }
 }
