@@ -2,6 +2,7 @@
 
 use core::ops::Range;
 use std::collections::HashMap;
+use std::format;
 use std::vec;
 use std::vec::Vec;
 
@@ -985,15 +986,7 @@ fn bands_joined_are_the_whole_scene() {
             }
         }
         let banded = build_in_pieces(extent, &script, &pieces);
-        assert_eq!(banded.dir, whole.dir, "case {case} {pieces:?}");
-        assert_eq!(banded.records, whole.records, "case {case}");
-        assert_eq!(banded.lists, whole.lists, "case {case}");
-        let unflagged = |p: &[u8]| p.iter().map(|c| c & !cell::PROXIMITY).collect::<Vec<_>>();
-        assert_eq!(
-            unflagged(&banded.plane),
-            unflagged(&whole.plane),
-            "case {case}"
-        );
+        assert_joined_is_whole(&banded, &whole, &format!("case {case} {pieces:?}"));
     }
 }
 
@@ -1054,16 +1047,19 @@ fn slabs_joined_are_the_whole_scene() {
             starts.push(z);
         }
         let slabs = build_in_slabs(extent, &script, &starts);
-        assert_eq!(slabs.dir, whole.dir, "case {case} {starts:?}");
-        assert_eq!(slabs.records, whole.records, "case {case}");
-        assert_eq!(slabs.lists, whole.lists, "case {case}");
-        // Slabs leave the proximity flags to a later pass; the rest of
-        // every cell (OPAQUE and the rank hints) is the same.
-        let unflagged = |p: &[u8]| p.iter().map(|c| c & !cell::PROXIMITY).collect::<Vec<_>>();
-        assert_eq!(
-            unflagged(&slabs.plane),
-            unflagged(&whole.plane),
-            "case {case}"
-        );
+        assert_joined_is_whole(&slabs, &whole, &format!("case {case} {starts:?}"));
     }
+}
+
+/// `joined` (slabs or bands built apart and joined) is the whole build:
+/// the same directory, records and lists, and every cell the same (OPAQUE
+/// and the rank hints) but for the proximity flags, which pieces leave to
+/// a later pass.
+#[track_caller]
+fn assert_joined_is_whole(joined: &Scene, whole: &Scene, what: &str) {
+    assert_eq!(joined.dir, whole.dir, "{what}");
+    assert_eq!(joined.records, whole.records, "{what}");
+    assert_eq!(joined.lists, whole.lists, "{what}");
+    let unflagged = |p: &[u8]| p.iter().map(|c| c & !cell::PROXIMITY).collect::<Vec<_>>();
+    assert_eq!(unflagged(&joined.plane), unflagged(&whole.plane), "{what}");
 }
