@@ -42,11 +42,12 @@ use rrt_core::store::{BRICK, Counter, Limits, Sizing, brick_count, directory_len
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
-use super::BuildError;
 use super::materials::MaterialTable;
 use super::objects::TableObject;
 use super::pass::Pass;
+use super::plane::Plane;
 use super::texture::MaterialTextures;
+use super::{BuildError, alloc_err};
 use crate::frame::RasterFrame;
 use crate::progress::Unit;
 
@@ -252,19 +253,17 @@ impl Passes<'_> {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let is_band = |p: &Piece| p.rows != (0..ny);
-        // The bands' own planes.
-        let mut band_planes: Vec<Vec<u8>> = pieces
+        // The bands' own planes (zero pages until written, as the raster's).
+        let mut band_planes = pieces
             .iter()
             .zip(&extents)
             .map(|(p, e)| {
-                if is_band(p) {
-                    vec![0u8; e.len()]
-                } else {
-                    Vec::new()
-                }
+                is_band(p)
+                    .then(|| Plane::zeroed(e.len()).map_err(alloc_err("band plane", e.len())))
+                    .transpose()
             })
-            .collect();
-        let band_bytes = band_planes.iter().map(Vec::len).sum::<usize>();
+            .collect::<Result<Vec<_>, _>>()?;
+        let band_bytes = band_planes.iter().flatten().map(|b| b.len()).sum::<usize>();
 
         // Each piece's parts: a slab's plane cut from the raster's, a
         // band's its own; the raster's layers of the bands are passed by.
@@ -287,7 +286,10 @@ impl Passes<'_> {
             };
             let (p, pr) = plane_rest.split_at_mut_checked(cut).ok_or_else(bad)?;
             plane_rest = pr;
-            let p = if is_band(pc) { &mut own[..] } else { p };
+            let p = match own {
+                Some(band) => &mut band[..],
+                None => p,
+            };
             let d_len = directory_len(e).ok_or_else(bad)?;
             let (d, dr) = dir_rest.split_at_mut_checked(d_len).ok_or_else(bad)?;
             parts.push(Part {
@@ -375,9 +377,9 @@ impl Passes<'_> {
         // The bands' planes into the raster's.
         let row = nx as usize;
         for (pc, own) in pieces.iter().zip(&band_planes) {
-            if !is_band(pc) {
+            let Some(own) = own else {
                 continue;
-            }
+            };
             let rows = pc.rows.end.saturating_sub(pc.rows.start) as usize;
             for (z, layer) in pc.layers.clone().zip(own.chunks_exact(row * rows)) {
                 let at = (z as usize * ny as usize + pc.rows.start as usize) * row;
