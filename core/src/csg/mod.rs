@@ -685,12 +685,7 @@ pub fn voxelize(tree: &CsgTree<'_>, extent: Extent, sink: &mut impl CsgSink) -> 
     let Some((lo, hi)) = tree.bounds() else {
         return report;
     };
-    let [nx, ny, nz] = extent.dims();
-    let within = |r: Range<u32>, n: u32| {
-        let end = r.end.min(n);
-        (r.start.min(end), end)
-    };
-    let win = [(0, nx), within(sink.rows(), ny), within(sink.layers(), nz)];
+    let win = crate::voxelize::window_of(extent, sink.rows(), sink.layers());
     let mut range = [(0u32, 0u32); 3];
     for k in 0..3 {
         let (Some(a), Some(b), Some(n), Some(slot)) =

@@ -80,12 +80,18 @@ pub(crate) const fn centres_within(a: i128, b: i128) -> (i128, i128) {
 /// keeps ([`VoxelSink::rows`](super::VoxelSink::rows),
 /// [`VoxelSink::layers`](super::VoxelSink::layers)).
 pub(crate) fn window<S: super::VoxelSink + ?Sized>(extent: Extent, sink: &S) -> [(u32, u32); 3] {
+    window_of(extent, sink.rows(), sink.layers())
+}
+
+/// The cells scanned along each axis, `start .. end`, of a sink keeping
+/// the rows `rows` and the layers `layers` ([`window`]; CSG sinks too).
+pub(crate) fn window_of(extent: Extent, rows: Range<u32>, layers: Range<u32>) -> [(u32, u32); 3] {
     let [nx, ny, nz] = extent.dims();
     let within = |r: Range<u32>, n: u32| {
         let end = r.end.min(n);
         (r.start.min(end), end)
     };
-    [(0, nx), within(sink.rows(), ny), within(sink.layers(), nz)]
+    [(0, nx), within(rows, ny), within(layers, nz)]
 }
 
 /// Intersects the cell range `lo ..= hi` with the cells `start .. end` of

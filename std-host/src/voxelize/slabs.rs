@@ -1,9 +1,9 @@
 //! The two voxelization passes on all cores: the raster cut into pieces,
 //! each built on its own by the core's single-threaded builder on rayon's
 //! threads, and joined. A piece is a *slab* of whole brick layers with
-//! every row ([`Counter::slab`]) or, where the raster has fewer brick
-//! layers than the threads want pieces (flat scenes), a *band* of whole
-//! brick rows of one brick layer ([`Counter::band`]).
+//! every row ([`Counter::slab`]) or, where the raster has at most half as
+//! many brick layers as the threads want pieces (flat scenes), a *band* of
+//! whole brick rows of one brick layer ([`Counter::band`]).
 //!
 //! Every piece voxelizes, in object-id order, every object that can offer
 //! a voxel in it ([`TableObject::cells`]; an object whose box lies outside
