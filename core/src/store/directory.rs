@@ -62,6 +62,9 @@ fn validate_bricks(extent: Extent, dir: &[u32], records: &[VoxelRecord]) -> Resu
         if hi < lo || hi.wrapping_sub(lo) > BRICK_VOXELS {
             return Err(StoreError::DirectoryOrder { brick });
         }
+        if hi == lo {
+            continue;
+        }
         let origin = brick_origin(extent, brick).ok_or(StoreError::DirectoryOrder { brick })?;
         let (lo, hi) = (to_usize(lo), to_usize(hi));
         let slice = records
@@ -297,15 +300,20 @@ impl<'a> RecordStore<'a> {
         let mut b = dir
             .partition_point(|&d| to_usize(d) <= first)
             .saturating_sub(1);
+        // The brick's origin, computed again only when the brick changes.
+        let mut origin = brick_origin(extent, b).unwrap_or([0; 3]);
         records.iter().enumerate().map(move |(k, r)| {
             let k = first.saturating_add(k);
+            let b0 = b;
             while dir
                 .get(b.saturating_add(1))
                 .is_some_and(|&end| to_usize(end) <= k)
             {
                 b = b.saturating_add(1);
             }
-            let origin = brick_origin(extent, b).unwrap_or([0; 3]);
+            if b != b0 {
+                origin = brick_origin(extent, b).unwrap_or([0; 3]);
+            }
             (voxel_at(origin, r.position()), r)
         })
     }
@@ -402,6 +410,9 @@ impl<'a> RecordStoreMut<'a> {
         let dir = self.dir;
         for (b, w) in dir.windows(2).enumerate() {
             let [lo, hi] = *w else { continue };
+            if hi <= lo {
+                continue;
+            }
             let Some(origin) = brick_origin(extent, b) else {
                 continue;
             };

@@ -81,7 +81,7 @@ pub(super) fn set_opaque_cells(raster: &mut RasterMut<'_>, store: &RecordStore<'
             [lo, hi] => (to_usize(*lo), to_usize(*hi)),
             _ => continue,
         };
-        let Some(slice) = store.records.get(lo..hi) else {
+        let Some(slice) = store.records.get(lo..hi).filter(|s| !s.is_empty()) else {
             continue;
         };
         let Some(origin) = brick_origin(extent, b) else {

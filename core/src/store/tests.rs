@@ -196,6 +196,12 @@ fn lookups_match_brute_force_on_random_sparse_rasters() {
         for (v, o) in listed {
             assert_eq!(expect[&v].0, o);
         }
+        // iter_from(k) is iter() from the k-th record on, for any k.
+        let all: Vec<_> = store.iter().collect();
+        for k in (0..=all.len() + 1).step_by(1 + all.len() / 37) {
+            let from: Vec<_> = store.iter_from(k).collect();
+            assert_eq!(from, all.get(k..).unwrap_or(&[]), "seed {seed}: from {k}");
+        }
     }
 }
 
