@@ -24,8 +24,25 @@ use super::objects::TableObject;
 use crate::fit::FittedLight;
 use crate::scene::light_intensity;
 
-/// Records per run of the parallel light pass.
+/// Records per run of the parallel light pass, at most.
 const LIGHT_RUN: usize = 1 << 14;
+
+/// Records per run at least, when a pass has few records for its threads.
+const LIGHT_RUN_MIN: usize = 1 << 8;
+
+/// Runs per thread the pass aims for, so that threads that finish early
+/// take more.
+const RUNS_PER_THREAD: usize = 8;
+
+/// Records per run of a pass over `records` records on `threads` threads:
+/// [`RUNS_PER_THREAD`] runs per thread, within [`LIGHT_RUN_MIN`] and
+/// [`LIGHT_RUN`]. Each record is lit on its own, so the runs change which
+/// thread lights it, never the result.
+fn run_length(records: usize, threads: usize) -> usize {
+    records
+        .div_ceil(threads.max(1) * RUNS_PER_THREAD)
+        .clamp(LIGHT_RUN_MIN, LIGHT_RUN)
+}
 
 /// What the light pass reads besides the raster: the core's object-table
 /// entries, material table and lights.
@@ -95,8 +112,9 @@ impl LightScene {
         // Copied on the pool's threads, as the copy is as large as the store.
         let mut out: Vec<VoxelRecord> =
             pool.install(|| store.records().par_iter().copied().collect());
+        let run_len = run_length(out.len(), pool.current_num_threads());
         let reports: Vec<Result<LightReport, LightError>> = pool.install(|| {
-            out.par_chunks_mut(LIGHT_RUN)
+            out.par_chunks_mut(run_len)
                 .enumerate()
                 .map(|(i, run)| {
                     let n = run.len() as u64;
@@ -121,7 +139,7 @@ impl LightScene {
                             report.add(&illuminate_run(
                                 raster,
                                 store,
-                                i * LIGHT_RUN + start,
+                                i * run_len + start,
                                 sub,
                                 &table,
                                 &self.materials,
@@ -141,5 +159,34 @@ impl LightScene {
             report.add(&r?);
         }
         Ok((out, report))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{LIGHT_RUN, LIGHT_RUN_MIN, RUNS_PER_THREAD, run_length};
+
+    #[test]
+    fn runs_share_a_pass_out_within_their_bounds() {
+        for threads in [0, 1, 2, 3, 8, 64] {
+            for records in [0, 1, 255, 256, 10_444, 100_000, 4_390_966, usize::MAX / 256] {
+                let run = run_length(records, threads);
+                assert!(
+                    (LIGHT_RUN_MIN..=LIGHT_RUN).contains(&run),
+                    "{records} {threads}"
+                );
+                let runs = records.div_ceil(run);
+                // As many runs as the threads want, unless runs would fall
+                // below their least length.
+                if run > LIGHT_RUN_MIN && run < LIGHT_RUN {
+                    assert!(
+                        runs >= threads.max(1) * RUNS_PER_THREAD - 1,
+                        "{records} {threads}"
+                    );
+                }
+            }
+        }
+        // Few records: more than one run for two threads.
+        assert!(10_444usize.div_ceil(run_length(10_444, 2)) >= 8);
     }
 }

@@ -210,23 +210,25 @@ pub fn derive_plane(
     // Every brick's records (positions checked by the store against the
     // extent), each at its index in the sub-plane, with its rank hint.
     let cells = || {
-        (first_brick..end_brick).flat_map(move |b| {
-            let (lo, hi) = (dir_at(b), dir_at(b + 1));
-            let origin = [b % bx, (b / bx) % by, b / (bx * by)].map(|c| c as u32 * BRICK);
-            let len = hi.saturating_sub(lo);
-            records
-                .get(lo..hi)
-                .unwrap_or(&[])
-                .iter()
-                .enumerate()
-                .filter_map(move |(j, r)| {
-                    let p = u32::from(r.position());
-                    let v = [p & 7, (p >> 3) & 7, p >> 6];
-                    let v = [0, 1, 2].map(|a| origin[a] + v[a]);
-                    let i = sub.index([v[0], v[1], v[2].checked_sub(z0)?])?;
-                    Some((i, rank_hint(j, len)))
-                })
-        })
+        (first_brick..end_brick)
+            .filter(move |&b| dir_at(b) < dir_at(b + 1))
+            .flat_map(move |b| {
+                let (lo, hi) = (dir_at(b), dir_at(b + 1));
+                let origin = [b % bx, (b / bx) % by, b / (bx * by)].map(|c| c as u32 * BRICK);
+                let len = hi.saturating_sub(lo);
+                records
+                    .get(lo..hi)
+                    .unwrap_or(&[])
+                    .iter()
+                    .enumerate()
+                    .filter_map(move |(j, r)| {
+                        let p = u32::from(r.position());
+                        let v = [p & 7, (p >> 3) & 7, p >> 6];
+                        let v = [0, 1, 2].map(|a| origin[a] + v[a]);
+                        let i = sub.index([v[0], v[1], v[2].checked_sub(z0)?])?;
+                        Some((i, rank_hint(j, len)))
+                    })
+            })
     };
     for (i, _) in cells() {
         plane[i] = cell::OPAQUE;
