@@ -224,29 +224,85 @@ pub fn relax_rows(rows: &mut [u8], neighbour: &[u8], nx: usize, y0: usize, area:
         return;
     }
     let ny = neighbour.len().checked_div(nx).unwrap_or(0);
-    for (i, row) in rows.chunks_exact_mut(nx).enumerate() {
-        let y = y0.saturating_add(i);
-        if y >= ny.min(area.y[1]) {
-            return;
+    let held = rows.len().checked_div(nx).unwrap_or(0);
+    let first = y0.max(area.y[0]);
+    let end = y0.saturating_add(held).min(area.y[1]).min(ny);
+    if first >= end {
+        return;
+    }
+    let at = |yy: usize| neighbour.get(yy.checked_mul(nx)?..)?.get(..nx);
+    let stop = area.x[1].min(nx);
+    let mut start = area.x[0];
+    // Column chunks; within one, the rows in order, each relaxed from the
+    // neighbour rows around it, each of those reduced once ([`beyond`]) and
+    // kept for the three rows it borders.
+    while start < stop {
+        let chunk_end = start.saturating_add(CHUNK).min(stop);
+        let len = chunk_end.wrapping_sub(start);
+        let mut ring = [[FAR; CHUNK]; 3];
+        let slot = |yy: usize| yy.wrapping_add(1) % 3;
+        if let (Some(above), Some(r)) = (
+            first.checked_sub(1).and_then(at),
+            ring.get_mut(slot(first.wrapping_sub(1))),
+        ) {
+            beyond(above, start, chunk_end, r);
         }
-        if y < area.y[0] {
-            continue;
+        if let (Some(row), Some(r)) = (at(first), ring.get_mut(slot(first))) {
+            beyond(row, start, chunk_end, r);
         }
-        let at = |yy: usize| neighbour.get(yy.checked_mul(nx)?..)?.get(..nx);
-        let near = [
-            y.checked_sub(1).and_then(at),
-            at(y),
-            at(y.saturating_add(1)),
-        ];
-        let mut given: [&[u8]; 3] = [&[]; 3];
-        let mut k = 0usize;
-        for r in near.into_iter().flatten() {
-            if let Some(slot) = given.get_mut(k) {
-                *slot = r;
-                k = k.saturating_add(1);
+        for y in first..end {
+            let next = y.saturating_add(1);
+            if let Some(r) = ring.get_mut(slot(next)) {
+                match at(next) {
+                    Some(row) => beyond(row, start, chunk_end, r),
+                    None => r.fill(FAR),
+                }
+            }
+            let base = y.wrapping_sub(y0).wrapping_mul(nx);
+            let Some(seg) = rows.get_mut(base.wrapping_add(start)..base.wrapping_add(chunk_end))
+            else {
+                continue;
+            };
+            let [r0, r1, r2] = &ring;
+            let (r0, r1, r2) = (
+                r0.get(..len).unwrap_or(&[]),
+                r1.get(..len).unwrap_or(&[]),
+                r2.get(..len).unwrap_or(&[]),
+            );
+            for (((cell, &a), &b), &c) in seg.iter_mut().zip(r0).zip(r1).zip(r2) {
+                *cell = (*cell).min(a.min(b).min(c));
             }
         }
-        relax_row(row, given.get(..k).unwrap_or(&[]), area.x);
+        start = chunk_end;
+    }
+}
+
+/// `out[j] = one_beyond(min of row at x − 1, x, x + 1)` for `x = start + j`
+/// over the columns `start..end` (at most [`CHUNK`]) of a neighbour row:
+/// what the row offers each cell of the rows beside it. Since
+/// [`one_beyond`] is increasing, the least of three such values is one
+/// beyond the least of the nine cells, so each neighbour row is reduced
+/// once for the three rows it borders.
+fn beyond(row: &[u8], start: usize, end: usize, out: &mut [u8; CHUNK]) {
+    let n = row.len();
+    // t[j] = the row's cell at x = start − 1 + j (FAR beyond the row).
+    let mut t = [FAR; CHUNK + 2];
+    let lo = start.saturating_sub(1);
+    let hi = end.saturating_add(1).min(n);
+    // 0 when start > 0, 1 at the row's start.
+    let off = lo.wrapping_add(1).wrapping_sub(start);
+    let width = hi.wrapping_sub(lo);
+    if let (Some(src), Some(dst)) = (row.get(lo..hi), t.get_mut(off..off.wrapping_add(width))) {
+        dst.copy_from_slice(src);
+    }
+    let len = end.wrapping_sub(start).min(CHUNK);
+    let (a, b, c) = (
+        t.get(..len).unwrap_or(&[]),
+        t.get(1..len.wrapping_add(1)).unwrap_or(&[]),
+        t.get(2..len.wrapping_add(2)).unwrap_or(&[]),
+    );
+    for (((o, &a), &b), &c) in out.iter_mut().zip(a).zip(b).zip(c) {
+        *o = one_beyond(a.min(b).min(c));
     }
 }
 
