@@ -171,7 +171,7 @@ pub fn slice_distances(slice: &mut [u8], nx: usize) -> Area {
             && reaches(y.wrapping_sub(l))
         {
             let below = done.get(start.wrapping_sub(nx)..).unwrap_or(&[]);
-            relax_row(row, &[below], seen.reached(nx, rows).x);
+            relax_row(row, below, seen.reached(nx, rows).x);
         }
         if let Some(x) = opaque {
             seen = seen.union(Area {
@@ -194,7 +194,7 @@ pub fn slice_distances(slice: &mut [u8], nx: usize) -> Area {
         {
             let (head, above) = slice.split_at_mut(start.wrapping_add(nx));
             let above = above.get(..nx).unwrap_or(&[]);
-            relax_row(head.get_mut(start..).unwrap_or(&mut []), &[above], columns);
+            relax_row(head.get_mut(start..).unwrap_or(&mut []), above, columns);
         }
         let row = slice.get(start..start.wrapping_add(nx)).unwrap_or(&[]);
         if row.contains(&OPAQUE_CELL) {
@@ -315,40 +315,19 @@ pub const fn reaches(gap: usize) -> bool {
     gap >= 1 && gap <= reach()
 }
 
-/// `row[x] = min(row[x], one_beyond(min of the neighbour rows at x − 1, x,
-/// x + 1))` for the columns `x0..x1` of `row`, with neighbour rows of
-/// its length.
-fn relax_row(row: &mut [u8], neighbours: &[&[u8]], [x0, x1]: [usize; 2]) {
-    let n = row.len();
-    let stop = x1.min(n);
+/// `row[x] = min(row[x], one_beyond(min of neighbour at x − 1, x, x + 1))`
+/// for the columns `x0..x1` of `row`, with a neighbour row of its length
+/// (step 1's relaxation of a row from the row below or above it).
+fn relax_row(row: &mut [u8], neighbour: &[u8], [x0, x1]: [usize; 2]) {
+    let stop = x1.min(row.len());
     let mut start = x0;
+    let mut offered = [FAR; CHUNK];
     while start < stop {
         let end = start.saturating_add(CHUNK).min(stop);
-        // t[j] = the least neighbour cell at x = start − 1 + j.
-        let mut t = [FAR; CHUNK + 2];
-        let lo = start.saturating_sub(1);
-        let hi = end.saturating_add(1).min(n);
-        // 0 when start > 0, 1 at the row's start.
-        let off = lo.wrapping_add(1).wrapping_sub(start);
-        let width = hi.wrapping_sub(lo);
-        for nb in neighbours {
-            if let (Some(src), Some(dst)) =
-                (nb.get(lo..hi), t.get_mut(off..off.wrapping_add(width)))
-            {
-                for (d, &s) in dst.iter_mut().zip(src) {
-                    *d = (*d).min(s);
-                }
-            }
-        }
+        beyond(neighbour, start, end, &mut offered);
         if let Some(seg) = row.get_mut(start..end) {
-            let len = seg.len();
-            let (a, b, c) = (
-                t.get(..len).unwrap_or(&[]),
-                t.get(1..len.wrapping_add(1)).unwrap_or(&[]),
-                t.get(2..len.wrapping_add(2)).unwrap_or(&[]),
-            );
-            for (((cell, &a), &b), &c) in seg.iter_mut().zip(a).zip(b).zip(c) {
-                *cell = (*cell).min(one_beyond(a.min(b).min(c)));
+            for (cell, &o) in seg.iter_mut().zip(&offered) {
+                *cell = (*cell).min(o);
             }
         }
         start = end;
