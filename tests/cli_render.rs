@@ -242,6 +242,31 @@ fn absurd_sizes_are_refused_up_front() {
                     &["--raster", "65536", "--max-memory", "1G"],
                     "more than the limit of 1.0 GiB",
                 ),
+                // So is an image, and a band of one by its own rows.
+                (
+                    &[
+                        "--width",
+                        "16384",
+                        "--height",
+                        "16384",
+                        "--max-memory",
+                        "1G",
+                    ],
+                    "--width/--height: a 16384×16384 image needs about 5.2 GiB, more than the memory limit of 1.0 GiB",
+                ),
+                (
+                    &[
+                        "--width",
+                        "32768",
+                        "--height",
+                        "32768",
+                        "--tile",
+                        "1/64",
+                        "--max-memory",
+                        "100M",
+                    ],
+                    "a 32768×512 image needs about 336.0 MiB",
+                ),
             ],
         );
         let v = dir.join("v.rrt");

@@ -52,8 +52,9 @@ pub struct RasterArgs {
     /// World box to voxelize, `X0,Y0,Z0,X1,Y1,Z1` (default: all geometry).
     #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_bounds, allow_hyphen_values = true)]
     pub bounds: Option<Bounds>,
-    /// Refuse rasters needing more memory than this (bytes, or with K, M,
-    /// G, T suffixes; binary units) [default: half of the machine's RAM].
+    /// Refuse rasters, and images, needing more memory than this (bytes,
+    /// or with K, M, G, T suffixes; binary units) [default: half of the
+    /// machine's RAM].
     #[arg(long, value_name = "SIZE", value_parser = parse_memory)]
     pub max_memory: Option<u64>,
 }

@@ -9,10 +9,11 @@ use super::common::{
     progress, secs,
 };
 use super::frames::{Frames, Names, TileArg, parse_frame_count, parse_tile};
+use crate::fit::{Bytes, default_max_memory};
 use crate::output::band::BandTag;
 use crate::output::image::{Encoding, ImageOutput};
 use crate::render::camera::Camera;
-use crate::render::{RenderOptions, check_sizes, render_rows};
+use crate::render::{RenderOptions, check_sizes, image_bytes, render_rows};
 use crate::scene::View;
 use crate::trace::{TraceOptions, Tracer};
 
@@ -142,9 +143,14 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             let [rw, rh] = view.resolution;
             let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
             check_sizes(w, h, args.supersample)?;
-            if let Some(t) = args.tile {
-                t.band(h)?;
-            }
+            let rows = match args.tile {
+                Some(t) => {
+                    let r = t.band(h)?.rows(h);
+                    r.end - r.start
+                }
+                None => h,
+            };
+            check_image_memory(w, rows, args.bits, &args.raster)?;
             Ok((Camera::new(&view, w, h)?, view, w, h))
         };
     // The raster is fitted to the base view (the scene's with the
@@ -248,6 +254,32 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
                 time,
             )?;
         }
+    }
+    Ok(())
+}
+
+/// Refuses an image of `width` × `rows` pixels whose memory (the
+/// rendered image and its `bits`-bit encoding, [`image_bytes`]) is more
+/// than `--max-memory` allows.
+fn check_image_memory(
+    width: u32,
+    rows: u32,
+    bits: u8,
+    raster: &RasterArgs,
+) -> Result<(), CliError> {
+    let limit = raster.max_memory.unwrap_or_else(default_max_memory);
+    // The encoder's samples and their byte order: two copies of 3 codes.
+    let codes = u64::from(width) * u64::from(rows) * 6 * u64::from(bits.div_ceil(8));
+    let needed = image_bytes(width, rows, false).saturating_add(codes);
+    if needed > limit {
+        return Err(CliError::Arg {
+            arg: "--width/--height",
+            message: format!(
+                "a {width}×{rows} image needs about {}, more than the memory limit of {} (--max-memory)",
+                Bytes(needed),
+                Bytes(limit)
+            ),
+        });
     }
     Ok(())
 }

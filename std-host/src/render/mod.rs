@@ -18,8 +18,8 @@
 //! alpha, as PNG's RGBA keeps it ([`Alpha`]).
 //!
 //! **Determinism.** Every pixel's colour and coverage depend only on its own
-//! rays, and its samples are summed in a fixed order; tiles are written back by
-//! index. The image is therefore byte-identical for every thread count.
+//! rays, and its samples are summed in a fixed order; tiles are written in
+//! place. The image is therefore byte-identical for every thread count.
 //! The ray counts are integer sums, identical as well.
 //!
 //! **Bands.** [`render_rows`] renders only some rows of the image (a
@@ -32,6 +32,7 @@
 pub mod band;
 pub mod camera;
 
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
@@ -127,6 +128,12 @@ pub enum RenderError {
         what: &'static str,
         /// What is wrong.
         message: String,
+    },
+    /// The image does not fit in memory.
+    #[error("cannot allocate {} for the image", crate::fit::Bytes(*.bytes))]
+    Memory {
+        /// The allocation refused.
+        bytes: u64,
     },
     /// The thread pool could not be started.
     #[error("cannot start {threads} render threads")]
@@ -224,16 +231,35 @@ pub fn render_rows(
             threads: opts.threads,
             source,
         })?;
+    let bh = rows.end - rows.start;
+    let n = w as usize * bh as usize;
+    // The image is allocated before any ray (fallibly: a size the machine
+    // cannot hold is an error, not an abort); tiles are written into it as
+    // they finish.
+    let image = Mutex::new(Image {
+        width: w,
+        height: bh,
+        rgb: zeroed(3 * n)?,
+        linear: zeroed(3 * n)?,
+        alpha: if opts.alpha {
+            Some(Alpha {
+                coverage: zeroed(n)?,
+                straight: zeroed(3 * n)?,
+            })
+        } else {
+            None
+        },
+    });
     let t0 = Instant::now();
     // Every thread takes the next tile in scanline order from one counter
     // (module docs: neighbouring tiles share the raster lines they read).
     let next = AtomicU64::new(0);
-    let per_thread: Vec<Vec<(u64, TileResult)>> = pool.broadcast(|_| {
-        let mut mine = Vec::new();
+    let per_thread: Vec<RayStats> = pool.broadcast(|_| {
+        let mut stats = RayStats::default();
         loop {
             let t = next.fetch_add(1, Ordering::Relaxed);
             if t >= tiles {
-                break mine;
+                break stats;
             }
             let tx = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0);
             let ty = first_ty + u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
@@ -242,54 +268,76 @@ pub fn render_rows(
                 y0: ty * TILE_H,
                 rows: rows.clone(),
             };
-            mine.push((t, render_tile(tracer, camera, k, &tile)));
+            let (pixels, s) = render_tile(tracer, camera, k, &tile);
+            stats.add(&s);
+            // A poisoned lock means another tile's thread panicked, which
+            // the broadcast passes on.
+            if let Ok(mut image) = image.lock() {
+                place(&mut image, &tile, &pixels);
+            }
             progress.inc(1);
         }
     });
     let elapsed = t0.elapsed();
-    let mut done: Vec<(u64, TileResult)> = per_thread.into_iter().flatten().collect();
-    done.sort_unstable_by_key(|&(t, _)| t);
-    let bh = rows.end - rows.start;
-    let n = w as usize * bh as usize;
-    let mut rgb = vec![0u8; 3 * n];
-    let mut linear = vec![0f32; 3 * n];
-    let mut alpha = opts.alpha.then(|| Alpha {
-        coverage: vec![0f32; n],
-        straight: vec![0f32; 3 * n],
-    });
     let mut stats = RayStats::default();
-    for (t, (pixels, s)) in &done {
+    for s in &per_thread {
         stats.add(s);
-        let x0 = u32::try_from(t % u64::from(tiles_x)).unwrap_or(0) * TILE_W;
-        let ty = first_ty + u32::try_from(t / u64::from(tiles_x)).unwrap_or(0);
-        // The tile's first row within the band.
-        let y0 = (ty * TILE_H).max(rows.start) - rows.start;
-        let tw = TILE_W.min(w - x0);
-        for (j, row) in pixels.chunks(tw as usize).enumerate() {
-            let y = y0 as usize + j;
-            let first = y * w as usize + x0 as usize;
-            for (i, p) in row.iter().enumerate() {
-                let at = 3 * (first + i);
-                rgb[at..at + 3].copy_from_slice(&p.rgb);
-                linear[at..at + 3].copy_from_slice(&p.linear);
-                if let Some(a) = alpha.as_mut() {
-                    a.coverage[first + i] = p.coverage;
-                    a.straight[at..at + 3].copy_from_slice(&p.straight);
+    }
+    let image = image.into_inner().map_err(|_| RenderError::Size {
+        what: "image",
+        message: "a render thread failed".to_string(),
+    })?;
+    Ok((image, stats, elapsed))
+}
+
+/// Bytes of memory [`render_rows`] needs for an image `width` pixels
+/// wide of `rows` rows, with alpha or not: the image it returns (8-bit
+/// RGB and linear `f32` RGB per pixel, coverage and straight colour with
+/// alpha), which it allocates before tracing any ray.
+#[must_use]
+pub fn image_bytes(width: u32, rows: u32, alpha: bool) -> u64 {
+    let per_pixel = 3 + 12 + if alpha { 4 + 12 } else { 0 };
+    u64::from(width) * u64::from(rows) * per_pixel
+}
+
+/// `len` zeroed values, or [`RenderError::Memory`] when they cannot be
+/// allocated.
+fn zeroed<T: Copy + Default>(len: usize) -> Result<Vec<T>, RenderError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|_| RenderError::Memory {
+        bytes: u64::try_from(len.saturating_mul(size_of::<T>())).unwrap_or(u64::MAX),
+    })?;
+    v.resize(len, T::default());
+    Ok(v)
+}
+
+/// Writes a tile's pixels (of [`render_tile`]) into `image`, which holds
+/// the tile's rows `tile.rows`.
+fn place(image: &mut Image, tile: &Tile, pixels: &[Pixel]) {
+    let w = image.width as usize;
+    let tw = TILE_W.min(image.width - tile.x0) as usize;
+    // The tile's first row within the band.
+    let y0 = (tile.y0.max(tile.rows.start) - tile.rows.start) as usize;
+    for (j, row) in pixels.chunks(tw).enumerate() {
+        let first = (y0 + j) * w + tile.x0 as usize;
+        for (i, p) in row.iter().enumerate() {
+            let at = 3 * (first + i);
+            if let Some(c) = image.rgb.get_mut(at..at + 3) {
+                c.copy_from_slice(&p.rgb);
+            }
+            if let Some(c) = image.linear.get_mut(at..at + 3) {
+                c.copy_from_slice(&p.linear);
+            }
+            if let Some(a) = image.alpha.as_mut() {
+                if let Some(c) = a.coverage.get_mut(first + i) {
+                    *c = p.coverage;
+                }
+                if let Some(c) = a.straight.get_mut(at..at + 3) {
+                    c.copy_from_slice(&p.straight);
                 }
             }
         }
     }
-    Ok((
-        Image {
-            width: w,
-            height: bh,
-            rgb,
-            linear,
-            alpha,
-        },
-        stats,
-        elapsed,
-    ))
 }
 
 /// One pixel of a tile: its samples' means.
