@@ -754,3 +754,35 @@ fn exact_mode_matches_embree_nff_on_patches_and_cylinders() {
         assert!(p >= floor, "{scene}: PSNR {p:.2} dB < {floor}");
     }
 }
+
+/// A scene spanning 200 orders of magnitude: a sphere beside its light
+/// and a second sphere 10²⁰⁰ away. The surface offset of rays leaving a
+/// hit scales with the scene's size but never exceeds a tenth of the
+/// object hit, so the near sphere is lit exactly as without the far one
+/// at a sane distance (the raster only accelerates in the exact mode).
+#[test]
+fn a_far_object_does_not_change_the_lighting_of_a_near_one() {
+    let scene = |far: &str| {
+        let src = format!(
+            "v\nfrom 0 -5 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 48 48\n\
+             l 3 -4 8\nf 1 0.5 0.3 0.8 0 0 0 1\ns 0 0 0 1\ns {far} 0 0 1\n"
+        );
+        Scene::parse("far.nff", src.as_bytes()).unwrap()
+    };
+    let image = |far: &str| {
+        let vs = voxelize_exact(&scene(far), 64);
+        draw(&vs, 48, 48, TraceOptions::default(), 1, 1)
+    };
+    let (near, near_stats) = image("1e3");
+    let (far, far_stats) = image("1e200");
+    assert!(near_stats.hits > 100, "{near_stats:?}");
+    assert_eq!(near_stats.hits, far_stats.hits);
+    assert!(
+        psnr(&near.rgb, &far.rgb) > 50.0,
+        "{} dB",
+        psnr(&near.rgb, &far.rgb)
+    );
+    // Lit: the brightest pixel is well above the ambient-only colour.
+    let brightest = far.rgb.chunks(3).map(|p| p[0]).max().unwrap_or(0);
+    assert!(brightest > 150, "{brightest}");
+}

@@ -72,7 +72,11 @@
 //! A ray leaving a verified hit starts [`surface_offset`] off the surface,
 //! towards the side it goes to, and counts every exact intersection after
 //! its start, as `embree_nff`'s rays do; shadow rays end twice that short
-//! of the light. A flat triangle or a sphere left from outside is not
+//! of the light. The offset is never more than a tenth of the size of the
+//! object hit ([`crate::shape::Shape::radius`]; nor less than 10⁻¹² of the
+//! hit point's largest coordinate, the rounding of the point), so that in
+//! a scene spanning many orders of magnitude a small object's rays do not
+//! start beyond its neighbours or its lights. A flat triangle or a sphere left from outside is not
 //! tested against its own rays ([`crate::shape::Shape::meets_itself_leaving`]).
 //! A ray leaving a discrete hit (the paper's mode, objects without exact
 //! geometry) starts at the point where the incoming ray entered the hit
@@ -447,8 +451,11 @@ pub struct Tracer<'s> {
     /// ([`Tracer::exact_light`]) to use it.
     classification: Classification,
     /// How far rays leaving a verified hit start off the surface
-    /// ([`Tracer::leaving`]).
+    /// ([`Tracer::leaving`]) at most.
     offset: f64,
+    /// Per object, the offset of rays leaving it ([`Tracer::offset_at`]):
+    /// `offset`, or a tenth of the object's size where that is less.
+    offsets: Vec<f64>,
     background: DVec3,
     intensity: f64,
     opts: TraceOptions,
@@ -564,6 +571,11 @@ impl<'s> Tracer<'s> {
             direct: &scene.direct,
             classification: Classification::of(scene, &store, &opts),
             offset: surface_offset(&scene.frame),
+            offsets: scene
+                .objects
+                .iter()
+                .map(|o| surface_offset(&scene.frame).min(0.1 * o.shape.radius()))
+                .collect(),
             background: scene.background,
             intensity: scene.intensity(),
             opts,

@@ -34,10 +34,24 @@ impl Tracer<'_> {
     /// hit point and a thousandth of a voxel.
     pub(super) fn leaving_point(&self, h: &SurfaceHit, side: DVec3) -> (DVec3, f64) {
         if h.verified {
-            (h.point + side * self.offset, 0.0)
+            (h.point + side * self.offset_at(h), 0.0)
         } else {
             (h.point, 1e-3 * self.frame.voxel_size)
         }
+    }
+
+    /// How far rays leaving verified hit `h` start off the surface: the
+    /// scene's [`surface_offset`](super::surface_offset), but no more than
+    /// a tenth of the hit object's size, nor less than 10⁻¹² of the hit
+    /// point's largest coordinate (module docs, *No acne*).
+    pub(super) fn offset_at(&self, h: &SurfaceHit) -> f64 {
+        let own = usize::try_from(h.object)
+            .ok()
+            .and_then(|i| self.offsets.get(i))
+            .copied()
+            .unwrap_or(self.offset);
+        own.max(1e-12 * h.point.abs().max_element())
+            .min(self.offset)
     }
 
     /// The acne rule for a ray leaving hit `h` towards the side `side`.
@@ -238,7 +252,7 @@ impl Tracer<'_> {
             return 1.0;
         }
         let segment = Ray::new(origin, to / dist);
-        let tmax = dist - 2.0 * self.offset;
+        let tmax = dist - 2.0 * self.offset_at(h);
         let voxel = *origin_voxel.get_or_insert_with(|| self.origin_voxel(origin));
         if let Some(own) = voxel.and_then(|v| self.classified_lit(&v, k)) {
             stats.classified += 1;
