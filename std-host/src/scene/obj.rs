@@ -6,14 +6,22 @@
 //! mesh one material.
 //!
 //! # Bad input
-//! Before `tobj` parses the file, every face's indices are checked against
-//! the vertex, texture-coordinate and normal counts (1-based, negative
-//! indices counting back from the latest element, 0 is never valid), so
-//! an out-of-range index is reported with its line and column rather than
-//! as tobj's unlocated error. Errors tobj finds on a line (a malformed
-//! number, say) are located on the line tobj was reading. Files are capped
-//! at [`MAX_FILE_BYTES`] and meshes at [`MAX_TRIANGLES`] triangles.
+//! Before `tobj` parses the file, a scan of its lines checks, reporting
+//! the line and column: every face's indices against the vertex,
+//! texture-coordinate and normal counts (1-based, negative indices
+//! counting back from the latest element, 0 is never valid), which tobj
+//! reports without a location; that every face (`f`) has at least three
+//! vertices (tobj takes shorter ones for points and lines and drops them);
+//! and that every vertex (`v`, including `x y z` divided by a weight `w`)
+//! and normal (`vn`) coordinate is finite in single precision, in which
+//! tobj stores them (so `1e308` is out of range, `nan` not finite). tobj
+//! reads a line element (`l`) of three or more vertices as a face; it is
+//! hidden from tobj so that lines stay ignored. Errors tobj finds on a
+//! line (a malformed number, say) are located on the line tobj was
+//! reading. Files are capped at [`MAX_FILE_BYTES`] and meshes at
+//! [`MAX_TRIANGLES`] triangles.
 
+use std::borrow::Cow;
 use std::io::{BufRead, Read};
 use std::path::Path;
 use std::sync::Arc;
@@ -54,20 +62,92 @@ pub fn load(path: &Path, name: &str) -> Result<Mesh, SceneError> {
     parse(&name, &text)
 }
 
-fn invalid(file: &Arc<str>, line: usize, column: usize, problem: &'static str) -> SceneError {
+fn invalid(
+    file: &Arc<str>,
+    line: usize,
+    column: usize,
+    field: &'static str,
+    problem: &'static str,
+) -> SceneError {
     SceneError::Invalid {
         loc: SourceLoc::new(
             Arc::clone(file),
             u32::try_from(line).unwrap_or(u32::MAX),
             u32::try_from(column).unwrap_or(u32::MAX),
         ),
-        field: "OBJ",
+        field,
         problem,
     }
 }
 
-/// Checks every face index (see the module docs).
-fn check_indices(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
+/// The words of `line` with their 1-based columns (in characters).
+fn words(line: &str) -> impl Iterator<Item = (usize, &str)> + Clone {
+    line.split_whitespace().map(move |w| {
+        let at = (w.as_ptr() as usize).saturating_sub(line.as_ptr() as usize);
+        (line.get(..at).map_or(at, |s| s.chars().count()) + 1, w)
+    })
+}
+
+/// Why a number tobj reads as `f32` is not a finite `f32`, if it is not.
+fn non_finite(word: &str, value: f32) -> Option<&'static str> {
+    if value.is_finite() {
+        None
+    } else if word.parse::<f64>().is_ok_and(f64::is_finite) {
+        Some(
+            "coordinate out of range: meshes are read in single precision (magnitude at most 3.4e38)",
+        )
+    } else {
+        Some("coordinate is not finite (NaN or infinity)")
+    }
+}
+
+/// Checks `x y z [w]` of a `v` line (words after the `v`) or `x y z` of a
+/// `vn` line as tobj reads them: every coordinate, the weight `w` and the
+/// coordinates divided by `w` must be finite `f32`s. Words tobj cannot
+/// parse are left to tobj, which reports them on this line.
+fn check_coordinates<'a>(
+    mut words: impl Iterator<Item = (usize, &'a str)>,
+    with_weight: bool,
+) -> Result<(), (usize, &'static str)> {
+    let mut xyz = [0f32; 3];
+    for c in &mut xyz {
+        let Some((col, w)) = words.next() else {
+            return Ok(());
+        };
+        let Ok(v) = w.parse::<f32>() else {
+            return Ok(());
+        };
+        if let Some(why) = non_finite(w, v) {
+            return Err((col, why));
+        }
+        *c = v;
+    }
+    if !with_weight {
+        return Ok(());
+    }
+    // One more number is the weight w (three more are a colour).
+    let (Some((col, w)), None) = (words.next(), words.next()) else {
+        return Ok(());
+    };
+    let Ok(v) = w.parse::<f32>() else {
+        return Ok(());
+    };
+    if let Some(why) = non_finite(w, v) {
+        return Err((col, why));
+    }
+    if v != 0.0 && xyz.iter().any(|c| !(c / v).is_finite()) {
+        return Err((
+            col,
+            "coordinate out of range once divided by w: meshes are read in single precision (magnitude at most 3.4e38)",
+        ));
+    }
+    Ok(())
+}
+
+/// Checks, with their lines and columns, what tobj would drop or report
+/// without a location (see the module docs): every vertex and normal
+/// coordinate, the vertex count of every face and every face index.
+fn prescan(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
     // Totals for positive indices (tobj resolves them once the object is
     // complete, against everything read by then; the whole file bounds
     // that), running counts for negative ones.
@@ -82,24 +162,41 @@ fn check_indices(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
     }
     let mut seen = [0i64; 3];
     const WHAT: [&str; 3] = [
-        "face vertex index out of range (indices count from 1; negative ones back from the latest vertex)",
-        "face texture coordinate index out of range",
-        "face normal index out of range",
+        "vertex index out of range (indices count from 1; negative ones back from the latest vertex)",
+        "texture coordinate index out of range",
+        "normal index out of range",
     ];
     for (n, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => seen[0] += 1,
-            Some("vt") => seen[1] += 1,
-            Some("vn") => seen[2] += 1,
-            Some("f") => {
-                let mut at = line.find('f').map_or(0, |p| p + 1);
-                for word in words {
-                    let col = line
-                        .get(at..)
-                        .and_then(|r| r.find(word))
-                        .map_or(at, |p| at + p);
-                    at = col + word.len();
+        let mut words = words(line);
+        let Some((first_col, first)) = words.next() else {
+            continue;
+        };
+        let at = |column: usize, field: &'static str, problem: &'static str| {
+            invalid(file, n + 1, column, field, problem)
+        };
+        match first {
+            "v" => {
+                seen[0] += 1;
+                check_coordinates(words, true).map_err(|(c, why)| at(c, "vertex", why))?;
+            }
+            "vt" => seen[1] += 1,
+            "vn" => {
+                seen[2] += 1;
+                check_coordinates(words, false).map_err(|(c, why)| at(c, "normal", why))?;
+            }
+            "f" => {
+                // tobj takes a face of one or two vertices for a point or
+                // a line, and drops it.
+                let few = match words.clone().count() {
+                    0 => Some("a face needs at least 3 vertices, found none"),
+                    1 => Some("a face needs at least 3 vertices, found 1"),
+                    2 => Some("a face needs at least 3 vertices, found 2"),
+                    _ => None,
+                };
+                if let Some(problem) = few {
+                    return Err(at(first_col, "face", problem));
+                }
+                for (col, word) in words {
                     for (k, part) in word.split('/').enumerate().take(3) {
                         if part.is_empty() {
                             continue;
@@ -114,8 +211,7 @@ fn check_indices(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
                             i < 0 && seen[k] + i >= 0
                         };
                         if !ok {
-                            let column = line.get(..col).map_or(col, |s| s.chars().count()) + 1;
-                            return Err(invalid(file, n + 1, column, WHAT[k]));
+                            return Err(at(col, "face", WHAT[k]));
                         }
                     }
                 }
@@ -162,7 +258,26 @@ impl BufRead for Counting<'_> {
 /// As [`load`], less the file-system errors.
 pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
     let file: Arc<str> = Arc::from(file);
-    check_indices(&file, text)?;
+    prescan(&file, text)?;
+    // tobj reads `l` like `f`, as a face when it has three vertices or
+    // more; lines are ignored, so `l` becomes `#` (same byte, same lines).
+    let polyline = |line: &str| line.split_whitespace().next() == Some("l");
+    let text: Cow<'_, str> = if text.lines().any(polyline) {
+        let mut hidden = String::with_capacity(text.len());
+        for line in text.split_inclusive('\n') {
+            match line.find('l') {
+                Some(at) if polyline(line) => {
+                    hidden.push_str(line.get(..at).unwrap_or_default());
+                    hidden.push('#');
+                    hidden.push_str(line.get(at + 1..).unwrap_or_default());
+                }
+                _ => hidden.push_str(line),
+            }
+        }
+        Cow::Owned(hidden)
+    } else {
+        Cow::Borrowed(text)
+    };
     let mut reader = Counting {
         bytes: text.as_bytes(),
         at: 0,
@@ -187,21 +302,23 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
             } else {
                 reader.lines + 1
             };
-            let problem = match e {
-                tobj::LoadError::PositionParseError => "malformed vertex position",
-                tobj::LoadError::NormalParseError => "malformed vertex normal",
-                tobj::LoadError::TexcoordParseError => "malformed texture coordinate",
-                tobj::LoadError::FaceParseError => "malformed face",
-                tobj::LoadError::ColorParseError => "malformed vertex colour",
-                tobj::LoadError::ScalingByZeroError => "vertex with w = 0",
-                tobj::LoadError::InvalidPolygon => "face with fewer than three vertices",
+            let (field, problem) = match e {
+                tobj::LoadError::PositionParseError => ("vertex", "malformed position"),
+                tobj::LoadError::NormalParseError => ("normal", "malformed normal"),
+                tobj::LoadError::TexcoordParseError => {
+                    ("texture coordinate", "malformed texture coordinate")
+                }
+                tobj::LoadError::FaceParseError => ("face", "malformed face"),
+                tobj::LoadError::ColorParseError => ("vertex", "malformed colour"),
+                tobj::LoadError::ScalingByZeroError => ("vertex", "weight w = 0"),
+                tobj::LoadError::InvalidPolygon => ("face", "fewer than three vertices"),
                 tobj::LoadError::FaceVertexOutOfBounds
                 | tobj::LoadError::FaceTexCoordOutOfBounds
                 | tobj::LoadError::FaceNormalOutOfBounds
-                | tobj::LoadError::FaceColorOutOfBounds => "face index out of range",
-                _ => "not a readable OBJ file",
+                | tobj::LoadError::FaceColorOutOfBounds => ("face", "index out of range"),
+                _ => ("OBJ", "not a readable OBJ file"),
             };
-            return Err(invalid(&file, line, 1, problem));
+            return Err(invalid(&file, line, 1, field, problem));
         }
     };
     let mut mesh = Mesh {
@@ -223,6 +340,7 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
         for p in m.positions.chunks_exact(3) {
             let v = DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
             if !v.is_finite() {
+                // A guard: `prescan` refuses these with their line.
                 return Err(SceneError::Invalid {
                     loc: SourceLoc::new(Arc::clone(&file), 1, 1),
                     field: "OBJ",
@@ -245,7 +363,7 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
         for t in m.indices.chunks_exact(3) {
             let idx = [t[0], t[1], t[2]];
             if idx.iter().any(|&i| i as usize >= count) {
-                return Err(invalid(&file, 1, 1, "face index out of range"));
+                return Err(invalid(&file, 1, 1, "face", "index out of range"));
             }
             let off = |i: u32| u32::try_from(base + i as usize).unwrap_or(u32::MAX);
             mesh.triangles.push(idx.map(off));
@@ -308,20 +426,98 @@ mod tests {
         assert_eq!(m.normals, None);
         let e = refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
         assert!(
-            e.starts_with("t.obj:4:7: OBJ: face vertex index out of range"),
+            e.starts_with("t.obj:4:7: face: vertex index out of range"),
             "{e}"
         );
         let e = refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
-        assert!(e.starts_with("t.obj:4:3: OBJ: face vertex index"), "{e}");
+        assert!(e.starts_with("t.obj:4:3: face: vertex index"), "{e}");
         let e = refused("v 0 0 0\nf -2 1 1\nv 1 0 0\nv 0 1 0\n");
         assert!(e.starts_with("t.obj:2:3:"), "{e}");
         let e = refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//0 3//1\n");
         // The column of the face vertex `2//0` that holds the bad index.
-        assert!(e.starts_with("t.obj:5:8: OBJ: face normal index"), "{e}");
+        assert!(e.starts_with("t.obj:5:8: face: normal index"), "{e}");
         let e = refused("v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n");
-        assert_eq!(e, "t.obj:2:1: OBJ: malformed vertex position");
+        assert_eq!(e, "t.obj:2:1: vertex: malformed position");
         let e = refused("# nothing\n");
         assert!(e.contains("no faces"), "{e}");
+    }
+
+    #[test]
+    fn faces_of_fewer_than_three_vertices_are_refused_on_their_line() {
+        let refused = |text: &str| parse("t.obj", text).unwrap_err().to_string();
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n";
+        assert_eq!(
+            refused(&format!("{tri}f 1 2 3 3\nf 2 3\nf 1\n")),
+            "t.obj:6:1: face: a face needs at least 3 vertices, found 2"
+        );
+        assert_eq!(
+            refused(&format!("{tri}  f 1\n")),
+            "t.obj:5:3: face: a face needs at least 3 vertices, found 1"
+        );
+        assert_eq!(
+            refused(&format!("{tri}f\n")),
+            "t.obj:5:1: face: a face needs at least 3 vertices, found none"
+        );
+        // Only such a face: that face, not \"no faces\".
+        assert_eq!(
+            refused("v 0 0 0\nv 1 0 0\nf 1 2\n"),
+            "t.obj:3:1: face: a face needs at least 3 vertices, found 2"
+        );
+        // Points and lines stay ignored, whatever their length.
+        let m = parse(
+            "t.obj",
+            &format!("{tri}l 1 2\np 1\n l 1 2 3\r\nl 3 2 1 3\n"),
+        )
+        .unwrap();
+        assert_eq!(m.triangles.len(), 1);
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 0 1\nl 1 2 3\n");
+        assert!(e.contains("no faces"), "{e}");
+        // Lines do not shift the lines tobj's errors are reported on.
+        let e = refused(&format!("l 1 2 3\n{tri}v 1 y 0\n"));
+        assert_eq!(e, "t.obj:6:1: vertex: malformed position");
+    }
+
+    #[test]
+    fn bad_coordinates_are_refused_on_their_line_and_column() {
+        let refused = |text: &str| parse("t.obj", text).unwrap_err().to_string();
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 0 1\n\n\nv 0 nan 0\nf 1 2 4\n");
+        assert_eq!(
+            e,
+            "t.obj:6:5: vertex: coordinate is not finite (NaN or infinity)"
+        );
+        // Unused, it is still refused.
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 0 1\nv inf 0 0\nf 1 2 3\n");
+        assert!(
+            e.starts_with("t.obj:4:3: vertex: coordinate is not finite"),
+            "{e}"
+        );
+        // Finite in f64 but not in f32, which tobj reads.
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 0 1\nv 0 0 -1e308\nf 1 2 4\n");
+        assert!(
+            e.starts_with(
+                "t.obj:4:7: vertex: coordinate out of range: meshes are read in single precision"
+            ),
+            "{e}"
+        );
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 0 1 NaN\nf 1 2 3\n");
+        assert!(
+            e.starts_with("t.obj:3:9: vertex: coordinate is not finite"),
+            "{e}"
+        );
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 0 1e30 1e-30\nf 1 2 3\n");
+        assert!(
+            e.starts_with("t.obj:3:12: vertex: coordinate out of range once divided by w"),
+            "{e}"
+        );
+        let e = refused("v 0 0 0\nv 1 0 0\nv 0 0 1\nvn 0 0 1\nvn 0 nan 1\nf 1//1 2//1 3//1\n");
+        assert!(
+            e.starts_with("t.obj:5:6: normal: coordinate is not finite"),
+            "{e}"
+        );
+        // Large but single-precision values, and a weight, are fine.
+        let m = parse("t.obj", "v 0 0 0\nv 3e38 0 0\nv 0 0 2 2\nf 1 2 3\n").unwrap();
+        assert_eq!(m.positions.len(), 3);
+        assert!(m.positions.iter().any(|p| *p == DVec3::new(0.0, 0.0, 1.0)));
     }
 
     #[test]
