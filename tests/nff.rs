@@ -551,19 +551,20 @@ fn view_lines_in_order() {
         ("0 64", 12),
         ("64 0", 15),
         ("70000 64", 12),
+        ("64 40000", 15),
         ("64.5 64", 12),
         ("-1 5", 12),
     ] {
         let bad = r
             .split(' ')
-            .find(|t| ["0", "70000", "64.5", "-1"].contains(t))
+            .find(|t| ["0", "70000", "40000", "64.5", "-1"].contains(t))
             .unwrap();
         assert_eq!(
             err(&format!(
                 "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution {r}\n"
             )),
             format!(
-                "scene.nff:7:{col}: view resolution: expected a whole number of pixels from 1 to 65536, found \"{bad}\""
+                "scene.nff:7:{col}: view resolution: expected a whole number of pixels from 1 to 32768, found \"{bad}\""
             )
         );
     }

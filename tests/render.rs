@@ -580,6 +580,50 @@ fn damaged_raster_files_are_refused() {
     let e = load("v3-short.rrt", &sparse[..sparse.len() - 64]);
     assert!(e.contains("truncated"), "{e}");
 
+    // Checksums intact, contents no view or world frame the scene formats
+    // allow: refused by the loader (and `rrt info --check`), not rendered
+    // black or refused later without the file's name.
+    let meta = u64::from_le_bytes(sparse[32..40].try_into().unwrap()) as usize;
+    for (name, at, value, expect) in [
+        (
+            "width",
+            160,
+            40000u32.to_le_bytes().to_vec(),
+            "view resolution 40000×",
+        ),
+        (
+            "height",
+            164,
+            0u32.to_le_bytes().to_vec(),
+            "expected 1 to 32768 pixels",
+        ),
+        (
+            "hither",
+            152,
+            f64::NAN.to_le_bytes().to_vec(),
+            "view hither NaN",
+        ),
+        (
+            "angle",
+            144,
+            180f64.to_le_bytes().to_vec(),
+            "view angle 180",
+        ),
+        ("up", 120, [0u8; 24].to_vec(), "view up: zero or parallel"),
+        ("voxel", 40, 1e308f64.to_le_bytes().to_vec(), "world frame"),
+        ("tiny", 40, 1e-320f64.to_le_bytes().to_vec(), "world frame"),
+        ("origin", 16, 1e308f64.to_le_bytes().to_vec(), "world frame"),
+    ] {
+        let mut bad = sparse.clone();
+        bad[meta + at..meta + at + value.len()].copy_from_slice(&value);
+        rasterfile::reseal(&mut bad);
+        let e = load(&format!("meta-{name}.rrt"), &bad);
+        assert!(e.contains(expect), "{name}: {e}");
+        let p = dir.join(format!("meta-{name}.rrt"));
+        let check = cli(&["info", "--check", p.to_str().unwrap()]).unwrap_err();
+        assert!(check.contains(expect), "{name}: {check}");
+    }
+
     let e = load("nff.rrt", &std::fs::read(data("tetra.nff")).unwrap());
     assert!(e.contains("not an rrt raster file"), "{e}");
     let e = load("empty.rrt", b"");

@@ -107,7 +107,8 @@ use rrt_core::voxelize::Separation;
 
 use crate::fit::{Bytes, default_max_memory};
 use crate::frame::RasterFrame;
-use crate::scene::{Material, SourceLoc, View};
+use crate::render::MAX_SIDE;
+use crate::scene::{Material, SourceLoc, View, ViewDefect};
 use crate::shape::{SLOTS, Shape, Slots};
 use crate::voxelize::plane::Plane;
 use crate::voxelize::{MAX_MATERIALS, VoxelScene, derive_plane, line_level};
@@ -1267,14 +1268,49 @@ fn read_meta(bytes: &[u8], path: &Path, h: &Header) -> Result<Meta, RasterFileEr
         lights: c.u32(),
     };
     Extent::new(dims[0], dims[1], dims[2]).map_err(|e| invalid(e.to_string()))?;
-    if !(origin.is_finite() && voxel_size > 0.0 && voxel_size.is_finite()) {
-        return Err(invalid("world frame is not finite".into()));
+    // The far corner finite and apart from the origin on every axis: the
+    // voxels have a size in world coordinates.
+    let far = origin + DVec3::from(dims.map(f64::from)) * voxel_size;
+    if !(origin.is_finite()
+        && voxel_size.is_normal()
+        && voxel_size > 0.0
+        && far.is_finite()
+        && (far - origin).min_element() > 0.0)
+    {
+        return Err(invalid(format!(
+            "world frame (origin ({:e}, {:e}, {:e}), voxel size {voxel_size:e}) is not a finite box of voxels",
+            origin.x, origin.y, origin.z
+        )));
     }
     if !unit_colour(background) {
         return Err(invalid("background colour channels not in [0, 1]".into()));
     }
+    // The view rules of the scene formats, so that a saved view renders.
     if !(from.is_finite() && at.is_finite() && up.is_finite() && angle.is_finite()) {
         return Err(invalid("view is not finite".into()));
+    }
+    if let Some(defect) = ViewDefect::of(from, at, up) {
+        let key = match defect {
+            ViewDefect::NoDirection => "at",
+            ViewDefect::NoUp => "up",
+        };
+        return Err(invalid(format!("view {key}: {}", defect.problem())));
+    }
+    if !(angle > 0.0 && angle < 180.0) {
+        return Err(invalid(format!(
+            "view angle {angle}, expected between 0 and 180 degrees (exclusive)"
+        )));
+    }
+    if !(hither >= 0.0 && hither.is_finite()) {
+        return Err(invalid(format!(
+            "view hither {hither}, expected a finite distance ≥ 0"
+        )));
+    }
+    if resolution.iter().any(|r| !(1..=MAX_SIDE).contains(r)) {
+        return Err(invalid(format!(
+            "view resolution {}×{}, expected 1 to {MAX_SIDE} pixels",
+            resolution[0], resolution[1]
+        )));
     }
     if m.lights as usize > MAX_LIGHTS {
         return Err(invalid(format!(

@@ -69,7 +69,7 @@ use super::{Light, Material, Object, Polygon, Scene, View, ViewDefect};
 use crate::shape::{Cone, Sphere};
 
 /// Largest image width or height a `resolution` line may ask for.
-pub const MAX_RESOLUTION: u32 = 65_536;
+pub const MAX_RESOLUTION: u32 = crate::render::MAX_SIDE;
 
 /// Limits that protect the parser's memory.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -575,7 +575,7 @@ impl<'a> Parser<'a> {
         self.expect_eol("view hither")?;
 
         self.view_line("resolution", "a `resolution` line")?;
-        const PIXELS: &str = "a whole number of pixels from 1 to 65536";
+        const PIXELS: &str = "a whole number of pixels from 1 to 32768";
         let max = u64::from(MAX_RESOLUTION);
         let (w, _) = self.whole("view resolution", PIXELS, 1, max)?;
         let (h, _) = self.whole("view resolution", PIXELS, 1, max)?;
