@@ -110,8 +110,8 @@ impl LightScene {
             let _ = table.push(*o);
         }
         // Copied on the pool's threads, as the copy is as large as the store.
-        let mut out: Vec<VoxelRecord> =
-            pool.install(|| store.records().par_iter().copied().collect());
+        let mut out: Vec<VoxelRecord> = super::try_vec(store.len(), "lit records")?;
+        pool.install(|| out.par_extend(store.records().par_iter().copied()));
         let run_len = run_length(out.len(), pool.current_num_threads());
         let reports: Vec<Result<LightReport, LightError>> = pool.install(|| {
             out.par_chunks_mut(run_len)

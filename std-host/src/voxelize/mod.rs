@@ -258,6 +258,19 @@ impl BuildError {
     }
 }
 
+/// An empty vector with room for `len` values, or [`BuildError::Alloc`]
+/// naming `what` when the allocation fails.
+fn try_vec<T>(len: usize, what: &'static str) -> Result<Vec<T>, BuildError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|e| {
+        alloc_err(what, len.saturating_mul(size_of::<T>()))(std::io::Error::new(
+            std::io::ErrorKind::OutOfMemory,
+            e,
+        ))
+    })?;
+    Ok(v)
+}
+
 fn alloc_err(what: &'static str, bytes: usize) -> impl FnOnce(std::io::Error) -> BuildError {
     move |source| BuildError::Alloc {
         what,
@@ -330,7 +343,8 @@ pub fn build(
                 .len()
                 .saturating_add(c.band_planes)
                 .saturating_add(c.directory.saturating_mul(size_of::<u32>()))
-                .saturating_add(c.records.saturating_mul(size_of::<VoxelRecord>()))
+                // The records, and the light pass's lit copy of them.
+                .saturating_add(c.records.saturating_mul(2 * size_of::<VoxelRecord>()))
                 .saturating_add(c.list_entries.saturating_mul(size_of::<u32>())),
         )
         .unwrap_or(u64::MAX);

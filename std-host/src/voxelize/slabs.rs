@@ -47,7 +47,7 @@ use super::objects::TableObject;
 use super::pass::Pass;
 use super::plane::Plane;
 use super::texture::MaterialTextures;
-use super::{BuildError, alloc_err};
+use super::{BuildError, alloc_err, try_vec};
 use crate::frame::RasterFrame;
 use crate::progress::Unit;
 
@@ -343,13 +343,16 @@ impl Passes<'_> {
 
         // Written (and its pages first touched) on the pool's threads: the
         // records are the build's largest allocation.
-        let mut records: Vec<VoxelRecord> = pool.install(|| {
-            (0..records_n)
-                .into_par_iter()
-                .map(|_| VoxelRecord::default())
-                .collect()
+        let mut records: Vec<VoxelRecord> = try_vec(records_n, "records")?;
+        pool.install(|| {
+            records.par_extend(
+                (0..records_n)
+                    .into_par_iter()
+                    .map(|_| VoxelRecord::default()),
+            );
         });
-        let mut lists = vec![0u32; list_n];
+        let mut lists: Vec<u32> = try_vec(list_n, "object lists")?;
+        lists.resize(list_n, 0);
         let record_counts: Vec<usize> = sizings.iter().map(|(s, _)| s.records()).collect();
         let mut jobs = Vec::with_capacity(sizings.len());
         let (mut rec_rest, mut list_rest) = (&mut records[..], &mut lists[..]);
