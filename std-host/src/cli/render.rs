@@ -83,10 +83,11 @@ pub struct RenderArgs {
     /// a %).
     #[arg(long, value_name = "N", value_parser = parse_frame_count, conflicts_with = "path")]
     pub orbit: Option<u64>,
-    /// An animation along a camera path: one view per line of FILE, `from
-    /// (x y z) at (x y z) up (x y z) angle`, whitespace-separated, #
-    /// comments and blank lines allowed; frame k is the k-th view (from
-    /// 0), with the scene's resolution. -o as for --orbit.
+    /// An animation along a camera path: one view per line of FILE, ten
+    /// whitespace-separated numbers `fx fy fz ax ay az ux uy uz angle`
+    /// (from, at, up, angle in degrees), # comments and blank lines
+    /// allowed; frame k is the k-th view (from 0), with the scene's
+    /// resolution. -o as for --orbit.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["from", "at", "up", "angle"])]
     pub path: Option<PathBuf>,
     /// Render only frame K of the animation, K from 0 to its frame count
