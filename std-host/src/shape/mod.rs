@@ -232,27 +232,15 @@ impl Shape {
         each_surface!(self, s => s.intersect(ray, tmin, tmax), voxels => None)
     }
 
-    /// The radius of a ball that holds the shape: its size (infinite for
-    /// [`Shape::Voxels`], which has no geometry of its own).
+    /// The radius of a ball that holds the shape, half the diagonal of its
+    /// [`Primitive::bounds`]: its size (infinite for [`Shape::Voxels`],
+    /// which has no geometry of its own).
     #[must_use]
     pub fn radius(&self) -> f64 {
-        match self {
-            Self::Sphere(s) => s.radius,
-            Self::Cone(c) => {
-                let half = (c.apex - c.base).length() / 2.0;
-                half.hypot(c.base_radius.abs().max(c.apex_radius.abs()))
-            }
-            Self::Triangle(t) => {
-                let [a, b, c] = t.vertices;
-                let centre = (a + b + c) / 3.0;
-                t.vertices
-                    .iter()
-                    .map(|v| (*v - centre).length())
-                    .fold(0.0, f64::max)
-            }
-            Self::Torus(t) => t.major.abs() + t.minor.abs(),
-            Self::Voxels { .. } => f64::INFINITY,
-        }
+        each_surface!(self, s => {
+            let b = s.bounds();
+            0.5 * (b.max - b.min).length()
+        }, voxels => f64::INFINITY)
     }
 
     /// Whether the shape has exact geometry to verify hits against (all
