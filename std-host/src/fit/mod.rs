@@ -103,7 +103,7 @@ pub enum FitError {
         max: DVec3,
     },
     /// The geometry has no extent (or is not finite).
-    #[error("{file}: the geometry's bounds {min} to {max} have no size to fit a raster to")]
+    #[error("{file}: {}", no_extent(*min, *max))]
     NoExtent {
         /// The scene file.
         file: String,
@@ -298,5 +298,25 @@ impl Table<'_> {
             self.add(o.shape, o.material, S::KIND, &o.loc)?;
         }
         Ok(())
+    }
+}
+
+/// What is wrong with geometry bounds `min` to `max` that fit no raster.
+fn no_extent(min: DVec3, max: DVec3) -> String {
+    let p = |v: DVec3| format!("({:e}, {:e}, {:e})", v.x, v.y, v.z);
+    if min.cmpgt(max).any() {
+        "nothing to fit a raster to: every object is empty (an empty CSG result, a .vox model without voxels)".to_string()
+    } else if !(max - min).is_finite() {
+        format!(
+            "the geometry's bounds {} to {} are too far apart to fit a raster to",
+            p(min),
+            p(max)
+        )
+    } else {
+        format!(
+            "the geometry's bounds {} to {} have no size to fit a raster to",
+            p(min),
+            p(max)
+        )
     }
 }

@@ -331,3 +331,23 @@ fn objects_keep_the_exact_world_geometry() {
     let h2 = ball.intersect(&r, 0.0, f64::INFINITY).unwrap();
     assert!((h2.t - h.t).abs() < 1e-9);
 }
+
+#[test]
+fn geometry_without_a_box_says_why() {
+    let e = |body: &str| fit(&scene(body), &opts(64)).unwrap_err().to_string();
+    assert_eq!(
+        e("s 1 1 1 1e308\n"),
+        "t.nff: the geometry's bounds (-1e308, -1e308, -1e308) to (1e308, 1e308, 1e308) are too far apart to fit a raster to"
+    );
+    let empty = FitError::NoExtent {
+        file: "x.toml".into(),
+        min: DVec3::INFINITY,
+        max: DVec3::NEG_INFINITY,
+    };
+    assert!(
+        empty
+            .to_string()
+            .starts_with("x.toml: nothing to fit a raster to: every object is empty"),
+        "{empty}"
+    );
+}
