@@ -271,6 +271,20 @@ fn missing_file_is_named_with_its_line_and_key() {
     );
     assert_located(&msg, 9, "object[0].mesh.file");
     assert!(msg.contains("nowhere.obj: no such file"), "{msg}");
+    // A directory or a device is named for what it is.
+    let msg = error_of(
+        "path-dir",
+        &format!("{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nmesh = {{ file = \".\" }}\n"),
+    );
+    assert_located(&msg, 9, "object[0].mesh.file");
+    assert!(msg.contains(": is a directory, not a file"), "{msg}");
+    let msg = error_of(
+        "path-dev",
+        &format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nmesh = {{ file = \"/dev/null\" }}\n"
+        ),
+    );
+    assert!(msg.contains("/dev/null: is not a regular file"), "{msg}");
 }
 
 #[test]

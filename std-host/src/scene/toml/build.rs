@@ -90,7 +90,13 @@ impl Builder<'_> {
         }
         let full = self.dir.join(p.get_ref());
         if !full.is_file() {
-            return Err(self.err(p.span(), key, format!("{}: no such file", full.display())));
+            let why = match std::fs::metadata(&full) {
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => "no such file",
+                Err(_) => "cannot be read",
+                Ok(m) if m.is_dir() => "is a directory, not a file",
+                Ok(_) => "is not a regular file",
+            };
+            return Err(self.err(p.span(), key, format!("{}: {why}", full.display())));
         }
         let shown = full.to_string_lossy().into_owned();
         Ok((full, shown))
