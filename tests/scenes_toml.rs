@@ -299,6 +299,18 @@ fn huge_volume_is_refused_before_allocating() {
 }
 
 #[test]
+fn metaballs_box_must_have_max_above_min() {
+    let msg = error_of(
+        "metaballs-box",
+        &format!(
+            "{CAMERA}[material.m]\n[volume.v]\nmetaballs = {{ dims = [8, 8, 8], min = [1,1,1], max = [-1,1,2], balls = [] }}\niso = 1\n[[object]]\nmaterial = \"m\"\nvolume = \"v\"\n"
+        ),
+    );
+    assert_located(&msg, 8, "volume.v.metaballs.max");
+    assert!(msg.contains("max above min on every axis"), "{msg}");
+}
+
+#[test]
 fn unknown_material_and_solid_are_named() {
     let msg = error_of(
         "material",

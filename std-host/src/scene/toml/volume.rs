@@ -93,6 +93,13 @@ impl Builder<'_> {
         } else if let Some(m) = &d.metaballs {
             let lo = self.vec3(&s, &key("metaballs.min"), m.min)?;
             let hi = self.vec3(&s, &key("metaballs.max"), m.max)?;
+            if !lo.cmplt(hi).all() || !(hi - lo).is_finite() {
+                return Err(self.err(
+                    s,
+                    &key("metaballs.max"),
+                    "expected a box: max above min on every axis",
+                ));
+            }
             let n = m.dims.map(|d| f64::from(d.max(2) - 1));
             let spacing = [
                 (hi.x - lo.x) / n[0],
