@@ -47,8 +47,8 @@ use crate::world::Ray;
 pub const TILE_W: u32 = 32;
 /// Tile height in pixels (a multiple of the block height).
 pub const TILE_H: u32 = 8;
-/// Largest image side accepted.
-pub const MAX_SIDE: u32 = 32768;
+/// Largest image side accepted (as a scene's resolution).
+pub const MAX_SIDE: u32 = crate::scene::nff::MAX_RESOLUTION;
 /// Largest supersampling factor accepted (K × K rays per pixel).
 pub const MAX_SUPERSAMPLE: u32 = 16;
 /// Most primary rays one render may trace (`width · height · K²`).
@@ -130,7 +130,7 @@ pub enum RenderError {
         message: String,
     },
     /// The image does not fit in memory.
-    #[error("cannot allocate {} for the image", crate::fit::Bytes(*.bytes))]
+    #[error("cannot allocate {bytes} bytes for the image")]
     Memory {
         /// The allocation refused.
         bytes: u64,

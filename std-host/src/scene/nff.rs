@@ -68,8 +68,9 @@ use super::text::byte_loc;
 use super::{Light, Material, Object, Polygon, Scene, View, ViewDefect};
 use crate::shape::{Cone, Sphere};
 
-/// Largest image width or height a `resolution` line may ask for.
-pub const MAX_RESOLUTION: u32 = crate::render::MAX_SIDE;
+/// Largest image width or height a `resolution` line may ask for: the
+/// renderer's largest side (`crate::render::MAX_SIDE` is this).
+pub const MAX_RESOLUTION: u32 = 32_768;
 
 /// Limits that protect the parser's memory.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
