@@ -237,10 +237,15 @@ impl Shape {
     /// which has no geometry of its own).
     #[must_use]
     pub fn radius(&self) -> f64 {
-        each_surface!(self, s => {
-            let b = s.bounds();
-            0.5 * (b.max - b.min).length()
-        }, voxels => f64::INFINITY)
+        self.bounds()
+            .map_or(f64::INFINITY, |b| 0.5 * (b.max - b.min).length())
+    }
+
+    /// A world box holding the shape ([`Primitive::bounds`]); `None` for
+    /// [`Shape::Voxels`], which has no geometry of its own.
+    #[must_use]
+    pub fn bounds(&self) -> Option<Bounds> {
+        each_surface!(self, s => Some(s.bounds()), voxels => None)
     }
 
     /// Whether the shape has exact geometry to verify hits against (all

@@ -170,7 +170,7 @@ pub use self::walk::FirstWalk;
 use crate::frame::RasterFrame;
 use crate::scene::Material;
 use crate::voxelize::{VoxelScene, WorldLight, WorldObject};
-use crate::world::Ray;
+use crate::world::{Bounds, Ray};
 
 /// Rays per primary block: 4 × 2 pixels, the lanes of `RayPacket8`.
 pub const BLOCK: usize = 8;
@@ -422,15 +422,26 @@ pub struct RayHit {
 
 /// How far a ray leaving a verified hit starts off the surface, along the
 /// normal towards the side it goes to: `embree_nff`'s ε, 10⁻⁵ of the
-/// diagonal of the scene's box (here the raster's box, which holds the
-/// scene). Near the contact of two objects (the spheres of a sphereflake
+/// diagonal of the box of the scene's geometry (the objects' boxes; the
+/// raster's box where some object has no geometry of its own, a volume
+/// or `.vox` model, or there is none), so that it does not depend on the
+/// raster. Near the contact of two objects (the spheres of a sphereflake
 /// touch their parents) which of them a grazing secondary ray meets
 /// depends on where it starts; starting where the exact tracer does gives
 /// its answer.
 #[must_use]
-pub fn surface_offset(frame: &RasterFrame) -> f64 {
-    let b = frame.world_bounds();
-    1e-5 * (b.max - b.min).length()
+pub fn surface_offset(scene: &VoxelScene) -> f64 {
+    let mut b = Bounds::EMPTY;
+    for o in &scene.objects {
+        match o.shape.bounds() {
+            Some(ob) => b.include_bounds(ob),
+            None => b.include_bounds(scene.frame.world_bounds()),
+        }
+    }
+    if b.is_empty() || !b.size().is_finite() {
+        b = scene.frame.world_bounds();
+    }
+    1e-5 * b.size().length()
 }
 
 /// The renderer over one voxelized scene.
@@ -495,7 +506,7 @@ impl Classification {
 
     /// The classification a tracer over `scene` with `opts` can use.
     fn of(scene: &VoxelScene, store: &RecordStore<'_>, opts: &TraceOptions) -> Self {
-        if !scene.exact || surface_offset(&scene.frame) >= scene.frame.voxel_size / 8.0 {
+        if !scene.exact || surface_offset(scene) >= scene.frame.voxel_size / 8.0 {
             return Self::Unavailable;
         }
         match scene.exact_records {
@@ -559,6 +570,7 @@ impl<'s> Tracer<'s> {
             .iter()
             .map(|l| scene.frame.to_fixed(l.position))
             .collect();
+        let offset = surface_offset(scene);
         Ok(Self {
             raster,
             store,
@@ -570,11 +582,11 @@ impl<'s> Tracer<'s> {
             lights_fx,
             direct: &scene.direct,
             classification: Classification::of(scene, &store, &opts),
-            offset: surface_offset(&scene.frame),
+            offset,
             offsets: scene
                 .objects
                 .iter()
-                .map(|o| surface_offset(&scene.frame).min(0.1 * o.shape.radius()))
+                .map(|o| offset.min(0.1 * o.shape.radius()))
                 .collect(),
             background: scene.background,
             intensity: scene.intensity(),
