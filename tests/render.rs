@@ -860,3 +860,20 @@ fn the_exact_image_does_not_depend_on_the_raster() {
         assert_eq!(differ, 0, "raster {n} against 64: {differ} channels differ");
     }
 }
+
+/// An eye a hair above a floor that lies on a voxel face: rounded to fixed
+/// point, the discrete rays start across the face, below the floor, but
+/// the floor is still the hit of every ray (found by comparing random
+/// scenes with `embree_nff`).
+#[test]
+fn an_eye_just_above_a_floor_sees_it() {
+    let src = "b 0.5 0.2 0.5\nv\nfrom 0.3 0.2 -0.9999\nat 0.3 0.2 -2\nup 0 1 0\nangle 40\n\
+               hither 0\nresolution 32 32\nl 0.3 0.2 1\nf 0.7 0.8 0.1 0.7 0 10 0 1\n\
+               p 4\n4300 4300 -1\n-4300 4300 -1\n-4300 -4300 -1\n4300 -4300 -1\n";
+    let scene = Scene::parse("floor.nff", src.as_bytes()).unwrap();
+    for raster in [96, 64, 300] {
+        let vs = voxelize_exact(&scene, raster);
+        let (_, stats) = draw(&vs, 32, 32, TraceOptions::default(), 1, 1);
+        assert_eq!(stats.hits, 32 * 32, "raster {raster}: {stats:?}");
+    }
+}

@@ -301,6 +301,9 @@ impl Tracer<'_> {
         let vs = self.frame.voxel_size;
         let mut mail = Mailbox::default();
         let mut best: Option<Candidate> = None;
+        if leave.is_none() {
+            self.test_origin_voxels(ray, o_r, tmin, &mut mail, &mut best);
+        }
         loop {
             if end != WalkEnd::Hit {
                 return best.map(|c| self.accept(ray, &c, stats));
@@ -350,6 +353,77 @@ impl Tracer<'_> {
         }
     }
 }
+
+impl Tracer<'_> {
+    /// Verification of the voxels around the exact origin `o_r` (raster
+    /// coordinates) of a ray that leaves no surface (a primary ray) when
+    /// it lies within [`ORIGIN_ROUNDING`] of a voxel face: the discrete
+    /// ray starts from the origin rounded to fixed point, which may lie
+    /// across that face (an eye a hair above a floor lying on a voxel face
+    /// starts in the voxel below it), so the walk may never visit the
+    /// voxel holding the eye. Every opaque voxel the exact origin may lie
+    /// in has its objects tested first. (A ray leaving a surface starts
+    /// off it by the surface offset, thousands of fixed-point units.)
+    fn test_origin_voxels(
+        &self,
+        ray: &Ray,
+        o_r: DVec3,
+        tmin: f64,
+        mail: &mut Mailbox,
+        best: &mut Option<Candidate>,
+    ) {
+        let base = o_r.floor();
+        // Per axis, the voxel offsets the origin may lie in: 0, and -1 or
+        // +1 across a face within rounding.
+        let mut across = [0i64; 3];
+        for k in 0..3 {
+            let f = o_r[k] - base[k];
+            if f < ORIGIN_ROUNDING {
+                across[k] = -1;
+            } else if f > 1.0 - ORIGIN_ROUNDING {
+                across[k] = 1;
+            }
+        }
+        if across == [0; 3] || !base.is_finite() {
+            return;
+        }
+        let dims = self.extent.dims();
+        for corner in 0..8u32 {
+            let moved = |k: usize| corner & (1 << k) != 0;
+            if (0..3).any(|k| moved(k) && across[k] == 0) {
+                continue;
+            }
+            let mut v = [0u32; 3];
+            let mut inside = true;
+            for k in 0..3 {
+                let step = if moved(k) { across[k] } else { 0 };
+                // A whole number: the floor of a finite coordinate.
+                match u32::try_from(base[k] as i64 + step) {
+                    Ok(c) if c < dims[k] => v[k] = c,
+                    _ => inside = false,
+                }
+            }
+            if !inside {
+                continue;
+            }
+            let Some(index) = self.extent.index(v) else {
+                continue;
+            };
+            let c = self.raster.plane().get(index).copied().unwrap_or(0);
+            if c & cell::OPAQUE == 0 {
+                continue;
+            }
+            if let Some(rec) = self.store.get_hinted(v, c) {
+                self.test_voxel(ray, o_r, v, index, rec, tmin, None, mail, best);
+            }
+        }
+    }
+}
+
+/// How close (in voxels) an exact ray origin may lie to a voxel face for
+/// its fixed-point rounding to put the discrete ray's start across it:
+/// two fixed-point units.
+const ORIGIN_ROUNDING: f64 = 2.0 / VOXEL as f64;
 
 /// The hit test of a secondary walk ([`surface_voxel`]); a hit leaves its
 /// index and record in `found`.
