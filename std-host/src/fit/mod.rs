@@ -277,7 +277,20 @@ impl Table<'_> {
                 kind,
                 loc: loc.clone(),
             }),
-            Err(Unfit::Degenerate) => self.dropped.degenerate += 1,
+            // An object with area in the world that rounds to none in
+            // fixed point (a cone or a sliver thinner than 1/65536 voxel):
+            // voxelized as a box around it, so that it keeps the voxels
+            // it lies in, and verified against its exact shape.
+            Err(Unfit::Degenerate) => match self.enclosing_box(&shape.into()) {
+                Some(b) => self.objects.push(FittedObject {
+                    shape: shape.into(),
+                    entry: table::Shape::Cuboid(b),
+                    material,
+                    kind,
+                    loc: loc.clone(),
+                }),
+                None => self.dropped.degenerate += 1,
+            },
             Err(Unfit::OutOfRange) => {
                 return Err(FitError::OutOfRange {
                     loc: loc.clone(),
@@ -286,6 +299,31 @@ impl Table<'_> {
             }
         }
         Ok(())
+    }
+
+    /// A fixed-point box holding `shape` with a unit to spare on every
+    /// side, for a shape that has area in the world (`None` for one that
+    /// has none: a triangle whose vertices are collinear, a cone whose
+    /// base is its apex; or one out of the fixed-point range).
+    fn enclosing_box(&self, shape: &Shape) -> Option<rrt_core::geometry::Cuboid> {
+        let flat = match shape {
+            Shape::Triangle(t) => {
+                let [a, b, c] = t.vertices;
+                (b - a).cross(c - a) == DVec3::ZERO
+            }
+            Shape::Cone(c) => c.base == c.apex,
+            _ => false,
+        };
+        if flat {
+            return None;
+        }
+        let b = shape.bounds()?;
+        let lo = self.frame.to_fixed(b.min)?;
+        let hi = self.frame.to_fixed(b.max)?;
+        Some(rrt_core::geometry::Cuboid {
+            min: lo.map(|v| v.saturating_sub(1)),
+            max: hi.map(|v| v.saturating_add(1)),
+        })
     }
 
     /// Adds every object of `list` that does not lie outside the raster.

@@ -323,6 +323,9 @@ pub fn voxelize(
         table::Shape::Cone(c) => Cone::voxelize(c, separation, extent, sink),
         table::Shape::Triangle(t) => Triangle::voxelize(t, separation, extent, sink),
         table::Shape::Torus(t) => Torus::voxelize(t, separation, extent, sink),
+        // The box around an object that has no area in fixed point
+        // (`crate::fit`).
+        table::Shape::Cuboid(c) => rrt_core::voxelize::cuboid::surface(c, separation, extent, sink),
         _ => Ok(0),
     }
 }
