@@ -33,7 +33,7 @@ pub(super) struct Builder<'t> {
 }
 
 pub(super) fn finite3(v: V3) -> Option<DVec3> {
-    let d = DVec3::from(v);
+    let d = DVec3::from(v.0);
     d.is_finite().then_some(d)
 }
 
@@ -111,7 +111,7 @@ impl Builder<'_> {
             up: self.vec3(&cs, "camera.up", c.up)?,
             angle: c.angle,
             hither: c.hither,
-            resolution: c.resolution,
+            resolution: c.resolution.0,
             loc: self.loc(cs.clone()),
         };
         if view.from == view.at {

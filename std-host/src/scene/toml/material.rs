@@ -121,7 +121,9 @@ impl Builder<'_> {
         let any = if let Some(c) = &d.checker {
             let origin = self.vec3(&s, &k("checker.origin"), c.origin)?;
             let size = positive(c.size, "checker.size")?;
-            AnyTexture::Checker(Checker::new(origin, size, c.colours).map_err(bad("checker"))?)
+            AnyTexture::Checker(
+                Checker::new(origin, size, c.colours.map(|c| c.0)).map_err(bad("checker"))?,
+            )
         } else if let Some(m) = &d.marble {
             let dir = direction(m.direction, "marble.direction")?;
             noise(m, "marble")?;
@@ -133,7 +135,7 @@ impl Builder<'_> {
                     m.noise_scale,
                     m.turbulence,
                     m.octaves,
-                    m.colours,
+                    m.colours.map(|c| c.0),
                 )
                 .map_err(bad("marble"))?,
             )
@@ -150,7 +152,7 @@ impl Builder<'_> {
                     w.noise_scale,
                     w.turbulence,
                     w.octaves,
-                    w.colours,
+                    w.colours.map(|c| c.0),
                 )
                 .map_err(bad("wood"))?,
             )

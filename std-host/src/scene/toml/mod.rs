@@ -43,7 +43,8 @@
 //! rendered directly cannot be a CSG leaf.
 //!
 //! # Errors
-//! Unknown keys (`deny_unknown_fields`), wrong types, missing keys, bad
+//! Unknown keys (`deny_unknown_fields`), wrong types (arrays of the wrong
+//! length too, longer or shorter), missing keys, bad
 //! values and the errors of the files a scene refers to are
 //! [`SceneError::Toml`] naming the scene file, the line and column of the
 //! value itself (from toml's spans) and its full key path
@@ -177,5 +178,194 @@ fn key_near(text: &str, at: usize) -> String {
         key.to_owned()
     } else {
         String::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CAMERA: &str =
+        "[camera]\nfrom = [0, -6, 2]\nat = [0, 0, 0]\nangle = 40\nresolution = [8, 8]\n";
+    const OBJECT: &str =
+        "[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = { centre = [0, 0, 0], radius = 1 }\n";
+
+    /// The error of `text`, read without files.
+    fn error(text: &str) -> String {
+        let opts = Options {
+            read_files: false,
+            ..Options::default()
+        };
+        match parse("x.toml", text, Path::new("."), &opts) {
+            Ok(_) => panic!("accepted:\n{text}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// `text` with `from` replaced by `to` is refused at the first `[` of
+    /// `to` (1-based line and column), naming `key` and the lengths.
+    fn assert_refused(text: &str, from: &str, to: &str, key: &str, found: usize, want: usize) {
+        assert_eq!(text.matches(from).count(), 1, "{from} in\n{text}");
+        let bad = text.replace(from, to);
+        let at = bad.find(to).unwrap() + to.find('[').unwrap();
+        let line = bad[..at].matches('\n').count() + 1;
+        let col = at - bad[..at].rfind('\n').map_or(0, |i| i + 1) + 1;
+        let msg = error(&bad);
+        assert_eq!(
+            msg,
+            format!(
+                "x.toml:{line}:{col}: {key}: invalid length {found}, expected an array of length {want}"
+            ),
+            "{bad}"
+        );
+    }
+
+    #[test]
+    fn too_long_fixed_arrays_are_refused_with_location_and_key() {
+        let scene = format!("{CAMERA}{OBJECT}");
+        // The reproducer: a sphere centre with extra elements of any type.
+        let centre = "centre = [0, 0, 0]";
+        assert_refused(
+            &scene,
+            centre,
+            "centre = [0, 0, 0, [1], {a=1}]",
+            "object[0].sphere.centre",
+            5,
+            3,
+        );
+        assert_refused(&scene, "[8, 8]", "[64, 64, 64]", "camera.resolution", 3, 2);
+        assert_refused(&scene, "[0, -6, 2]", "[0, -6, 2, 5]", "camera.from", 4, 3);
+        let colour = format!(
+            "{CAMERA}[material.m]\ncolour = [0.8, 0.5, 0.3]\n{}",
+            &OBJECT[13..]
+        );
+        assert_refused(
+            &colour,
+            "[0.8, 0.5, 0.3]",
+            "[0.8, 0.5, 0.3, 1]",
+            "material.m.colour",
+            4,
+            3,
+        );
+        let light =
+            format!("{CAMERA}[[light]]\nposition = [3, -4, 8]\ncolour = [1, 1, 1]\n{OBJECT}");
+        assert_refused(&light, "[1, 1, 1]", "[1, 1, 1, 1]", "light[0].colour", 4, 3);
+        assert_refused(
+            &light,
+            "[3, -4, 8]",
+            "[3, -4, 8, 0]",
+            "light[0].position",
+            4,
+            3,
+        );
+        let background = format!("background = [0, 0, 0.5]\n{CAMERA}{OBJECT}");
+        assert_refused(
+            &background,
+            "[0, 0, 0.5]",
+            "[0, 0, 0.5, 0]",
+            "background",
+            4,
+            3,
+        );
+        let raw = format!(
+            "{CAMERA}{OBJECT}[volume.v]\nraw = {{ file = \"raw16.bin\", dims = [16, 16, 16], type = \"uint8\" }}\niso = 100\n"
+        );
+        assert_refused(
+            &raw,
+            "[16, 16, 16]",
+            "[16,16,16,1]",
+            "volume.v.raw.dims",
+            4,
+            3,
+        );
+        let polygon = format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\npolygon = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n"
+        );
+        assert_refused(
+            &polygon,
+            "[1, 0, 0]",
+            "[1, 0, 0, 7]",
+            "object[0].polygon[1]",
+            4,
+            3,
+        );
+        // Nested: one colour of a checker's pair, and the pair itself.
+        let checker = format!(
+            "{CAMERA}[material.m]\ntexture = {{ checker = {{ size = 1, colours = [[0, 0, 0], [255, 255, 255]] }} }}\n{}",
+            &OBJECT[13..]
+        );
+        let key = "material.m.texture.checker.colours";
+        assert_refused(
+            &checker,
+            "[255, 255, 255]",
+            "[255, 255, 255, 9]",
+            &format!("{key}[1]"),
+            4,
+            3,
+        );
+        assert_refused(
+            &checker,
+            "[[0, 0, 0], [255, 255, 255]]",
+            "[[0, 0, 0], [255, 255, 255], [1, 1, 1]]",
+            key,
+            3,
+            2,
+        );
+        // Lists of fixed-length points.
+        let ramps = format!(
+            "{CAMERA}{OBJECT}[volume.v]\nmetaballs = {{ dims = [8, 8, 8], min = [-1, -1, -1], max = [1, 1, 1], balls = [[0, 0, 0, 1, 1]] }}\nopacity = [[0, 0], [1, 1]]\ncolours = [[0, 1, 1, 1]]\n"
+        );
+        assert_refused(
+            &ramps,
+            "[0, 0, 0, 1, 1]",
+            "[0, 0, 0, 1, 1, 1]",
+            "volume.v.metaballs.balls[0]",
+            6,
+            5,
+        );
+        assert_refused(&ramps, "[1, 1]]", "[1, 1, 0]]", "volume.v.opacity[1]", 3, 2);
+        assert_refused(
+            &ramps,
+            "[0, 1, 1, 1]",
+            "[0, 1, 1, 1, 1]",
+            "volume.v.colours[0]",
+            5,
+            4,
+        );
+    }
+
+    #[test]
+    fn too_short_fixed_arrays_are_refused_and_exact_ones_accepted() {
+        let scene = format!("{CAMERA}{OBJECT}");
+        assert_refused(
+            &scene,
+            "centre = [0, 0, 0]",
+            "centre = [0, 0]",
+            "object[0].sphere.centre",
+            2,
+            3,
+        );
+        assert_refused(&scene, "[8, 8]", "[]", "camera.resolution", 0, 2);
+        let opts = Options {
+            read_files: false,
+            ..Options::default()
+        };
+        let s = parse("x.toml", &scene, Path::new("."), &opts).unwrap();
+        assert_eq!(s.view.resolution, [8, 8]);
+    }
+
+    /// Every fixed-length array of the schema is an [`schema::Exact`]: a
+    /// plain `[T; N]` would silently drop extra elements.
+    #[test]
+    fn the_schema_has_no_plain_arrays() {
+        let src = include_str!("schema.rs");
+        for ty in [
+            "f64", "f32", "u8", "u16", "u32", "u64", "i32", "i64", "bool", "String",
+        ] {
+            assert!(
+                !src.contains(&format!("[{ty};")),
+                "a plain [{ty}; N] in schema.rs"
+            );
+        }
     }
 }

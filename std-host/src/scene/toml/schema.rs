@@ -2,11 +2,72 @@
 //! are refused). [`ShapeDef`] is an object's one shape key.
 
 use std::collections::BTreeMap;
+use std::fmt;
+use std::marker::PhantomData;
 
 use ::toml::Spanned;
 use serde::Deserialize;
+use serde::de::{self, Deserializer, IgnoredAny, SeqAccess, Visitor};
 
-pub(super) type V3 = [f64; 3];
+/// An array of exactly `N` elements: every fixed-length array of the
+/// schema is one. serde's `[T; N]` reads the first `N` elements of a TOML
+/// array and ignores the rest, so `centre = [0, 0, 0, 5]` would pass; this
+/// refuses too few and too many alike ("invalid length 4, expected an
+/// array of length 3"), located at the array with its key path.
+#[derive(Clone, Copy)]
+pub(super) struct Exact<T, const N: usize>(pub(super) [T; N]);
+
+impl<T, const N: usize> std::ops::Deref for Exact<T, N> {
+    type Target = [T; N];
+    fn deref(&self) -> &[T; N] {
+        &self.0
+    }
+}
+
+impl<T: Copy, const N: usize> Exact<T, N> {
+    /// The elements of a list of arrays, as plain arrays.
+    pub(super) fn plain(list: &[Self]) -> Vec<[T; N]> {
+        list.iter().map(|a| a.0).collect()
+    }
+}
+
+impl<T: Copy + Default, const N: usize> Default for Exact<T, N> {
+    fn default() -> Self {
+        Self([T::default(); N])
+    }
+}
+
+impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Deserialize<'de> for Exact<T, N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Elems<T, const N: usize>(PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Copy + Default, const N: usize> Visitor<'de> for Elems<T, N> {
+            type Value = Exact<T, N>;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                write!(f, "an array of length {N}")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut out = [T::default(); N];
+                for (i, slot) in out.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                let mut len = N;
+                while seq.next_element::<IgnoredAny>()?.is_some() {
+                    len += 1;
+                }
+                if len > N {
+                    return Err(de::Error::invalid_length(len, &self));
+                }
+                Ok(Exact(out))
+            }
+        }
+        d.deserialize_seq(Elems::<T, N>(PhantomData))
+    }
+}
+
+/// A point, vector or colour: exactly three numbers.
+pub(super) type V3 = Exact<f64, 3>;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -36,11 +97,11 @@ pub(super) struct CameraDef {
     pub(super) angle: f64,
     #[serde(default = "default_hither")]
     pub(super) hither: f64,
-    pub(super) resolution: [u32; 2],
+    pub(super) resolution: Exact<u32, 2>,
 }
 
 const fn default_up() -> V3 {
-    [0.0, 0.0, 1.0]
+    Exact([0.0, 0.0, 1.0])
 }
 const fn default_hither() -> f64 {
     1.0
@@ -74,7 +135,7 @@ pub(super) struct MaterialDef {
 }
 
 const fn default_colour() -> V3 {
-    [0.8, 0.8, 0.8]
+    Exact([0.8, 0.8, 0.8])
 }
 const fn one() -> f64 {
     1.0
@@ -101,7 +162,7 @@ pub(super) struct CheckerDef {
     #[serde(default)]
     pub(super) origin: V3,
     pub(super) size: f64,
-    pub(super) colours: [[u8; 3]; 2],
+    pub(super) colours: Exact<Exact<u8, 3>, 2>,
 }
 
 #[derive(Deserialize)]
@@ -120,7 +181,7 @@ pub(super) struct NoiseDef {
     pub(super) turbulence: f64,
     #[serde(default = "default_octaves")]
     pub(super) octaves: u32,
-    pub(super) colours: [[u8; 3]; 2],
+    pub(super) colours: Exact<Exact<u8, 3>, 2>,
 }
 
 const fn default_octaves() -> u32 {
@@ -170,9 +231,9 @@ pub(super) struct VolumeDef {
     #[serde(default)]
     pub(super) iso: Option<f64>,
     #[serde(default)]
-    pub(super) opacity: Option<Vec<[f64; 2]>>,
+    pub(super) opacity: Option<Vec<Exact<f64, 2>>>,
     #[serde(default)]
-    pub(super) colours: Option<Vec<[f64; 4]>>,
+    pub(super) colours: Option<Vec<Exact<f64, 4>>>,
     /// `"iso"` or `"direct"`; the default is `"direct"` when an opacity
     /// point lies strictly between 0 and 1, else `"iso"`.
     #[serde(default)]
@@ -189,7 +250,7 @@ pub(super) struct VolumeDef {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawDef {
     pub(super) file: Spanned<String>,
-    pub(super) dims: [u32; 3],
+    pub(super) dims: Exact<u32, 3>,
     #[serde(rename = "type")]
     pub(super) sample_type: String,
     #[serde(default = "default_spacing")]
@@ -201,17 +262,17 @@ pub(super) struct RawDef {
 }
 
 const fn default_spacing() -> V3 {
-    [1.0, 1.0, 1.0]
+    Exact([1.0, 1.0, 1.0])
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct MetaballsDef {
-    pub(super) dims: [u32; 3],
+    pub(super) dims: Exact<u32, 3>,
     pub(super) min: V3,
     pub(super) max: V3,
     /// `[x, y, z, radius, strength]` each.
-    pub(super) balls: Vec<[f64; 5]>,
+    pub(super) balls: Vec<Exact<f64, 5>>,
 }
 
 #[derive(Deserialize)]

@@ -9,7 +9,7 @@ use ::toml::Spanned;
 use glam::DVec3;
 
 use super::build::Builder;
-use super::schema::VolumeDef;
+use super::schema::{Exact, VolumeDef};
 use crate::assets::volume::computed::{self, Metaball, Metaballs};
 use crate::assets::volume::raw::{self, RawSpec};
 use crate::assets::volume::{self, Classifier, Endian, Grid, Placement, SampleType, Volume};
@@ -78,14 +78,14 @@ impl Builder<'_> {
             }
             let (path, _) = self.path(&r.file, &key("raw.file"))?;
             let spec = RawSpec {
-                dims: r.dims,
+                dims: r.dims.0,
                 sample_type,
                 endian: if r.big_endian {
                     Endian::Big
                 } else {
                     Endian::Little
                 },
-                grid: Grid::axis_aligned(r.spacing, DVec3::ZERO),
+                grid: Grid::axis_aligned(r.spacing.0, DVec3::ZERO),
                 skip: r.skip,
             };
             raw::read(&path, &spec, &self.opts.volume)
@@ -123,7 +123,7 @@ impl Builder<'_> {
             }
             computed::sample(
                 &Metaballs(balls),
-                m.dims,
+                m.dims.0,
                 Grid::axis_aligned(spacing, lo),
                 &self.opts.volume,
             )
@@ -140,10 +140,12 @@ impl Builder<'_> {
         s: &Range<usize>,
         key: &dyn Fn(&str) -> String,
     ) -> Result<Classifier, SceneError> {
+        let opacity = d.opacity.as_deref().map(Exact::plain);
+        let colours = d.colours.as_deref().map(Exact::plain);
         Classifier::from_points(
             d.iso,
-            d.opacity.as_deref(),
-            d.colours.as_deref(),
+            opacity.as_deref(),
+            colours.as_deref(),
             d.render.as_deref(),
         )
         .map_err(|e| self.err(s.clone(), &key(&e.key), e.message))
