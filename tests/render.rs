@@ -902,3 +902,47 @@ fn an_object_smaller_than_fixed_point_keeps_its_voxels() {
         assert_eq!(img, &images[0].0, "raster {n}");
     }
 }
+
+/// A light as far as the sun (here 1e12 scene sizes away) is taken by its
+/// direction instead of being refused for fixed point: the exact image is
+/// the one lit from a light 1e5 away in the same direction (whose
+/// direction differs by 1e-4 radians at most: no channel by more than one
+/// level), at a coarse and a fine raster; the paper's mode renders it too,
+/// from the light bits.
+#[test]
+fn a_light_as_far_as_the_sun_lights_the_scene() {
+    let scene = |d: &str| {
+        let src = format!(
+            "v\nfrom 0 -6 3\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\nresolution 48 48\n\
+             b 0.1 0.2 0.6\nl {d} -{d} {d}\nf 1 0.5 0.3 1 0 0 0 1\ns 0 0 0 1\n\
+             f 0.8 0.8 0.8 1 0 0 0 1\np 4\n-4 -4 -1\n4 -4 -1\n4 4 -1\n-4 4 -1\n"
+        );
+        Scene::parse("sun.nff", src.as_bytes()).unwrap()
+    };
+    let image = |d: &str, raster: u32| {
+        let vs = voxelize_exact(&scene(d), raster);
+        draw(&vs, 48, 48, TraceOptions::default(), 1, 1).0.rgb
+    };
+    for raster in [64, 1024] {
+        let near = image("1e5", raster);
+        let sun = image("1e12", raster);
+        let most = near
+            .iter()
+            .zip(&sun)
+            .map(|(a, b)| a.abs_diff(*b))
+            .max()
+            .unwrap_or(0);
+        assert!(most <= 1, "raster {raster}: a channel differs by {most}");
+        let lit = sun.chunks(3).filter(|p| p[0] > 100).count();
+        assert!(lit > 300, "raster {raster}: {lit} lit pixels");
+    }
+    let paper = voxelize(&scene("1e12"), 64, Connectivity::Adaptive);
+    let opts = TraceOptions {
+        mode: Mode::Paper,
+        ..TraceOptions::default()
+    };
+    let (img, stats) = draw(&paper, 48, 48, opts, 1, 1);
+    assert!(stats.hits > 1000, "{stats:?}");
+    let lit = img.rgb.chunks(3).filter(|p| p[0] > 100).count();
+    assert!(lit > 300, "paper mode: {lit} lit pixels");
+}

@@ -20,6 +20,11 @@ use crate::world::{Bounds, Ray};
 /// products of coordinates stay far from `i64` limits.
 pub const MAX_FIXED: i64 = ORIGIN_LIMIT;
 
+/// How far a light's fixed-point position may lie from the raster's
+/// origin, per axis: 2^60 fixed units, 2^44 voxels
+/// ([`RasterFrame::light_to_fixed`]).
+pub const FAR_LIGHT_FIXED: i64 = 1 << 60;
+
 /// `log2` of [`MAX_FIXED`] in voxels, for messages.
 pub const MAX_FIXED_VOXEL_BITS: u32 = ORIGIN_LIMIT_BITS - FRAC_BITS;
 
@@ -76,6 +81,42 @@ impl RasterFrame {
             (r.abs() <= MAX_FIXED as f64).then_some(r as i64)
         };
         Some([c(q.x)?, c(q.y)?, c(q.z)?])
+    }
+
+    /// A light's world position in fixed units, for the shadow rays
+    /// towards it; `None` only if it is not finite. Within 2^44 voxels
+    /// ([`FAR_LIGHT_FIXED`]) of the raster's origin, the position rounded
+    /// to the nearest 1/65536 voxel as [`RasterFrame::to_fixed`] rounds it;
+    /// beyond, a light is taken by its direction: the point 2^44 voxels
+    /// from the raster's centre towards it (a sun, a light "at infinity").
+    /// From any point of a raster up to 2^15 voxels wide the directions to
+    /// that point and to the light differ by less than 2^-27 radians, so
+    /// a shadow ray towards either stays within 2^-11 voxel of the other
+    /// across the raster. The core takes lights anywhere in `i64` (its
+    /// shadow rays towards a light far outside the raster go by direction),
+    /// so no light is refused for its distance.
+    #[must_use]
+    pub fn light_to_fixed(&self, p: DVec3) -> Option<Point> {
+        if !p.is_finite() {
+            return None;
+        }
+        let limit = FAR_LIGHT_FIXED as f64;
+        let q = self.world_to_raster(p) * VOXEL as f64;
+        if q.abs().max_element() <= limit {
+            return Some(q.to_array().map(|v| round(v) as i64));
+        }
+        // Halves keep the difference finite for any finite coordinates.
+        let centre = DVec3::from(self.dims().map(f64::from)) * 0.5;
+        let d = 0.5 * p - 0.5 * self.raster_to_world(centre);
+        let m = d.abs().max_element();
+        let u = (d / m).normalize_or_zero();
+        if u == DVec3::ZERO {
+            return None;
+        }
+        // |centre| ≤ 2^15 voxels: every coordinate within 2^61, exact in
+        // `i64`.
+        let far = (centre * VOXEL as f64 + u * limit).to_array();
+        Some(far.map(|v| round(v) as i64))
     }
 
     /// A fixed-point point back in the world.

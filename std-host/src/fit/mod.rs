@@ -122,7 +122,16 @@ pub enum FitError {
         /// The limit in bytes.
         limit: u64,
     },
-    /// A light or object lies too far from the raster for fixed point.
+    /// A light's position is not finite (scene readers refuse such
+    /// numbers; this guards scenes built in code).
+    #[error("{loc}: {what} position is not finite")]
+    NotFinite {
+        /// Where it is defined.
+        loc: SourceLoc,
+        /// What it is.
+        what: &'static str,
+    },
+    /// An object lies too far from the raster for fixed point.
     #[error("{loc}: {what} lies more than 2^{MAX_FIXED_VOXEL_BITS} voxels from the raster")]
     OutOfRange {
         /// Where it is defined.
@@ -152,7 +161,9 @@ pub struct FittedObject {
 /// A light in fixed-point raster coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FittedLight {
-    /// Position in fixed units (anywhere within [`MAX_FIXED`](crate::frame::MAX_FIXED)).
+    /// Position in fixed units ([`RasterFrame::light_to_fixed`]: within
+    /// 2^44 voxels of the raster, a light farther away taken by its
+    /// direction).
     pub position: Point,
     /// Colour (white if the file gives none).
     pub colour: DVec3,
@@ -225,10 +236,12 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
         .iter()
         .map(|l| {
             Ok(FittedLight {
-                position: frame.to_fixed(l.position).ok_or(FitError::OutOfRange {
-                    loc: l.loc.clone(),
-                    what: "light",
-                })?,
+                position: frame
+                    .light_to_fixed(l.position)
+                    .ok_or(FitError::NotFinite {
+                        loc: l.loc.clone(),
+                        what: "light",
+                    })?,
                 colour: l.rgb(),
             })
         })

@@ -174,12 +174,27 @@ fn objects_lights_and_normals() {
     assert_eq!(fitted.dropped, Dropped::default());
 }
 
+/// A light too far for fixed point near the raster (a sun) is taken by its
+/// direction: 2^44 voxels from the raster's centre towards it; a light
+/// within that distance keeps its rounded position.
 #[test]
-fn far_light_is_refused_with_its_location() {
-    let s = scene("l 1e30 0 0\ns 0 0 0 1\n");
+fn a_far_light_is_taken_by_its_direction() {
+    let s = scene("l 1e30 -2e30 3e30\nl 1e9 0 0\ns 0 0 0 1\n");
+    let fitted = fit(&s, &opts(36)).unwrap();
+    let f = fitted.frame;
+    let far = DVec3::from(fitted.lights[0].position.map(|v| v as f64)) / VOXEL as f64;
+    let centre = DVec3::from(f.dims().map(f64::from)) * 0.5;
+    let to = far - centre;
+    assert!((to.length() / 2f64.powi(44) - 1.0).abs() < 1e-9, "{to}");
+    let want = DVec3::new(1.0, -2.0, 3.0).normalize();
+    assert!(to.normalize().angle_between(want) < 1e-12);
+    // Beyond the 2^31 voxels of other points, within 2^44.
+    let near = DVec3::new(1e9, 0.0, 0.0);
+    assert!(f.to_fixed(near).is_none());
+    let q = f.world_to_raster(near) * VOXEL as f64;
     assert_eq!(
-        fit(&s, &opts(36)).unwrap_err().to_string(),
-        "t.nff:8:1: light lies more than 2^31 voxels from the raster"
+        fitted.lights[1].position,
+        q.to_array().map(|v| v.round() as i64)
     );
 }
 

@@ -568,7 +568,7 @@ impl<'s> Tracer<'s> {
         let lights_fx = scene
             .lights
             .iter()
-            .map(|l| scene.frame.to_fixed(l.position))
+            .map(|l| scene.frame.light_to_fixed(l.position))
             .collect();
         let offset = surface_offset(scene);
         Ok(Self {
