@@ -946,3 +946,50 @@ fn a_light_as_far_as_the_sun_lights_the_scene() {
     let lit = img.rgb.chunks(3).filter(|p| p[0] > 100).count();
     assert!(lit > 300, "paper mode: {lit} lit pixels");
 }
+
+/// A ground made huge to look infinite (here 2·10⁶ wide under a sphere of
+/// radius 1) does not push the rays leaving it off the sphere's shadow:
+/// seen from above, where the ground fills the view, the image is the one
+/// with a ground 20 wide, shadow included, but for pixels on the shadow's
+/// edge (the offset of leaving rays is at most a tenth of the smallest
+/// object's size, not 10⁻⁵ of the scene's, which here is larger than the
+/// sphere).
+#[test]
+fn a_huge_ground_keeps_the_shadows_on_it() {
+    let image = |half: &str| {
+        let src = format!(
+            "v\nfrom 0 -3 9\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\nresolution 64 64\n\
+             b 0.1 0.2 0.6\nl 3 -2 12\nf 1 0.5 0.3 0.8 0 0 0 1\ns 0 0 1.5 1\n\
+             f 0.8 0.8 0.8 1 0 0 0 1\np 4\n-{half} -{half} 0\n{half} -{half} 0\n\
+             {half} {half} 0\n-{half} {half} 0\n"
+        );
+        let scene = Scene::parse("ground.nff", src.as_bytes()).unwrap();
+        let vs = voxelize_exact(&scene, 64);
+        draw(&vs, 64, 64, TraceOptions::default(), 1, 1).0.rgb
+    };
+    // Ground pixels in the sphere's shadow (grey, lit by the ambient
+    // light only: the darkest grey) and lit (grey, brighter).
+    let shadow = |img: &[u8]| {
+        let grey = || img.chunks(3).filter(|p| p[0] == p[1] && p[1] == p[2]);
+        let ambient = grey().map(|p| p[0]).min().unwrap_or(0);
+        (
+            grey().filter(|p| p[0] == ambient).count(),
+            grey().filter(|p| p[0] > ambient.saturating_add(20)).count(),
+        )
+    };
+    let small = image("10");
+    let huge = image("1e6");
+    let (dark, lit) = shadow(&small);
+    assert!(dark > 40 && lit > 2000, "{dark} in shadow, {lit} lit");
+    let (huge_dark, _) = shadow(&huge);
+    assert!(
+        huge_dark.abs_diff(dark) * 10 <= dark,
+        "{huge_dark} pixels in shadow, {dark} with the small ground"
+    );
+    let differ = small
+        .chunks(3)
+        .zip(huge.chunks(3))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count();
+    assert!(differ * 100 <= 64 * 64, "{differ} pixels differ");
+}

@@ -73,10 +73,13 @@
 //! towards the side it goes to, and counts every exact intersection after
 //! its start, as `embree_nff`'s rays do; shadow rays end twice that short
 //! of the light. The offset is never more than a tenth of the size of the
-//! object hit ([`crate::shape::Shape::radius`]; nor less than 10⁻¹² of the
-//! hit point's largest coordinate, the rounding of the point), so that in
-//! a scene spanning many orders of magnitude a small object's rays do not
-//! start beyond its neighbours or its lights. A flat triangle or a sphere left from outside is not
+//! smallest object of the scene ([`crate::shape::Shape::radius`]; nor less
+//! than 10⁻¹² of the hit point's largest coordinate, the rounding of the
+//! point): a ray displaced from its surface by more than an object's size
+//! could pass that object, so in a scene spanning many orders of magnitude
+//! (a ground made huge to look infinite, a far object, small objects among
+//! large ones) no object loses its shadow, its reflection or its
+//! neighbours to the offset. A flat triangle or a sphere left from outside is not
 //! tested against its own rays ([`crate::shape::Shape::meets_itself_leaving`]).
 //! A ray leaving a discrete hit (the paper's mode, objects without exact
 //! geometry) starts at the point where the incoming ray entered the hit
@@ -464,9 +467,10 @@ pub struct Tracer<'s> {
     /// How far rays leaving a verified hit start off the surface
     /// ([`Tracer::leaving`]) at most.
     offset: f64,
-    /// Per object, the offset of rays leaving it ([`Tracer::offset_at`]):
-    /// `offset`, or a tenth of the object's size where that is less.
-    offsets: Vec<f64>,
+    /// The offset of rays leaving a surface ([`Tracer::offset_at`]):
+    /// `offset`, or a tenth of the smallest object's size where that is
+    /// less.
+    least_offset: f64,
     background: DVec3,
     intensity: f64,
     opts: TraceOptions,
@@ -583,11 +587,11 @@ impl<'s> Tracer<'s> {
             direct: &scene.direct,
             classification: Classification::of(scene, &store, &opts),
             offset,
-            offsets: scene
+            least_offset: scene
                 .objects
                 .iter()
-                .map(|o| offset.min(0.1 * o.shape.radius()))
-                .collect(),
+                .map(|o| 0.1 * o.shape.radius())
+                .fold(offset, f64::min),
             background: scene.background,
             intensity: scene.intensity(),
             opts,

@@ -42,15 +42,11 @@ impl Tracer<'_> {
 
     /// How far rays leaving verified hit `h` start off the surface: the
     /// scene's [`surface_offset`](super::surface_offset), but no more than
-    /// a tenth of the hit object's size, nor less than 10⁻¹² of the hit
-    /// point's largest coordinate (module docs, *No acne*).
+    /// a tenth of the smallest object's size, nor less than 10⁻¹² of the
+    /// hit point's largest coordinate (module docs, *No acne*).
     pub(super) fn offset_at(&self, h: &SurfaceHit) -> f64 {
-        let own = usize::try_from(h.object)
-            .ok()
-            .and_then(|i| self.offsets.get(i))
-            .copied()
-            .unwrap_or(self.offset);
-        own.max(1e-12 * h.point.abs().max_element())
+        self.least_offset
+            .max(1e-12 * h.point.abs().max_element())
             .min(self.offset)
     }
 
