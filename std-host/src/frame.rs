@@ -180,6 +180,51 @@ pub fn round_to_i64(x: f64) -> i64 {
 mod tests {
     use super::*;
 
+    /// A light too far for fixed point is the point 2^44 voxels from the
+    /// raster's centre towards it: from every corner of the widest raster
+    /// the directions to that point and to the light differ by less than
+    /// 2^-27 radians, and nearer lights keep their rounded position.
+    #[test]
+    fn far_lights_keep_their_direction() {
+        let frame = RasterFrame {
+            extent: Extent::new(32768, 32768, 32768).unwrap(),
+            origin: DVec3::new(-3.0, 5.0, 7.0),
+            voxel_size: 0.25,
+        };
+        let n = 32768.0;
+        for dir in [
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(-1.0, 2.0, 0.5),
+            DVec3::new(0.3, -0.2, -1.0),
+        ] {
+            for dist in [1e20, 1e200, 1e308] {
+                let light = dir.normalize() * dist;
+                let p = frame.light_to_fixed(light).unwrap();
+                let proxy = DVec3::from(p.map(|v| v as f64)) / VOXEL as f64;
+                for corner in 0..8 {
+                    let c = DVec3::new(
+                        f64::from(corner & 1) * n,
+                        f64::from((corner >> 1) & 1) * n,
+                        f64::from((corner >> 2) & 1) * n,
+                    );
+                    let angle = (proxy - c).angle_between(dir);
+                    assert!(angle < 2f64.powi(-27), "{dir} {dist} {corner}: {angle}");
+                }
+            }
+        }
+        let near = DVec3::new(1e9, -2e9, 3e9);
+        let q = frame.world_to_raster(near) * VOXEL as f64;
+        assert_eq!(
+            frame.light_to_fixed(near),
+            Some(q.to_array().map(|v| v.round() as i64))
+        );
+        assert_eq!(frame.light_to_fixed(DVec3::new(f64::NAN, 0.0, 0.0)), None);
+        assert_eq!(
+            frame.light_to_fixed(DVec3::new(f64::INFINITY, 0.0, 0.0)),
+            None
+        );
+    }
+
     #[test]
     fn round_is_f64_round() {
         let mut vals = vec![
