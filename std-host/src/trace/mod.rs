@@ -423,8 +423,10 @@ pub struct RayHit {
     pub verified: bool,
 }
 
-/// How far a ray leaving a verified hit starts off the surface, along the
-/// normal towards the side it goes to: `embree_nff`'s ε, 10⁻⁵ of the
+/// How far a ray leaving a verified hit starts off the surface at most,
+/// along the normal towards the side it goes to (less where the scene has
+/// objects smaller than ten times this: module docs, *No acne*):
+/// `embree_nff`'s ε, 10⁻⁵ of the
 /// diagonal of the box of the scene's geometry (the objects' boxes; the
 /// raster's box where some object has no geometry of its own, a volume
 /// or `.vox` model, or there is none), so that it does not depend on the
