@@ -162,7 +162,7 @@ use std::sync::atomic::AtomicU16;
 use glam::DVec3;
 use rrt_core::discrete_ray::Connectivity;
 use rrt_core::light::{ExactRecords, LeavingSurface, LightParams};
-use rrt_core::raster::{Extent, Raster};
+use rrt_core::raster::{Extent, Raster, cell};
 use rrt_core::store::RecordStore;
 use rrt_core::voxel::VoxelRecord;
 
@@ -598,6 +598,15 @@ impl<'s> Tracer<'s> {
             intensity: scene.intensity(),
             opts,
         })
+    }
+
+    /// The raster index and cell of voxel `v` when it lies in the raster
+    /// and is non-transparent (its record is then looked up by the cell's
+    /// rank hint).
+    pub(super) fn opaque_cell(&self, v: [u32; 3]) -> Option<(usize, u8)> {
+        let index = self.extent.index(v)?;
+        let c = self.raster.plane().get(index).copied()?;
+        (c & cell::OPAQUE != 0).then_some((index, c))
     }
 
     /// The options in use.

@@ -327,11 +327,7 @@ impl Tracer<'_> {
                 u32::MAX
             }
         });
-        let index = self.extent.index(v)?;
-        let c = self.raster.plane().get(index).copied()?;
-        if c & cell::OPAQUE == 0 {
-            return None;
-        }
+        let (_, c) = self.opaque_cell(v)?;
         let at = self.store.index_hinted(v, c)?;
         let rec = self.store.records().get(at)?;
         let own = self.store.objects(rec);

@@ -4,7 +4,6 @@
 
 use glam::DVec3;
 use rrt_core::light::LeavingSurface;
-use rrt_core::raster::cell;
 use rrt_core::voxel::VoxelRecord;
 
 use super::{RayStats, SurfaceHit, Tracer};
@@ -365,13 +364,9 @@ impl Tracer<'_> {
                     if w <= 0.0 {
                         continue;
                     }
-                    let Some(index) = self.extent.index(v) else {
+                    let Some((_, cell)) = self.opaque_cell(v) else {
                         continue;
                     };
-                    let cell = self.raster.plane().get(index).copied().unwrap_or(0);
-                    if cell & cell::OPAQUE == 0 {
-                        continue;
-                    }
                     if let Some(rec) = self.store.get_hinted(v, cell)
                         && self.store.owner(rec) == id
                     {
@@ -398,13 +393,9 @@ impl Tracer<'_> {
             ) else {
                 continue;
             };
-            let Some(index) = self.extent.index([x, y, z]) else {
+            let Some((_, c)) = self.opaque_cell([x, y, z]) else {
                 continue;
             };
-            let c = self.raster.plane().get(index).copied().unwrap_or(0);
-            if c & cell::OPAQUE == 0 {
-                continue;
-            }
             if let Some(n) = self.store.get_hinted([x, y, z], c)
                 && self.store.owner(n) == id
             {

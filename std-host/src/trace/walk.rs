@@ -406,13 +406,9 @@ impl Tracer<'_> {
             if !inside {
                 continue;
             }
-            let Some(index) = self.extent.index(v) else {
+            let Some((index, c)) = self.opaque_cell(v) else {
                 continue;
             };
-            let c = self.raster.plane().get(index).copied().unwrap_or(0);
-            if c & cell::OPAQUE == 0 {
-                continue;
-            }
             if let Some(rec) = self.store.get_hinted(v, c) {
                 self.test_voxel(ray, o_r, v, index, rec, tmin, None, mail, best);
             }
