@@ -24,6 +24,7 @@ mod embree;
 mod head;
 mod plot;
 mod python;
+mod scale;
 mod skipping;
 mod table1;
 mod table2;
@@ -66,7 +67,7 @@ struct Args {
     #[arg(long, default_value_t = 1992)]
     seed: u64,
     /// Run only this section (repeatable): table1, table2, connectivity,
-    /// verification, skipping, embree, dvr, python, whole [default: all].
+    /// verification, skipping, embree, dvr, python, whole, scale [default: all].
     #[arg(long = "section", value_name = "NAME")]
     sections: Vec<String>,
 }
@@ -120,7 +121,7 @@ fn run() -> Res<()> {
     let mut body = Md::default();
     std::mem::swap(&mut body, &mut ctx.md);
 
-    let sections: [(&str, &str, Section); 9] = [
+    let sections: [(&str, &str, Section); 10] = [
         ("Table 1", "table1", table1::table1),
         ("Table 2", "table2", table2::table2),
         ("connectivity", "connectivity", connectivity::connectivity),
@@ -130,6 +131,7 @@ fn run() -> Res<()> {
         ("direct volume rendering", "dvr", dvr::dvr),
         ("Python", "python", python::python),
         ("whole job", "whole", whole::whole),
+        ("rasters at scale", "scale", scale::scale),
     ];
     if let Some(bad) = args
         .sections

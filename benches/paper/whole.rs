@@ -22,18 +22,18 @@ const SCENES: [&str; 7] = [
 
 /// One process's figures.
 #[derive(Clone, Debug, Default)]
-struct Run {
+pub(crate) struct Run {
     /// Wall time, s.
-    wall: f64,
+    pub(crate) wall: f64,
     /// Peak resident memory, MiB (NaN without `/usr/bin/time`).
-    rss: f64,
+    pub(crate) rss: f64,
     /// Standard output and error.
-    out: String,
+    pub(crate) out: String,
 }
 
 impl Run {
     /// A phase's seconds from rrt's summary line (`name 0.123 s`).
-    fn phase(&self, name: &str) -> f64 {
+    pub(crate) fn phase(&self, name: &str) -> f64 {
         self.out
             .split(&format!("{name} "))
             .nth(1)
@@ -43,7 +43,7 @@ impl Run {
     }
 
     /// A count from rrt's summary line (`123 name`).
-    fn count(&self, name: &str) -> f64 {
+    pub(crate) fn count(&self, name: &str) -> f64 {
         self.out
             .split(&format!(" {name}"))
             .next()
@@ -57,7 +57,7 @@ impl Run {
 /// clock's resolution), under `/usr/bin/time` for its peak memory when
 /// that exists (its own wall time has only 10 ms steps, too coarse for
 /// processes of a tenth of a second).
-fn run(cmd: &Path, args: &[String]) -> Res<Run> {
+pub(crate) fn run(cmd: &Path, args: &[String]) -> Res<Run> {
     let time = Path::new("/usr/bin/time");
     let t = Instant::now();
     let o = if time.is_file() {
@@ -92,7 +92,7 @@ fn scene_path(ctx: &Ctx, stem: &str) -> PathBuf {
     }
 }
 
-fn strings(a: &[&str]) -> Vec<String> {
+pub(crate) fn strings(a: &[&str]) -> Vec<String> {
     a.iter().map(|s| (*s).to_string()).collect()
 }
 
