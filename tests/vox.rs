@@ -204,7 +204,9 @@ fn voxelized_into_the_raster() {
     let colors = scene.colors(placement);
     let offers = std::cell::RefCell::new(Vec::new());
     let built = OneObject::textured(extent, [9, 9, 9], &colors, |sink| {
-        offers.borrow_mut().push(scene.voxelize(placement, sink));
+        offers
+            .borrow_mut()
+            .push(scene.voxelize(placement, extent.dims(), sink));
     });
     // Both passes offer every voxel once.
     assert_eq!(*offers.borrow(), [36 * 8; 2]);
@@ -230,6 +232,22 @@ fn voxelized_into_the_raster() {
         .sum();
     assert!(dot as f64 > 0.999 * f64::from(NORMAL_ONE).powi(2), "{n:?}");
     assert!(store.get_voxel([37, 8, 8]).is_none());
+
+    // A raster 41 voxels wide: the voxels at x ≥ 41 are not offered.
+    struct Offers(Vec<[u32; 3]>);
+    impl rrt_core::voxelize::VoxelSink for Offers {
+        fn offer(&mut self, v: [u32; 3], _: rrt_core::voxelize::Surfel) {
+            self.0.push(v);
+        }
+    }
+    let mut all = Offers(Vec::new());
+    scene.voxelize(placement, extent.dims(), &mut all);
+    let mut narrow = Offers(Vec::new());
+    let n = scene.voxelize(placement, [41, 64, 64], &mut narrow);
+    let kept: Vec<[u32; 3]> = all.0.into_iter().filter(|v| v[0] < 41).collect();
+    assert!(!kept.is_empty() && kept.len() < 36 * 8);
+    assert_eq!(narrow.0, kept);
+    assert_eq!(n, kept.len() as u64);
 }
 
 #[track_caller]
@@ -360,4 +378,95 @@ fn bad_files() {
     // A missing file.
     let e = vox::read("/nonexistent/dir/x.vox").unwrap_err();
     assert!(matches!(e, VoxError::Io { .. }));
+}
+
+/// A file of `levels` groups, each holding its next level twice (a node
+/// shared by two parents), ending in the shape of a `side`³ model (or, with
+/// `side` 0, in an empty group and no model): 2^levels paths through a
+/// graph of 2·levels + 2 nodes.
+fn shared_levels(levels: u32, side: u8) -> Vec<u8> {
+    let mut scenes = Vec::new();
+    for i in 0..levels {
+        // Node 2i: a transform to the group 2i + 1, which holds node
+        // 2i + 2 twice.
+        scenes.push(transform(&[("_t", &format!("{i} 0 0"))], 2 * i + 1, 0));
+        scenes.push(SceneNode::Group {
+            attributes: dict(&[]),
+            children: vec![2 * i + 2, 2 * i + 2],
+        });
+    }
+    scenes.push(transform(&[], 2 * levels + 1, 0));
+    let mut models = Vec::new();
+    if side == 0 {
+        scenes.push(SceneNode::Group {
+            attributes: dict(&[]),
+            children: vec![],
+        });
+    } else {
+        scenes.push(shape(0));
+        let mut voxels = Vec::new();
+        for z in 0..side {
+            for y in 0..side {
+                for x in 0..side {
+                    voxels.push(Voxel { x, y, z, i: 0 });
+                }
+            }
+        }
+        let n = u32::from(side);
+        models.push(Model {
+            size: Size { x: n, y: n, z: n },
+            voxels,
+        });
+    }
+    let d = DotVoxData {
+        version: 150,
+        index_map: vec![],
+        models,
+        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+        materials: vec![],
+        scenes,
+        layers: vec![],
+    };
+    let mut out = Vec::new();
+    d.write_vox(&mut out).unwrap();
+    out
+}
+
+/// A small file can stand for very many instances, node visits or voxels
+/// through shared scene nodes: each is refused, naming the file, before
+/// anything is made (a 1 MB file placing 17 G voxels ran out of memory).
+#[test]
+fn shared_scene_nodes_cannot_blow_up() {
+    // 2^12 instances of a 2³ model: read, every instance placed.
+    let ok = vox::parse_bytes("ok.vox", &shared_levels(12, 2)).unwrap();
+    assert_eq!(ok.instances().len(), 1 << 12);
+    assert_eq!(ok.world_voxel_count(), 8 << 12);
+    assert_eq!(ok.world_voxels().len(), 8 << 12);
+    // 2^17 instances.
+    let e = err(&shared_levels(17, 1));
+    assert!(
+        e.starts_with("bad.vox: scene node ")
+            && e.ends_with(&format!("more than {} model instances", vox::MAX_INSTANCES)),
+        "{e}"
+    );
+    // 2^16 instances (the most) of a 32³ model: 2^31 voxels.
+    let e = err(&shared_levels(16, 32));
+    assert_eq!(
+        e,
+        format!(
+            "bad.vox: scene node 0: the 65536 model instances place 2147483648 voxels, more \
+             than the limit of {}",
+            vox::MAX_WORLD_VOXELS
+        )
+    );
+    // 2^60 paths to an empty group: no instance, but the walk is bounded.
+    let e = err(&shared_levels(60, 0));
+    assert!(
+        e.starts_with("bad.vox: scene node ")
+            && e.contains(&format!(
+                "visits more than {} scene nodes",
+                vox::MAX_NODE_VISITS
+            )),
+        "{e}"
+    );
 }

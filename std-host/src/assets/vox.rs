@@ -57,7 +57,11 @@
 //! whose voxel lies outside its model, a bad palette size, or a scene
 //! graph with missing nodes, cycles, bad `_t`/`_r` values or unknown
 //! models: a [`VoxError`] naming the file and the byte offset (or scene
-//! node).
+//! node). So is a scene graph that places more than [`MAX_INSTANCES`]
+//! model instances, visits more than [`MAX_NODE_VISITS`] nodes (shared
+//! nodes are visited once per path to them) or places more than
+//! [`MAX_WORLD_VOXELS`] voxels in all: a file of a few bytes per node can
+//! stand for far more, and each is refused before its voxels are made.
 
 use std::path::{Path, PathBuf};
 
@@ -70,6 +74,13 @@ pub const MAX_MODEL_EDGE: u32 = 256;
 pub const MAX_DEPTH: usize = 256;
 /// Most model instances a scene graph may produce.
 pub const MAX_INSTANCES: usize = 1 << 16;
+/// Most scene-graph nodes visited while placing the instances: a node
+/// that several groups share is visited once per path to it, so a small
+/// graph of shared nodes can stand for very many paths.
+pub const MAX_NODE_VISITS: usize = 1 << 20;
+/// Most voxels the instances may place in all (each instance places its
+/// model's voxels): two full 256³ models.
+pub const MAX_WORLD_VOXELS: u64 = 1 << 25;
 
 /// Why a `.vox` file cannot be read.
 #[derive(Debug, thiserror::Error)]
@@ -385,11 +396,24 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<VoxScene, VoxError> {
     } else {
         walk_scene(path, &data, models.len())?
     };
-    Ok(VoxScene {
+    let scene = VoxScene {
         models,
         instances,
         palette,
-    })
+    };
+    let placed = scene.world_voxel_count();
+    if placed > MAX_WORLD_VOXELS {
+        return Err(VoxError::Scene {
+            path: path.to_path_buf(),
+            node: 0,
+            msg: format!(
+                "the {} model instances place {placed} voxels, more than the limit of \
+                 {MAX_WORLD_VOXELS}",
+                scene.instances.len()
+            ),
+        });
+    }
+    Ok(scene)
 }
 
 const IDENTITY: [[i32; 3]; 3] = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
@@ -434,7 +458,18 @@ fn walk_scene(
     let mut out = Vec::new();
     // (node, rotation, translation, depth)
     let mut stack = vec![(0u32, IDENTITY, [0i64; 3], 0usize)];
+    let mut visits = 0usize;
     while let Some((node, rot, tr, depth)) = stack.pop() {
+        visits += 1;
+        if visits > MAX_NODE_VISITS {
+            return Err(serr(
+                node,
+                format!(
+                    "placing the models visits more than {MAX_NODE_VISITS} scene nodes \
+                     (nodes shared by several groups are visited once per path)"
+                ),
+            ));
+        }
         if depth > MAX_DEPTH {
             return Err(serr(
                 node,
@@ -629,24 +664,52 @@ impl VoxScene {
         Some(out)
     }
 
-    /// Every voxel of every instance in MagicaVoxel's world frame.
+    /// The voxels the instances place in all (at most
+    /// [`MAX_WORLD_VOXELS`] for a scene read from a file).
+    #[must_use]
+    pub fn world_voxel_count(&self) -> u64 {
+        self.instances
+            .iter()
+            .filter_map(|i| self.models.get(i.model))
+            .map(|m| m.voxels.len() as u64)
+            .fold(0, u64::saturating_add)
+    }
+
+    /// Calls `f` with every voxel of every instance in MagicaVoxel's world
+    /// frame, instance by instance, each model's voxels in file order
+    /// (each model's voxels and normals are made once).
+    pub fn for_each_world_voxel(&self, mut f: impl FnMut(WorldVoxel)) {
+        let local: Vec<Option<Vec<ModelVoxel>>> = (0..self.models.len())
+            .map(|m| {
+                self.instances
+                    .iter()
+                    .any(|i| i.model == m)
+                    .then(|| self.model_voxels(m))
+                    .flatten()
+            })
+            .collect();
+        for inst in &self.instances {
+            let (Some(m), Some(Some(vs))) = (self.models.get(inst.model), local.get(inst.model))
+            else {
+                continue;
+            };
+            for v in vs {
+                f(WorldVoxel {
+                    cell: inst.to_world(v.local, m.size),
+                    color: v.color,
+                    normal: inst.rotate(v.normal),
+                    interior: v.interior,
+                });
+            }
+        }
+    }
+
+    /// Every voxel of every instance in MagicaVoxel's world frame, in the
+    /// order of [`VoxScene::for_each_world_voxel`].
     #[must_use]
     pub fn world_voxels(&self) -> Vec<WorldVoxel> {
         let mut out = Vec::new();
-        for inst in &self.instances {
-            let Some(m) = self.models.get(inst.model) else {
-                continue;
-            };
-            let Some(vs) = self.model_voxels(inst.model) else {
-                continue;
-            };
-            out.extend(vs.into_iter().map(|v| WorldVoxel {
-                cell: inst.to_world(v.local, m.size),
-                color: v.color,
-                normal: inst.rotate(v.normal),
-                interior: v.interior,
-            }));
-        }
+        self.for_each_world_voxel(|v| out.push(v));
         out
     }
 

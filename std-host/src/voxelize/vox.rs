@@ -26,36 +26,42 @@ pub struct VoxPlacement {
 impl VoxScene {
     /// Offers every voxel of the scene to `sink` at `placement` (each
     /// world cell as `scale³` raster voxels, all with the cell's normal,
-    /// distance 0); voxels at negative or too large raster coordinates are
-    /// skipped. Returns the offers made. Colour them through
-    /// [`VoxScene::colors`] with the same placement (the builder's
-    /// `Filler::textured`).
-    pub fn voxelize<S: VoxelSink + ?Sized>(&self, placement: VoxPlacement, sink: &mut S) -> u64 {
+    /// distance 0), clipped to a raster of `dims` voxels and to the rows
+    /// and layers the sink keeps; returns the offers made. Colour them
+    /// through [`VoxScene::colors`] with the same placement (the
+    /// builder's `Filler::textured`). Work: the world voxels plus the
+    /// offers.
+    pub fn voxelize<S: VoxelSink + ?Sized>(
+        &self,
+        placement: VoxPlacement,
+        dims: [u32; 3],
+        sink: &mut S,
+    ) -> u64 {
         let s = i64::from(placement.scale.max(1));
-        let layers = sink.layers();
-        let (z0, z1) = (i64::from(layers.start), i64::from(layers.end));
+        let (rows, layers) = (sink.rows(), sink.layers());
+        // Raster voxels kept along each axis: `lo[a] .. hi[a]`.
+        let lo = [0, i64::from(rows.start), i64::from(layers.start)];
+        let hi = [
+            i64::from(dims[0]),
+            i64::from(rows.end.min(dims[1])),
+            i64::from(layers.end.min(dims[2])),
+        ];
         let mut n = 0u64;
-        for v in self.world_voxels() {
-            let base: [i64; 3] = std::array::from_fn(|a| {
-                placement.offset[a].saturating_add(v.cell[a].saturating_mul(s))
+        self.for_each_world_voxel(|v| {
+            // The cell's voxels kept, per axis (empty when it misses).
+            let span: [(i64, i64); 3] = std::array::from_fn(|a| {
+                let base = placement.offset[a].saturating_add(v.cell[a].saturating_mul(s));
+                (base.max(lo[a]), base.saturating_add(s).min(hi[a]))
             });
-            // A cell wholly outside the sink's layers offers nothing it keeps.
-            if base[2].saturating_add(s) <= z0 || base[2] >= z1 {
-                continue;
+            if span.iter().any(|(a, b)| a >= b) {
+                return;
             }
-            for dz in 0..s {
-                for dy in 0..s {
-                    for dx in 0..s {
-                        let r = [base[0] + dx, base[1] + dy, base[2] + dz];
-                        let (Ok(x), Ok(y), Ok(z)) = (
-                            u32::try_from(r[0]),
-                            u32::try_from(r[1]),
-                            u32::try_from(r[2]),
-                        ) else {
-                            continue;
-                        };
+            for z in span[2].0..span[2].1 {
+                for y in span[1].0..span[1].1 {
+                    for x in span[0].0..span[0].1 {
+                        // Within 0 .. dims: each fits in u32.
                         sink.offer(
-                            [x, y, z],
+                            [x, y, z].map(|c| u32::try_from(c).unwrap_or(u32::MAX)),
                             Surfel {
                                 normal: v.normal,
                                 distance: 0,
@@ -65,7 +71,7 @@ impl VoxScene {
                     }
                 }
             }
-        }
+        });
         n
     }
 
@@ -74,11 +80,13 @@ impl VoxScene {
     pub fn colors(&self, placement: VoxPlacement) -> VoxColors {
         VoxColors {
             placement,
-            cells: self
-                .world_voxels()
-                .into_iter()
-                .map(|v| (v.cell, v.color))
-                .collect(),
+            cells: {
+                let mut cells = HashMap::new();
+                self.for_each_world_voxel(|v| {
+                    cells.insert(v.cell, v.color);
+                });
+                cells
+            },
         }
     }
 }
@@ -139,13 +147,13 @@ pub(super) fn voxelize_object(
     let placement = placement(v, frame)?;
     match pass {
         Pass::Count(c) => {
-            v.vox.voxelize(placement, c);
+            v.vox.voxelize(placement, frame.dims(), c);
         }
         Pass::Fill { filler, attrs, .. } => {
             filler.begin_object(attrs)?;
             let colors = v.vox.colors(placement);
             let mut s = filler.textured(&colors);
-            v.vox.voxelize(placement, &mut s);
+            v.vox.voxelize(placement, frame.dims(), &mut s);
         }
     }
     Ok(())
