@@ -84,3 +84,8 @@ fn scene_toml_inputs_replay() {
 fn raster_file_inputs_replay() {
     replay_checked("raster_file", rrt_host::check::raster_file_input);
 }
+
+#[test]
+fn asset_inputs_replay() {
+    replay_checked("assets", rrt_host::check::asset_input);
+}

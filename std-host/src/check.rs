@@ -6,6 +6,7 @@
 //! * [`nrrd_input`]: the NRRD reader and a volume's raster block;
 //! * [`raster_file_input`]: the saved-raster loader, and rendering what it loads;
 //! * [`path_input`]: the camera path reader;
+//! * [`asset_input`]: the `.vox`, OBJ and Bézier patch readers;
 //! * [`check_scene`]: the guarantees of a parsed [`Scene`](crate::scene::Scene).
 
 use glam::DVec3;
@@ -112,6 +113,119 @@ pub fn path_input(data: &[u8]) -> Result<(), String> {
         return Err("views out of line order".into());
     }
     Ok(())
+}
+
+/// Feeds arbitrary bytes, after a first byte choosing the reader, to the
+/// `.vox` reader (as `fuzz.vox`), the OBJ reader (`fuzz.obj`) or the
+/// Bézier patch reader (`fuzz.bpt`), and checks: an error names the file;
+/// a `.vox` scene places at most [`vox::MAX_WORLD_VOXELS`] voxels from
+/// at most [`vox::MAX_INSTANCES`] instances of models that exist, and
+/// voxelizes into a 16³ raster with only voxels inside it (each at most
+/// once per world voxel); an OBJ mesh has finite vertices, triangles
+/// indexing them and a normal per vertex where it has normals; every
+/// control point of a patch is finite.
+///
+/// # Errors
+/// The first broken invariant.
+///
+/// [`vox::MAX_WORLD_VOXELS`]: crate::assets::vox::MAX_WORLD_VOXELS
+/// [`vox::MAX_INSTANCES`]: crate::assets::vox::MAX_INSTANCES
+pub fn asset_input(data: &[u8]) -> Result<(), String> {
+    use crate::assets::vox;
+    let Some((&which, data)) = data.split_first() else {
+        return Ok(());
+    };
+    match which % 3 {
+        0 => {
+            let Some(scene) = read_or_refused("fuzz.vox", vox::parse_bytes("fuzz.vox", data))?
+            else {
+                return Ok(());
+            };
+            let placed = scene.world_voxel_count();
+            if placed > vox::MAX_WORLD_VOXELS || scene.instances().len() > vox::MAX_INSTANCES {
+                return Err(format!(
+                    "{} instances placing {placed} voxels accepted",
+                    scene.instances().len()
+                ));
+            }
+            if let Some(i) = scene
+                .instances()
+                .iter()
+                .find(|i| i.model >= scene.models().len())
+            {
+                return Err(format!("instance of a missing model: {i:?}"));
+            }
+            if placed > 1 << 20 {
+                return Ok(());
+            }
+            struct Inside(u64, Option<[u32; 3]>);
+            impl rrt_core::voxelize::VoxelSink for Inside {
+                fn offer(&mut self, v: [u32; 3], _: rrt_core::voxelize::Surfel) {
+                    self.0 += 1;
+                    if v.iter().any(|&c| c >= 16) {
+                        self.1.get_or_insert(v);
+                    }
+                }
+            }
+            let mut sink = Inside(0, None);
+            let placement = crate::voxelize::vox::VoxPlacement {
+                offset: [8; 3],
+                scale: 1,
+            };
+            let n = scene.voxelize(placement, [16; 3], &mut sink);
+            if let Some(v) = sink.1 {
+                return Err(format!("voxel {v:?} offered outside a 16³ raster"));
+            }
+            if n != sink.0 || n > placed {
+                return Err(format!(
+                    "{n} offers reported, {} made, for {placed} world voxels",
+                    sink.0
+                ));
+            }
+            Ok(())
+        }
+        1 => {
+            let Ok(text) = std::str::from_utf8(data) else {
+                return Ok(());
+            };
+            let Some(mesh) =
+                read_or_refused("fuzz.obj", crate::scene::obj::parse("fuzz.obj", text))?
+            else {
+                return Ok(());
+            };
+            if let Some(p) = mesh.positions.iter().find(|p| !p.is_finite()) {
+                return Err(format!("vertex {p} accepted"));
+            }
+            let n = mesh.positions.len();
+            if let Some(t) = mesh
+                .triangles
+                .iter()
+                .find(|t| t.iter().any(|&i| i as usize >= n))
+            {
+                return Err(format!("triangle {t:?} indexes past {n} vertices"));
+            }
+            if let Some(normals) = &mesh.normals
+                && (normals.len() != n || normals.iter().any(|v| !v.is_finite()))
+            {
+                return Err(format!("{} normals for {n} vertices", normals.len()));
+            }
+            Ok(())
+        }
+        _ => {
+            let Ok(text) = std::str::from_utf8(data) else {
+                return Ok(());
+            };
+            let Some(patches) =
+                read_or_refused("fuzz.bpt", crate::scene::bpt::parse("fuzz.bpt", text))?
+            else {
+                return Ok(());
+            };
+            if let Some(p) = patches.iter().flatten().flatten().find(|p| !p.is_finite()) {
+                return Err(format!("control point {p} accepted"));
+            }
+            Ok(())
+        }
+    }
 }
 
 /// The checks of the `scene_toml` fuzz target (shared with
