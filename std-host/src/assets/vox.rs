@@ -679,14 +679,16 @@ impl VoxScene {
     /// frame, instance by instance, each model's voxels in file order
     /// (each model's voxels and normals are made once).
     pub fn for_each_world_voxel(&self, mut f: impl FnMut(WorldVoxel)) {
-        let local: Vec<Option<Vec<ModelVoxel>>> = (0..self.models.len())
-            .map(|m| {
-                self.instances
-                    .iter()
-                    .any(|i| i.model == m)
-                    .then(|| self.model_voxels(m))
-                    .flatten()
-            })
+        let mut used = vec![false; self.models.len()];
+        for i in &self.instances {
+            if let Some(u) = used.get_mut(i.model) {
+                *u = true;
+            }
+        }
+        let local: Vec<Option<Vec<ModelVoxel>>> = used
+            .iter()
+            .enumerate()
+            .map(|(m, &u)| u.then(|| self.model_voxels(m)).flatten())
             .collect();
         for inst in &self.instances {
             let (Some(m), Some(Some(vs))) = (self.models.get(inst.model), local.get(inst.model))
