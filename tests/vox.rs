@@ -202,6 +202,15 @@ fn voxelized_into_the_raster() {
     };
     let extent = Extent::cube(64).unwrap();
     let colors = scene.colors(placement);
+    // The colours, made once and kept, are every world voxel's; the
+    // scene's value does not include what it keeps.
+    let cells = scene.world_colors();
+    assert_eq!(cells.len(), scene.world_voxels().len());
+    for v in scene.world_voxels() {
+        assert_eq!(cells.get(&v.cell), Some(&v.color));
+    }
+    assert_eq!(scene.clone(), scene);
+    assert_eq!(vox::parse_bytes("two.vox", &bytes(true)).unwrap(), scene);
     let offers = std::cell::RefCell::new(Vec::new());
     let built = OneObject::textured(extent, [9, 9, 9], &colors, |sink| {
         offers

@@ -63,7 +63,9 @@
 //! [`MAX_WORLD_VOXELS`] voxels in all: a file of a few bytes per node can
 //! stand for far more, and each is refused before its voxels are made.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use rrt_core::voxelize::NORMAL_ONE;
@@ -196,7 +198,36 @@ pub struct VoxScene {
     models: Vec<VoxModel>,
     instances: Vec<VoxInstance>,
     palette: Vec<[u8; 4]>,
+    made: Made,
 }
+
+/// What a scene's voxels need made once, when first needed, and kept for
+/// every later use (the voxelizer's passes and pieces, on any thread):
+/// each model's voxels with their normals, and the colour of every world
+/// cell. Not part of the scene's value: clones start without it and
+/// equality ignores it.
+#[derive(Debug, Default)]
+struct Made {
+    /// [`VoxScene::model_voxels`] of each model an instance uses.
+    local: OnceLock<Vec<Option<Vec<ModelVoxel>>>>,
+    /// The palette colour of each world cell (the last instance's where
+    /// several place a voxel in one cell).
+    colors: OnceLock<Arc<HashMap<[i64; 3], [u8; 3]>>>,
+}
+
+impl Clone for Made {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl PartialEq for Made {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl Eq for Made {}
 
 /// Reads the `.vox` file at `path`.
 ///
@@ -400,6 +431,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<VoxScene, VoxError> {
         models,
         instances,
         palette,
+        made: Made::default(),
     };
     let placed = scene.world_voxel_count();
     if placed > MAX_WORLD_VOXELS {
@@ -677,19 +709,20 @@ impl VoxScene {
 
     /// Calls `f` with every voxel of every instance in MagicaVoxel's world
     /// frame, instance by instance, each model's voxels in file order
-    /// (each model's voxels and normals are made once).
+    /// (each model's voxels and normals are made once per scene).
     pub fn for_each_world_voxel(&self, mut f: impl FnMut(WorldVoxel)) {
-        let mut used = vec![false; self.models.len()];
-        for i in &self.instances {
-            if let Some(u) = used.get_mut(i.model) {
-                *u = true;
+        let local = self.made.local.get_or_init(|| {
+            let mut used = vec![false; self.models.len()];
+            for i in &self.instances {
+                if let Some(u) = used.get_mut(i.model) {
+                    *u = true;
+                }
             }
-        }
-        let local: Vec<Option<Vec<ModelVoxel>>> = used
-            .iter()
-            .enumerate()
-            .map(|(m, &u)| u.then(|| self.model_voxels(m)).flatten())
-            .collect();
+            used.iter()
+                .enumerate()
+                .map(|(m, &u)| u.then(|| self.model_voxels(m)).flatten())
+                .collect()
+        });
         for inst in &self.instances {
             let (Some(m), Some(Some(vs))) = (self.models.get(inst.model), local.get(inst.model))
             else {
@@ -704,6 +737,20 @@ impl VoxScene {
                 });
             }
         }
+    }
+
+    /// The palette colour of every world cell that holds a voxel (of the
+    /// last instance in [`VoxScene::for_each_world_voxel`]'s order where
+    /// several do), made once per scene.
+    #[must_use]
+    pub fn world_colors(&self) -> Arc<HashMap<[i64; 3], [u8; 3]>> {
+        Arc::clone(self.made.colors.get_or_init(|| {
+            let mut cells = HashMap::new();
+            self.for_each_world_voxel(|v| {
+                cells.insert(v.cell, v.color);
+            });
+            Arc::new(cells)
+        }))
     }
 
     /// Every voxel of every instance in MagicaVoxel's world frame, in the

@@ -2,6 +2,7 @@
 //! `scale³` raster voxels at a placement, with the palette colours.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use rrt_core::fixed::FRAC_BITS;
 use rrt_core::store::Texture;
@@ -80,13 +81,7 @@ impl VoxScene {
     pub fn colors(&self, placement: VoxPlacement) -> VoxColors {
         VoxColors {
             placement,
-            cells: {
-                let mut cells = HashMap::new();
-                self.for_each_world_voxel(|v| {
-                    cells.insert(v.cell, v.color);
-                });
-                cells
-            },
+            cells: self.world_colors(),
         }
     }
 }
@@ -96,7 +91,7 @@ impl VoxScene {
 #[derive(Clone, Debug)]
 pub struct VoxColors {
     placement: VoxPlacement,
-    cells: HashMap<[i64; 3], [u8; 3]>,
+    cells: Arc<HashMap<[i64; 3], [u8; 3]>>,
 }
 
 impl Texture for VoxColors {
