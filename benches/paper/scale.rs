@@ -4,7 +4,7 @@
 //! 4096³ raster's memory estimate.
 
 use crate::common::*;
-use crate::whole::{Run, run, strings};
+use crate::whole::{Run, render_args, run, strings};
 
 /// Rasters of a full run, and the one the others are compared to.
 const RASTERS: [u32; 4] = [512, 1024, 2048, 4096];
@@ -101,20 +101,8 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
     for _ in 0..cfg.reps {
         for row in &mut rows {
             let file = file_of(row.raster);
-            let args = strings(&[
-                "render",
-                &file,
-                "-o",
-                &out,
-                "--linear",
-                "--width",
-                &side,
-                "--height",
-                &side,
-                "--threads",
-                "1",
-            ]);
-            row.renders.push(run(&rrt, &args)?);
+            row.renders
+                .push(run(&rrt, &render_args(&file, &out, &side, 1))?);
         }
     }
 

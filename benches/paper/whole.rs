@@ -92,6 +92,26 @@ fn scene_path(ctx: &Ctx, stem: &str) -> PathBuf {
     }
 }
 
+/// `rrt render INPUT -o OUT --linear --width SIDE --height SIDE --threads
+/// T`: an image of a scene or a saved raster, every other setting at its
+/// default.
+pub(crate) fn render_args(input: &str, out: &str, side: &str, threads: usize) -> Vec<String> {
+    let t = threads.to_string();
+    strings(&[
+        "render",
+        input,
+        "-o",
+        out,
+        "--linear",
+        "--width",
+        side,
+        "--height",
+        side,
+        "--threads",
+        &t,
+    ])
+}
+
 pub(crate) fn strings(a: &[&str]) -> Vec<String> {
     a.iter().map(|s| (*s).to_string()).collect()
 }
@@ -138,8 +158,7 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
         let ours_png = |t: usize| tmp.join(format!("{stem}-{t}.png"));
         let rrt_args = |t: usize, extra: &[&str]| -> Vec<String> {
             let out = ours_png(t).display().to_string();
-            let mut a = strings(&["render", &p, "-o", &out, "--linear", "--width", &side]);
-            a.extend(strings(&["--height", &side, "--threads", &t.to_string()]));
+            let mut a = render_args(&p, &out, &side, t);
             a.extend(strings(extra));
             a
         };
@@ -271,19 +290,7 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
         run(&rrt, &strings(&["voxelize", &p, "-o", &rrt_file, "-q"]))?;
         let saved_args = |th: usize| {
             let out = tmp.join(format!("{stem}-saved.png")).display().to_string();
-            strings(&[
-                "render",
-                &rrt_file,
-                "-o",
-                &out,
-                "--linear",
-                "--width",
-                &side,
-                "--height",
-                &side,
-                "--threads",
-                &th.to_string(),
-            ])
+            render_args(&rrt_file, &out, &side, th)
         };
         let mut ts = [
             [Vec::new(), Vec::new(), Vec::new()],

@@ -40,6 +40,19 @@ fn read_or_refused<T, E: std::fmt::Display>(
     }
 }
 
+/// [`read_or_refused`] for a text reader `parse` of the file `name`:
+/// `None` too for bytes that are not UTF-8 (never handed to it).
+fn read_text_or_refused<T, E: std::fmt::Display>(
+    name: &str,
+    data: &[u8],
+    parse: fn(&str, &str) -> Result<T, E>,
+) -> Result<Option<T>, String> {
+    match std::str::from_utf8(data) {
+        Ok(text) => read_or_refused(name, parse(name, text)),
+        Err(_) => Ok(None),
+    }
+}
+
 /// Feeds arbitrary bytes (as the file `fuzz.nff`) to the NFF parser, then
 /// to the camera and a 32-voxel raster fit, and checks: an error names the
 /// file; a parsed scene keeps the guarantees of
@@ -185,11 +198,7 @@ pub fn asset_input(data: &[u8]) -> Result<(), String> {
             Ok(())
         }
         1 => {
-            let Ok(text) = std::str::from_utf8(data) else {
-                return Ok(());
-            };
-            let Some(mesh) =
-                read_or_refused("fuzz.obj", crate::scene::obj::parse("fuzz.obj", text))?
+            let Some(mesh) = read_text_or_refused("fuzz.obj", data, crate::scene::obj::parse)?
             else {
                 return Ok(());
             };
@@ -212,11 +221,7 @@ pub fn asset_input(data: &[u8]) -> Result<(), String> {
             Ok(())
         }
         _ => {
-            let Ok(text) = std::str::from_utf8(data) else {
-                return Ok(());
-            };
-            let Some(patches) =
-                read_or_refused("fuzz.bpt", crate::scene::bpt::parse("fuzz.bpt", text))?
+            let Some(patches) = read_text_or_refused("fuzz.bpt", data, crate::scene::bpt::parse)?
             else {
                 return Ok(());
             };
