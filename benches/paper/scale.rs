@@ -4,7 +4,7 @@
 //! 4096³ raster's memory estimate.
 
 use crate::common::*;
-use crate::whole::{Run, render_args, run, strings};
+use crate::whole::{Run, render_args, run, scene_path, strings};
 
 /// Rasters of a full run, and the one the others are compared to.
 const RASTERS: [u32; 4] = [512, 1024, 2048, 4096];
@@ -14,15 +14,6 @@ const QUICK_RASTERS: [u32; 3] = [64, 128, 256];
 const QUICK_REFERENCE: u32 = 128;
 /// Peak memory the largest raster must stay within (MiB).
 const MEMORY_TARGET_MIB: f64 = 2048.0;
-
-/// The raster's dimensions from rrt's summary line (`raster 485×485×31`).
-fn raster_dims(out: &str) -> String {
-    out.split("raster ")
-        .nth(1)
-        .and_then(|t| t.split([' ', ',']).next())
-        .unwrap_or("?")
-        .to_string()
-}
 
 /// One raster's figures.
 struct Row {
@@ -91,7 +82,7 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
             std::fs::metadata(&file).map_or(f64::NAN, |m| m.len() as f64) / f64::from(1u32 << 20);
         rows.push(Row {
             raster: n,
-            dims: raster_dims(&voxelize.out),
+            dims: voxelize.raster(),
             voxelize,
             file_mib,
             renders: Vec::new(),
@@ -109,7 +100,7 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
     // A 4096³ raster (one sphere, the raster a cube): its memory estimate,
     // against a stated limit so that the answer does not depend on the
     // machine's memory.
-    let one_sphere = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/one-sphere.toml");
+    let one_sphere = scene_path(ctx, "one-sphere");
     let cube = 4096;
     let refused = Command::new(&rrt)
         .args(["voxelize", &one_sphere.display().to_string(), "-o"])

@@ -42,6 +42,17 @@ impl Run {
             .unwrap_or(f64::NAN)
     }
 
+    /// The raster's dimensions from rrt's summary line (`raster
+    /// 485×485×31`), `?` without one.
+    pub(crate) fn raster(&self) -> String {
+        self.out
+            .split("raster ")
+            .nth(1)
+            .and_then(|t| t.split([' ', ',']).next())
+            .unwrap_or("?")
+            .to_string()
+    }
+
     /// A count from rrt's summary line (`123 name`).
     pub(crate) fn count(&self, name: &str) -> f64 {
         self.out
@@ -84,7 +95,7 @@ pub(crate) fn run(cmd: &Path, args: &[String]) -> Res<Run> {
 }
 
 /// The scene file of `stem`.
-fn scene_path(ctx: &Ctx, stem: &str) -> PathBuf {
+pub(crate) fn scene_path(ctx: &Ctx, stem: &str) -> PathBuf {
     if stem == "one-sphere" {
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/one-sphere.toml")
     } else {
@@ -216,14 +227,7 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
         if exact_psnr < worst.0 {
             worst = (exact_psnr, stem.to_string());
         }
-        let r1 = &last[0];
-        let raster = r1
-            .out
-            .split("raster ")
-            .nth(1)
-            .and_then(|s| s.split_whitespace().next())
-            .unwrap_or("?")
-            .to_string();
+        let raster = last[0].raster();
         let [o1, e1, o2, e2] = [&t[0][0], &t[0][1], &t[1][0], &t[1][1]].map(|v| median(v));
         rows.push(vec![
             stem.to_string(),
