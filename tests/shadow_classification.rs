@@ -231,7 +231,8 @@ fn on_demand_classification_is_the_pass_classification() {
                 continue;
             }
             for (k, &light) in lights.iter().enumerate() {
-                let got = classify_voxel(&raster, &store, v, rec, light).unwrap();
+                let shape = |id: u32| vs.objects[id as usize].shape.entry(&vs.frame);
+                let got = classify_voxel(&raster, &store, shape, v, rec, light).unwrap();
                 assert_eq!(got, rec.light(k), "seed {seed}: voxel {v:?}, light {k}");
                 compared += 1;
             }

@@ -80,13 +80,28 @@
 //! depend on the stored normal (the renderer decides which side faces the
 //! light from the true normal), and the walk reads the distance field:
 //! the plane must be finished before the pass.
+//!
+//! # Dark side
+//! A point `p` of a sphere of centre `C` and radius `R` faces a light at
+//! `L` exactly when `(p − C)·(L − C) > R²`: it lies beyond the plane of the
+//! terminator. When a voxel's objects are all spheres and its whole cube
+//! lies on the dark side of each (the cube's corner farthest along
+//! `L − C` stays below that plane, with a margin for the rounding of `C`,
+//! `R` and `L` to fixed point), no point of the cube faces the light from
+//! outside: a renderer shading a lit-side hit starts its shadow ray just
+//! off the surface towards the light, beyond the plane, so in another
+//! voxel. The pair is left undecided without a walk, which is always a
+//! correct answer (a render-time shadow ray decides, for a hit seen from
+//! inside a sphere); it saves the walks of the half of a sphere's voxels
+//! that face away from each light.
 
 use core::fmt;
 
 use crate::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use crate::error::RayError;
 use crate::fixed::{VOXEL, voxel_centre};
-use crate::object_table::{Lights, Materials, ObjectTable, SCALAR_BITS};
+use crate::geometry::Sphere;
+use crate::object_table::{Lights, Materials, ObjectTable, SCALAR_BITS, Shape};
 use crate::raster::{Extent, Raster, cell};
 use crate::store::{RecordStore, RecordStoreMut};
 use crate::voxel::{LightVisibility, VoxelRecord, decode_normal, dot_unit, normalize};
@@ -197,6 +212,10 @@ pub struct LightReport {
     /// Pairs on a closed shape facing away from the light (occluded, no
     /// ray fired).
     pub facing_away: u64,
+    /// Exact pairs whose voxel lies wholly on the dark side of its spheres
+    /// (module docs, *Dark side*): left undecided (counted in
+    /// `translucent` too) without a walk.
+    pub dark_side: u64,
     /// Records whose object id or material is not in the tables (treated
     /// as a closed, opaque, non-diffuse object).
     pub missing: u64,
@@ -294,6 +313,7 @@ impl LightReport {
         self.translucent = self.translucent.saturating_add(other.translucent);
         self.occluded = self.occluded.saturating_add(other.occluded);
         self.facing_away = self.facing_away.saturating_add(other.facing_away);
+        self.dark_side = self.dark_side.saturating_add(other.dark_side);
         self.missing = self.missing.saturating_add(other.missing);
     }
 }
@@ -347,6 +367,17 @@ fn shade_record<const N: usize>(
         let ndl = l.map_or(0, |l| dot_unit(normal, l));
         let front = ndl > 0;
         let vis = match (exact, params.exact_records) {
+            (true, _)
+                if dark_side(
+                    |id| objects.get(id).map(|o| o.shape),
+                    own,
+                    v,
+                    light.position,
+                ) =>
+            {
+                report.dark_side = report.dark_side.saturating_add(1);
+                LightVisibility::Translucent
+            }
             (true, _) => {
                 report.rays = report.rays.saturating_add(1);
                 classify(raster, view, v, own, c0, light.position)?
@@ -414,6 +445,64 @@ fn shade_record<const N: usize>(
         *out = u8::try_from(x.min(255)).unwrap_or(u8::MAX);
     }
     Ok(rec)
+}
+
+/// Whether every object of `own` (at least one) is a sphere and voxel
+/// `v`'s closed cube lies wholly on the dark side of each for a light at
+/// `light` (module docs, *Dark side*).
+///
+/// A point `p` of a sphere of centre `C` and radius `R` faces a light at `L`
+/// exactly when `(p − C)·(L − C) > R²` (it lies beyond the plane of the
+/// terminator). The linear function `(q − C)·(L − C)` is largest over the
+/// cube at one corner; the cube is on the dark side when that corner's value
+/// stays below `R²` by a margin that covers the rounding of `C`, `R` and `L`
+/// to fixed point by up to one unit per coordinate (the renderer's spheres
+/// and lights are the exact ones).
+fn dark_side(
+    shape: impl Fn(u32) -> Option<Shape>,
+    own: &[u32],
+    v: [u32; 3],
+    light: [i64; 3],
+) -> bool {
+    !own.is_empty()
+        && own.iter().all(|&id| match shape(id) {
+            Some(Shape::Sphere(s)) => cube_beyond_terminator(&s, v, light),
+            _ => false,
+        })
+}
+
+/// The test of [`dark_side`] for one sphere.
+fn cube_beyond_terminator(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
+    let mut f: i128 = 0;
+    // Σ|q − C| over the axes at the chosen corner, and Σ|L − C|.
+    let mut spread: i128 = 0;
+    let mut reach: i128 = 0;
+    for k in 0..3 {
+        let (Some(&c), Some(&l), Some(&vk)) = (s.centre.get(k), light.get(k), v.get(k)) else {
+            return false;
+        };
+        let (c, l) = (i128::from(c), i128::from(l));
+        let lo = i128::from(vk).saturating_mul(i128::from(VOXEL));
+        let d = l.saturating_sub(c);
+        let q = if d > 0 {
+            lo.saturating_add(i128::from(VOXEL))
+        } else {
+            lo
+        };
+        let w = q.saturating_sub(c);
+        f = f.saturating_add(w.saturating_mul(d));
+        spread = spread.saturating_add(w.saturating_abs());
+        reach = reach.saturating_add(d.saturating_abs());
+    }
+    let r = i128::from(s.radius);
+    // (q − C')·(L' − C') with C', L' within one unit per axis differs from
+    // f by at most 2·spread + reach + 6; R'² ≥ R² − 2R + 1.
+    let margin = spread
+        .saturating_mul(2)
+        .saturating_add(reach)
+        .saturating_add(r.saturating_mul(2))
+        .saturating_add(8);
+    f.saturating_add(margin) <= r.saturating_mul(r)
 }
 
 /// `a − b` per axis, saturating.
@@ -514,14 +603,18 @@ fn blocks<const N: usize>(
 /// The shadow classification of the voxel `v` holding record `rec` for a
 /// light at `light` (fixed units), as the light pass computes it for a
 /// record all of whose objects have exact geometry
-/// ([`ExactRecords::Classify`], module docs, *Shadow classification*):
-/// [`LightVisibility::Visible`] when only `rec`'s own objects can stand
-/// between any point of the voxel's closed cube and the light,
-/// [`LightVisibility::Translucent`] (undecided) otherwise. A renderer that
-/// skipped the classification in the pass ([`ExactRecords::Skip`]) computes
-/// it here for the voxels its hits need; the answer depends on nothing but
-/// the raster, the store, `v` and the light, so it may be memoized and
-/// computed in any order. The caller checks that the objects are exact.
+/// ([`ExactRecords::Classify`], module docs, *Shadow classification* and
+/// *Dark side*): [`LightVisibility::Visible`] when only `rec`'s own objects
+/// can stand between any point of the voxel's closed cube and the light,
+/// [`LightVisibility::Translucent`] (undecided) otherwise, and undecided
+/// without a walk when the cube lies wholly on the dark side of its
+/// objects, all spheres. `shape` gives an object's object-table shape by
+/// id (`None`: unknown, never a sphere). A renderer that skipped the
+/// classification in the pass ([`ExactRecords::Skip`]) computes it here
+/// for the voxels its hits need; the answer depends on nothing but the
+/// raster, the store, the shapes, `v` and the light, so it may be memoized
+/// and computed in any order. The caller checks that the objects are
+/// exact.
 ///
 /// Work: one walk of the segment's tube, bounded by the raster's size.
 ///
@@ -531,6 +624,7 @@ fn blocks<const N: usize>(
 pub fn classify_voxel(
     raster: &Raster<'_>,
     store: &RecordStore<'_>,
+    shape: impl Fn(u32) -> Option<Shape>,
     v: [u32; 3],
     rec: &VoxelRecord,
     light: [i64; 3],
@@ -538,14 +632,11 @@ pub fn classify_voxel(
     if store.extent() != raster.extent() {
         return Err(LightError::ExtentMismatch);
     }
-    classify(
-        raster,
-        store,
-        v,
-        store.objects(rec),
-        v.map(voxel_centre),
-        light,
-    )
+    let own = store.objects(rec);
+    if dark_side(shape, own, v, light) {
+        return Ok(LightVisibility::Translucent);
+    }
+    classify(raster, store, v, own, v.map(voxel_centre), light)
 }
 
 /// The shadow classification of voxel `v` (centre `c0`, objects `own`)

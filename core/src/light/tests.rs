@@ -599,7 +599,8 @@ fn classification_is_the_tube_rule() {
                         continue;
                     };
                     for &light in &lights {
-                        let got = classify_voxel(&raster, &store, v, rec, light).unwrap();
+                        // No shapes: the tube rule alone.
+                        let got = classify_voxel(&raster, &store, |_| None, v, rec, light).unwrap();
                         let want = tube_rule(&raster, &store, v, light);
                         assert_eq!(
                             got == LightVisibility::Visible,
@@ -620,6 +621,110 @@ fn classification_is_the_tube_rule() {
         lit > 1000 && undecided > 1000,
         "{lit} lit, {undecided} undecided"
     );
+}
+
+/// The dark-side rule is sound and fires: a cube it finds dark has every
+/// corner (so every point) strictly on the dark side of the terminator
+/// plane, for the sphere and light as given and for every rounding of
+/// them by up to one unit per coordinate; a cube whose corners all lie
+/// well inside the dark side is found dark.
+#[test]
+fn dark_side_cubes_lie_beyond_the_terminator() {
+    let mut rng = testkit::Rng(0xda4c_51de);
+    let (mut dark, mut checked) = (0u32, 0u32);
+    for _ in 0..4000 {
+        let r = rng.range(VOXEL / 4, 40 * VOXEL);
+        let s = Sphere {
+            centre: [0; 3].map(|_| rng.range(50 * VOXEL, 60 * VOXEL)),
+            radius: r,
+        };
+        let light: [i64; 3] = if rng.below(4) == 0 {
+            // Far away, as a light at infinity is.
+            [0; 3].map(|_| rng.range(-(1 << 58), 1 << 58))
+        } else {
+            [0; 3].map(|_| rng.range(-200 * VOXEL, 300 * VOXEL))
+        };
+        // A voxel near the sphere's surface.
+        let v = s
+            .centre
+            .map(|c| u32::try_from((c + rng.range(-r - VOXEL, r + VOXEL)) / VOXEL).unwrap());
+        let value = |c: [i64; 3], l: [i64; 3], corner: u32| -> i128 {
+            (0..3)
+                .map(|k| {
+                    let lo = i128::from(v[k]) * i128::from(VOXEL);
+                    let q = lo + i128::from(VOXEL) * i128::from((corner >> k) & 1);
+                    (q - i128::from(c[k])) * (i128::from(l[k]) - i128::from(c[k]))
+                })
+                .sum()
+        };
+        let r2 = |r: i64| i128::from(r) * i128::from(r);
+        let found = cube_beyond_terminator(&s, v, light);
+        checked += 1;
+        if found {
+            dark += 1;
+            for _ in 0..8 {
+                let jiggle = |p: [i64; 3], rng: &mut testkit::Rng| p.map(|x| x + rng.range(-1, 2));
+                let c = jiggle(s.centre, &mut rng);
+                let l = jiggle(light, &mut rng);
+                let rr = (r + rng.range(-1, 2)).max(1);
+                for corner in 0..8 {
+                    assert!(
+                        value(c, l, corner) < r2(rr),
+                        "{s:?} voxel {v:?} light {light:?}: corner {corner} faces the light"
+                    );
+                }
+            }
+        } else {
+            // Not found: some corner comes within a small margin of the
+            // plane (a thousandth of a voxel times the lengths involved).
+            let d1: i128 = (0..3)
+                .map(|k| (i128::from(light[k]) - i128::from(s.centre[k])).abs())
+                .sum();
+            let slack = (d1 + 8 * i128::from(r) + i128::from(VOXEL) * 200) * 64;
+            assert!(
+                (0..8).any(|corner| value(s.centre, light, corner) + slack >= r2(r)),
+                "{s:?} voxel {v:?} light {light:?}: a dark cube was missed"
+            );
+        }
+    }
+    // About half the voxels around a sphere face away from a light.
+    assert!(dark > checked / 5, "{dark} of {checked}");
+}
+
+/// Through [`classify_voxel`] with the object shapes: a lone sphere's
+/// voxels wholly on the dark side are undecided without a walk, every
+/// other voxel gets the tube rule's answer.
+#[test]
+fn classification_leaves_the_dark_side_undecided() {
+    let e = Extent::cube(48).unwrap();
+    let (c, r) = (vox([24, 24, 24]), 15 * VOXEL + 1234);
+    let vz = |s: &mut dyn VoxelSink| testkit::sphere(e, c, r, Separation::TwentySix, s);
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &vz)], LIM);
+    crate::proximity::distance_field(
+        &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
+    );
+    let raster = Raster::new(e, &scene.plane).unwrap();
+    let store = scene.store();
+    let sphere = Sphere {
+        centre: c,
+        radius: r,
+    };
+    let shape = |id: u32| (id == 0).then_some(Shape::Sphere(sphere));
+    let (mut dark, mut walked) = (0u32, 0u32);
+    for light in [vox([200, 90, 30]), vox([24, 24, -40]), vox([30, 20, 26])] {
+        for (v, rec) in store.iter() {
+            let got = classify_voxel(&raster, &store, shape, v, rec, light).unwrap();
+            if cube_beyond_terminator(&sphere, v, light) {
+                assert_eq!(got, LightVisibility::Translucent, "voxel {v:?}");
+                dark += 1;
+            } else {
+                let tube = tube_rule(&raster, &store, v, light);
+                assert_eq!(got == LightVisibility::Visible, tube, "voxel {v:?}");
+                walked += 1;
+            }
+        }
+    }
+    assert!(dark > 2000 && walked > 2000, "{dark} dark, {walked} walked");
 }
 
 /// On a finished plane (proximity flags and distances set) adaptive shadow

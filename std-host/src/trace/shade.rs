@@ -280,7 +280,7 @@ impl Tracer<'_> {
         let lit = match &self.classification {
             Classification::Unavailable => false,
             Classification::Records => o.rec.light(k) == LightVisibility::Visible,
-            Classification::OnDemand(memo) => {
+            Classification::OnDemand(memo, shapes) => {
                 let (Some(slot), Some(Some(light)), Ok(shift)) =
                     (memo.get(o.at), self.lights_fx.get(k), u32::try_from(2 * k))
                 else {
@@ -291,8 +291,10 @@ impl Tracer<'_> {
                 }
                 let known = (slot.load(Ordering::Relaxed) >> shift) & 3;
                 let answer = if known == Classification::UNKNOWN {
-                    let lit = classify_voxel(&self.raster, &self.store, o.voxel, o.rec, *light)
-                        == Ok(LightVisibility::Visible);
+                    let shape = |id: u32| shapes.get(usize::try_from(id).ok()?).copied().flatten();
+                    let lit =
+                        classify_voxel(&self.raster, &self.store, shape, o.voxel, o.rec, *light)
+                            == Ok(LightVisibility::Visible);
                     let answer = if lit {
                         Classification::LIT
                     } else {
