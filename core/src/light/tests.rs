@@ -625,70 +625,93 @@ fn classification_is_the_tube_rule() {
 
 /// The dark-side rule is sound and fires: a cube it finds dark has every
 /// corner (so every point) strictly on the dark side of the terminator
-/// plane, for the sphere and light as given and for every rounding of
-/// them by up to one unit per coordinate; a cube whose corners all lie
-/// well inside the dark side is found dark.
+/// plane for every rounding of the sphere's centre and radius and of the
+/// light by up to one unit per coordinate (the worst one computed exactly:
+/// the corner's value is a sum of one term per axis); spheres whose
+/// terminator plane passes within a few margins of the cube test the
+/// margin; a cube whose corners all lie well inside the dark side is found
+/// dark.
 #[test]
 fn dark_side_cubes_lie_beyond_the_terminator() {
     let mut rng = testkit::Rng(0xda4c_51de);
-    let (mut dark, mut checked) = (0u32, 0u32);
-    for _ in 0..4000 {
-        let r = rng.range(VOXEL / 4, 40 * VOXEL);
-        let s = Sphere {
-            centre: [0; 3].map(|_| rng.range(50 * VOXEL, 60 * VOXEL)),
-            radius: r,
-        };
+    let (mut dark, mut checked, mut close) = (0u32, 0u32, 0u32);
+    for case in 0..6000 {
+        let centre: [i64; 3] = [0; 3].map(|_| rng.range(50 * VOXEL, 60 * VOXEL));
         let light: [i64; 3] = if rng.below(4) == 0 {
             // Far away, as a light at infinity is.
             [0; 3].map(|_| rng.range(-(1 << 58), 1 << 58))
         } else {
             [0; 3].map(|_| rng.range(-200 * VOXEL, 300 * VOXEL))
         };
+        let mut r = rng.range(VOXEL / 4, 40 * VOXEL);
         // A voxel near the sphere's surface.
-        let v = s
-            .centre
-            .map(|c| u32::try_from((c + rng.range(-r - VOXEL, r + VOXEL)) / VOXEL).unwrap());
-        let value = |c: [i64; 3], l: [i64; 3], corner: u32| -> i128 {
-            (0..3)
-                .map(|k| {
-                    let lo = i128::from(v[k]) * i128::from(VOXEL);
-                    let q = lo + i128::from(VOXEL) * i128::from((corner >> k) & 1);
-                    (q - i128::from(c[k])) * (i128::from(l[k]) - i128::from(c[k]))
-                })
-                .sum()
+        let v =
+            centre.map(|c| u32::try_from((c + rng.range(-r - VOXEL, r + VOXEL)) / VOXEL).unwrap());
+        // Corner `corner`'s term on axis `k` for centre offset `ec` and
+        // light offset `el`.
+        let term = |k: usize, corner: u32, ec: i128, el: i128| -> i128 {
+            let lo = i128::from(v[k]) * i128::from(VOXEL);
+            let q = lo + i128::from(VOXEL) * i128::from((corner >> k) & 1);
+            let c = i128::from(centre[k]) + ec;
+            (q - c) * (i128::from(light[k]) + el - c)
         };
-        let r2 = |r: i64| i128::from(r) * i128::from(r);
+        let value = |corner: u32| -> i128 { (0..3).map(|k| term(k, corner, 0, 0)).sum() };
+        let top = (0..8).map(value).max().unwrap();
+        if case % 2 == 1 && top > 0 {
+            // A sphere whose terminator plane passes near the cube's
+            // farthest corner: within a few margins of the rule.
+            let m = i128::from(r) * 64
+                + (0..3)
+                    .map(|k| (i128::from(light[k]) - i128::from(centre[k])).abs())
+                    .sum::<i128>();
+            let target = (top + i128::from(rng.range(-4, 5)) * m / 4).max(1);
+            r = i64::try_from(target.isqrt()).unwrap_or(i64::MAX).max(1);
+        }
+        let s = Sphere { centre, radius: r };
         let found = cube_beyond_terminator(&s, v, light);
         checked += 1;
         if found {
             dark += 1;
-            for _ in 0..8 {
-                let jiggle = |p: [i64; 3], rng: &mut testkit::Rng| p.map(|x| x + rng.range(-1, 2));
-                let c = jiggle(s.centre, &mut rng);
-                let l = jiggle(light, &mut rng);
-                let rr = (r + rng.range(-1, 2)).max(1);
-                for corner in 0..8 {
-                    assert!(
-                        value(c, l, corner) < r2(rr),
-                        "{s:?} voxel {v:?} light {light:?}: corner {corner} faces the light"
-                    );
-                }
+            // The worst rounding: per axis the largest term, and R − 1.
+            let worst = (0..8)
+                .map(|corner| {
+                    (0..3)
+                        .map(|k| {
+                            (-1..=1)
+                                .flat_map(|ec| (-1..=1).map(move |el| (ec, el)))
+                                .map(|(ec, el)| term(k, corner, ec, el))
+                                .max()
+                                .unwrap()
+                        })
+                        .sum::<i128>()
+                })
+                .max()
+                .unwrap();
+            let least = i128::from(r - 1) * i128::from(r - 1);
+            assert!(
+                worst < least,
+                "{s:?} voxel {v:?} light {light:?}: a rounding puts a corner on the lit side"
+            );
+            if least - top < 1 << 40 {
+                close += 1;
             }
         } else {
             // Not found: some corner comes within a small margin of the
             // plane (a thousandth of a voxel times the lengths involved).
             let d1: i128 = (0..3)
-                .map(|k| (i128::from(light[k]) - i128::from(s.centre[k])).abs())
+                .map(|k| (i128::from(light[k]) - i128::from(centre[k])).abs())
                 .sum();
             let slack = (d1 + 8 * i128::from(r) + i128::from(VOXEL) * 200) * 64;
             assert!(
-                (0..8).any(|corner| value(s.centre, light, corner) + slack >= r2(r)),
+                top + slack >= i128::from(r) * i128::from(r),
                 "{s:?} voxel {v:?} light {light:?}: a dark cube was missed"
             );
         }
     }
-    // About half the voxels around a sphere face away from a light.
+    // About half the voxels around a sphere face away from a light, and
+    // the spheres set near the rule's margin test it.
     assert!(dark > checked / 5, "{dark} of {checked}");
+    assert!(close > 100, "{close} dark cubes near the plane");
 }
 
 /// Through [`classify_voxel`] with the object shapes: a lone sphere's
