@@ -13,6 +13,7 @@ use rrt_core::voxel::LightVisibility;
 use rrt_host::render::camera::Camera;
 use rrt_host::render::{Image, RenderOptions, render};
 use rrt_host::scene::Scene;
+use rrt_host::shape::{Shape, Surface};
 use rrt_host::trace::{RayStats, TraceOptions, Tracer};
 use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
 use rrt_host::world::Ray;
@@ -231,7 +232,10 @@ fn on_demand_classification_is_the_pass_classification() {
                 continue;
             }
             for (k, &light) in lights.iter().enumerate() {
-                let shape = |id: u32| vs.objects[id as usize].shape.entry(&vs.frame);
+                let shape = |id: u32| match vs.objects[id as usize].shape {
+                    Shape::Sphere(s) => s.to_fixed(&vs.frame).ok(),
+                    _ => None,
+                };
                 let got = classify_voxel(&raster, &store, shape, v, rec, light).unwrap();
                 assert_eq!(got, rec.light(k), "seed {seed}: voxel {v:?}, light {k}");
                 compared += 1;

@@ -369,7 +369,10 @@ fn shade_record<const N: usize>(
         let vis = match (exact, params.exact_records) {
             (true, _)
                 if dark_side(
-                    |id| objects.get(id).map(|o| o.shape),
+                    |id| match objects.get(id)?.shape {
+                        Shape::Sphere(s) => Some(s),
+                        _ => None,
+                    },
                     own,
                     v,
                     light.position,
@@ -459,16 +462,15 @@ fn shade_record<const N: usize>(
 /// to fixed point by up to one unit per coordinate (the renderer's spheres
 /// and lights are the exact ones).
 fn dark_side(
-    shape: impl Fn(u32) -> Option<Shape>,
+    sphere: impl Fn(u32) -> Option<Sphere>,
     own: &[u32],
     v: [u32; 3],
     light: [i64; 3],
 ) -> bool {
     !own.is_empty()
-        && own.iter().all(|&id| match shape(id) {
-            Some(Shape::Sphere(s)) => cube_beyond_terminator(&s, v, light),
-            _ => false,
-        })
+        && own
+            .iter()
+            .all(|&id| sphere(id).is_some_and(|s| cube_beyond_terminator(&s, v, light)))
 }
 
 /// The test of [`dark_side`] for one sphere.
@@ -608,13 +610,13 @@ fn blocks<const N: usize>(
 /// can stand between any point of the voxel's closed cube and the light,
 /// [`LightVisibility::Translucent`] (undecided) otherwise, and undecided
 /// without a walk when the cube lies wholly on the dark side of its
-/// objects, all spheres. `shape` gives an object's object-table shape by
-/// id (`None`: unknown, never a sphere). A renderer that skipped the
-/// classification in the pass ([`ExactRecords::Skip`]) computes it here
-/// for the voxels its hits need; the answer depends on nothing but the
-/// raster, the store, the shapes, `v` and the light, so it may be memoized
-/// and computed in any order. The caller checks that the objects are
-/// exact.
+/// objects, all spheres. `sphere` gives the fixed-point sphere of an
+/// object by id, as the object table holds it, and `None` for every other
+/// object. A renderer that skipped the classification in the pass
+/// ([`ExactRecords::Skip`]) computes it here for the voxels its hits need;
+/// the answer depends on nothing but the raster, the store, the spheres,
+/// `v` and the light, so it may be memoized and computed in any order. The
+/// caller checks that the objects are exact.
 ///
 /// Work: one walk of the segment's tube, bounded by the raster's size.
 ///
@@ -624,7 +626,7 @@ fn blocks<const N: usize>(
 pub fn classify_voxel(
     raster: &Raster<'_>,
     store: &RecordStore<'_>,
-    shape: impl Fn(u32) -> Option<Shape>,
+    sphere: impl Fn(u32) -> Option<Sphere>,
     v: [u32; 3],
     rec: &VoxelRecord,
     light: [i64; 3],
@@ -633,7 +635,7 @@ pub fn classify_voxel(
         return Err(LightError::ExtentMismatch);
     }
     let own = store.objects(rec);
-    if dark_side(shape, own, v, light) {
+    if dark_side(sphere, own, v, light) {
         return Ok(LightVisibility::Translucent);
     }
     classify(raster, store, v, own, v.map(voxel_centre), light)

@@ -732,7 +732,7 @@ fn classification_leaves_the_dark_side_undecided() {
         centre: c,
         radius: r,
     };
-    let shape = |id: u32| (id == 0).then_some(Shape::Sphere(sphere));
+    let shape = |id: u32| (id == 0).then_some(sphere);
     let (mut dark, mut walked) = (0u32, 0u32);
     for light in [vox([200, 90, 30]), vox([24, 24, -40]), vox([30, 20, 26])] {
         for (v, rec) in store.iter() {

@@ -248,17 +248,6 @@ impl Shape {
         each_surface!(self, s => Some(s.bounds()), voxels => None)
     }
 
-    /// The core object-table shape of this one in `frame` (its fixed-point
-    /// geometry, as the fit makes it); `None` for [`Shape::Voxels`] or a
-    /// shape the frame cannot hold.
-    #[must_use]
-    pub fn entry(&self, frame: &RasterFrame) -> Option<table::Shape> {
-        fn entry<S: Surface>(s: &S, frame: &RasterFrame) -> Option<table::Shape> {
-            s.to_fixed(frame).ok().map(S::entry)
-        }
-        each_surface!(self, s => entry(s, frame), voxels => None)
-    }
-
     /// Whether the shape has exact geometry to verify hits against (all
     /// but [`Shape::Voxels`]).
     #[must_use]

@@ -491,13 +491,8 @@ enum Classification {
     /// [`RecordStore::records`]), [`Classification::UNKNOWN`],
     /// [`Classification::LIT`] or [`Classification::UNDECIDED`]. The
     /// answer is a function of the record and the light alone, so the
-    /// order in which threads fill it in changes nothing. With it, each
-    /// object's object-table shape (by id), which the classification reads
-    /// for its dark-side rule.
-    OnDemand(
-        Arc<[AtomicU16]>,
-        Arc<[Option<rrt_core::object_table::Shape>]>,
-    ),
+    /// order in which threads fill it in changes nothing.
+    OnDemand(Arc<[AtomicU16]>),
 }
 
 impl fmt::Debug for Classification {
@@ -505,7 +500,7 @@ impl fmt::Debug for Classification {
         match self {
             Self::Unavailable => f.write_str("Unavailable"),
             Self::Records => f.write_str("Records"),
-            Self::OnDemand(memo, _) => write!(f, "OnDemand({} records)", memo.len()),
+            Self::OnDemand(memo) => write!(f, "OnDemand({} records)", memo.len()),
         }
     }
 }
@@ -523,14 +518,7 @@ impl Classification {
         match scene.exact_records {
             ExactRecords::Classify => Self::Records,
             ExactRecords::Skip if opts.classify_on_demand && opts.mode.exact_shadows() => {
-                Self::OnDemand(
-                    (0..store.len()).map(|_| AtomicU16::new(0)).collect(),
-                    scene
-                        .objects
-                        .iter()
-                        .map(|o| o.shape.entry(&scene.frame))
-                        .collect(),
-                )
+                Self::OnDemand((0..store.len()).map(|_| AtomicU16::new(0)).collect())
             }
             _ => Self::Unavailable,
         }

@@ -18,6 +18,7 @@ use super::walk::surface_voxel;
 use super::{Classification, RayStats, SurfaceHit, Tracer, shading};
 use crate::frame::unit_to_fixed;
 use crate::scene::Material;
+use crate::shape::{Shape, Surface};
 use crate::world::Ray;
 
 fn rgb(c: [u8; 3]) -> DVec3 {
@@ -280,7 +281,7 @@ impl Tracer<'_> {
         let lit = match &self.classification {
             Classification::Unavailable => false,
             Classification::Records => o.rec.light(k) == LightVisibility::Visible,
-            Classification::OnDemand(memo, shapes) => {
+            Classification::OnDemand(memo) => {
                 let (Some(slot), Some(Some(light)), Ok(shift)) =
                     (memo.get(o.at), self.lights_fx.get(k), u32::try_from(2 * k))
                 else {
@@ -291,7 +292,12 @@ impl Tracer<'_> {
                 }
                 let known = (slot.load(Ordering::Relaxed) >> shift) & 3;
                 let answer = if known == Classification::UNKNOWN {
-                    let shape = |id: u32| shapes.get(usize::try_from(id).ok()?).copied().flatten();
+                    // A sphere's fixed-point geometry as the fit makes it,
+                    // made when asked: no copy of the object table is kept.
+                    let shape = |id: u32| match self.objects.get(usize::try_from(id).ok()?)?.shape {
+                        Shape::Sphere(s) => s.to_fixed(&self.frame).ok(),
+                        _ => None,
+                    };
                     let lit =
                         classify_voxel(&self.raster, &self.store, shape, o.voxel, o.rec, *light)
                             == Ok(LightVisibility::Visible);
