@@ -497,12 +497,15 @@ fn cube_beyond_terminator(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
         reach = reach.saturating_add(d.saturating_abs());
     }
     let r = i128::from(s.radius);
-    // (q − C')·(L' − C') with C', L' within one unit per axis differs from
-    // f by at most 2·spread + reach + 6; R'² ≥ R² − 2R + 1.
+    // With C', L' within one unit per axis, (q − C')·(L' − C') differs from
+    // f by at most 2·spread + reach + 6, and another corner can be the
+    // farthest only on an axis where |L − C| ≤ 2, by at most 2·VOXEL there;
+    // R'² ≥ R² − 2R + 1.
     let margin = spread
         .saturating_mul(2)
         .saturating_add(reach)
         .saturating_add(r.saturating_mul(2))
+        .saturating_add(i128::from(VOXEL).saturating_mul(6))
         .saturating_add(8);
     f.saturating_add(margin) <= r.saturating_mul(r)
 }
