@@ -10,7 +10,7 @@ use rrt_host::output::rasterfile;
 use rrt_host::scene::Scene;
 use rrt_host::shape::Shape;
 use rrt_host::trace::{Verdict, verify};
-use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
+use rrt_host::voxelize::{BuildOptions, VoxelScene, build, derive_plane};
 use rrt_host::world::Ray;
 
 fn scenes_dir() -> PathBuf {
@@ -197,6 +197,47 @@ fn every_object_kind_reaches_the_raster() {
     }
     assert!(ball.iter().any(|b| b.2 == [0, 255, 0]));
     assert!(ball.iter().any(|b| b.2 == [255, 0, 0]));
+}
+
+/// The builder's plane is the plane made again from its records
+/// (`derive_plane`: the records' voxels opaque with their rank hints, the
+/// distance field, the proximity flags), byte for byte, for every kind of
+/// object and the scenes of `scenes/`, in the exact and the paper's mode:
+/// so a saved raster stores no plane bricks, and a loaded one renders as
+/// the built one.
+#[test]
+fn built_planes_are_their_records_planes() {
+    let d = features_dir("planes");
+    let mut scenes = vec![Scene::load(d.join("features.toml")).unwrap()];
+    let mut names: Vec<PathBuf> = std::fs::read_dir(scenes_dir())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    names.sort();
+    for name in names {
+        scenes.push(Scene::load(&name).unwrap_or_else(|e| panic!("{}: {e}", name.display())));
+    }
+    let mut compared = 0;
+    for scene in &scenes {
+        for opts in [BuildOptions::new(48), BuildOptions::paper(48)] {
+            let vs = build(scene, &opts, &ProgressBar::hidden())
+                .unwrap_or_else(|e| panic!("{}: {e}", scene.file))
+                .0;
+            let [_, _, nz] = vs.extent().dims();
+            let (derived, z0) =
+                derive_plane(vs.extent(), &vs.directory, &vs.records, &vs.lists, [0, nz]).unwrap();
+            assert_eq!(z0, 0);
+            assert!(
+                derived[..] == vs.plane[..],
+                "{} (exact: {}): the built plane is not its records' plane",
+                scene.file,
+                vs.exact
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared >= 12, "{compared} scenes compared");
 }
 
 #[test]
