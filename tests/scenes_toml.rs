@@ -10,7 +10,7 @@ use rrt_host::output::rasterfile;
 use rrt_host::scene::Scene;
 use rrt_host::shape::Shape;
 use rrt_host::trace::{Verdict, verify};
-use rrt_host::voxelize::{BuildOptions, VoxelScene, build, derive_plane};
+use rrt_host::voxelize::{BuildOptions, VoxelScene, build, derive_plane, plane_matches_records};
 use rrt_host::world::Ray;
 
 fn scenes_dir() -> PathBuf {
@@ -234,6 +234,14 @@ fn built_planes_are_their_records_planes() {
                 scene.file,
                 vs.exact
             );
+            // What saving a built raster checks instead.
+            assert!(plane_matches_records(
+                vs.extent(),
+                &vs.plane,
+                &vs.directory,
+                &vs.records,
+                &vs.lists
+            ));
             compared += 1;
         }
     }

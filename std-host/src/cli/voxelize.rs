@@ -128,7 +128,8 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
             compress: !args.uncompressed,
         }
     };
-    let saved = rasterfile::save_to(&scene, file, &bar, format);
+    // The scene is the builder's, unchanged.
+    let saved = rasterfile::save_built_to(&scene, file, &bar, format);
     bar.finish_and_clear();
     let bytes = saved?;
     if !args.quiet {

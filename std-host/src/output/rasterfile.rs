@@ -111,7 +111,7 @@ use crate::render::MAX_SIDE;
 use crate::scene::{Material, SourceLoc, View, ViewDefect};
 use crate::shape::{SLOTS, Shape, Slots};
 use crate::voxelize::plane::Plane;
-use crate::voxelize::{MAX_MATERIALS, VoxelScene, derive_plane, line_level};
+use crate::voxelize::{MAX_MATERIALS, VoxelScene, derive_plane, line_level, plane_matches_records};
 use crate::voxelize::{WorldLight, WorldObject};
 
 /// The file's first bytes.
@@ -492,9 +492,47 @@ pub fn save_to(
         what: "cannot write",
         source,
     };
-    let len = write_raster(scene, out.file(), progress, format).map_err(io)?;
+    let len = write_raster(scene, out.file(), progress, format, Trust::Any).map_err(io)?;
     out.commit().map_err(io)?;
     Ok(len)
+}
+
+/// [`save_to`] for a scene exactly as [`build`](crate::voxelize::build)
+/// returned it, its plane unchanged since: a version 3 file then checks
+/// the plane against its records by its opaque cells alone
+/// ([`plane_matches_records`]), one pass over the plane, instead of making
+/// the plane again slab by slab (several whole derivations for a large
+/// raster); were they to differ, the bricks are found as [`save_to`] finds
+/// them. The file is the one [`save_to`] writes.
+///
+/// # Errors
+/// As [`save_to`].
+pub fn save_built_to(
+    scene: &VoxelScene,
+    mut out: AtomicFile,
+    progress: &ProgressBar,
+    format: Format,
+) -> Result<u64, RasterFileError> {
+    let path = out.target().to_path_buf();
+    refuse_direct(scene, &path)?;
+    let io = |source| RasterFileError::Io {
+        path: path.clone(),
+        what: "cannot write",
+        source,
+    };
+    let len = write_raster(scene, out.file(), progress, format, Trust::Built).map_err(io)?;
+    out.commit().map_err(io)?;
+    Ok(len)
+}
+
+/// What a writer may assume of a scene's plane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Trust {
+    /// Anything: it is compared with the plane made from the records.
+    Any,
+    /// As the builder made it: its transparent cells are the distance
+    /// field of its opaque ones ([`save_built_to`]).
+    Built,
 }
 
 /// The bytes [`save`] writes for `scene` (named `path` in errors).
@@ -516,13 +554,13 @@ pub fn save_bytes_as(
 ) -> Result<Vec<u8>, RasterFileError> {
     refuse_direct(scene, path)?;
     let mut out = std::io::Cursor::new(Vec::new());
-    write_raster(scene, &mut out, &ProgressBar::hidden(), format).map_err(|source| {
-        RasterFileError::Io {
+    write_raster(scene, &mut out, &ProgressBar::hidden(), format, Trust::Any).map_err(
+        |source| RasterFileError::Io {
             path: path.to_path_buf(),
             what: "cannot write",
             source,
-        }
-    })?;
+        },
+    )?;
     Ok(out.into_inner())
 }
 
@@ -760,9 +798,25 @@ fn encode_entries(
 }
 
 /// The sections of a version 3 file: (codec, bytes) in kind order.
-fn sparse_sections(scene: &VoxelScene, compress: bool) -> std::io::Result<Vec<(u32, Vec<u8>)>> {
+fn sparse_sections(
+    scene: &VoxelScene,
+    compress: bool,
+    plane: Trust,
+) -> std::io::Result<Vec<(u32, Vec<u8>)>> {
     let codec = if compress { CODEC_BLOCKS } else { CODEC_RAW };
-    let bricks = differing_bricks(scene)?;
+    let built = plane == Trust::Built
+        && plane_matches_records(
+            scene.extent(),
+            &scene.plane,
+            &scene.directory,
+            &scene.records,
+            &scene.lists,
+        );
+    let bricks = if built {
+        Vec::new()
+    } else {
+        differing_bricks(scene)?
+    };
     Ok(vec![
         (CODEC_RAW, meta_bytes(scene, 3)),
         (
@@ -803,9 +857,10 @@ fn write_raster<F: Write + Seek>(
     file: &mut F,
     progress: &ProgressBar,
     format: Format,
+    plane: Trust,
 ) -> std::io::Result<u64> {
     let (version, sparse) = match format {
-        Format::Sparse { compress } => (3, Some(sparse_sections(scene, compress)?)),
+        Format::Sparse { compress } => (3, Some(sparse_sections(scene, compress, plane)?)),
         Format::Dense => (if scene.exact { 2 } else { 1 }, None),
     };
     let mut w = BufWriter::with_capacity(1 << 20, &mut *file);
@@ -1943,6 +1998,7 @@ mod tests {
     use super::*;
     use crate::scene::Scene;
     use crate::voxelize::{BuildOptions, build};
+    use rrt_core::raster::cell;
 
     const SCENE: &str = "v\nfrom 0 -5 2\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0.1\nresolution 8 8\n\
         b 0.1 0.2 0.3\nl 3 -4 6\nf 0.9 0.4 0.2 0.8 0.2 20 0 1\ns 0 0 0.7 0.7\ns 0.9 0.2 0.3 0.3\n\
@@ -2037,6 +2093,52 @@ mod tests {
             let back = load_bytes(Path::new("t.rrt"), &bytes).unwrap();
             assert_eq!(&back.plane[..], &s.plane[..]);
             assert_eq!(back.lines, line_level(e, &s.plane));
+        }
+    }
+
+    /// A built scene saved as built writes the bytes of the full check;
+    /// a plane whose opaque cells are not its records' (a rank hint
+    /// changed, an opaque cell cleared, a transparent one made opaque) is
+    /// not taken for built, and its bricks are stored.
+    #[test]
+    fn saving_as_built_checks_the_opaque_cells() {
+        let bytes = |s: &VoxelScene, trust: Trust| {
+            let mut out = std::io::Cursor::new(Vec::new());
+            write_raster(
+                s,
+                &mut out,
+                &ProgressBar::hidden(),
+                Format::default(),
+                trust,
+            )
+            .unwrap();
+            out.into_inner()
+        };
+        let s = built(BuildOptions::new(37));
+        let matches = |s: &VoxelScene| {
+            plane_matches_records(s.extent(), &s.plane, &s.directory, &s.records, &s.lists)
+        };
+        assert!(matches(&s));
+        assert_eq!(bytes(&s, Trust::Built), bytes(&s, Trust::Any));
+        let opaque: Vec<usize> = (0..s.plane.len())
+            .filter(|&i| s.plane[i] & cell::OPAQUE != 0)
+            .collect();
+        let clear = (0..s.plane.len())
+            .find(|&i| s.plane[i] & (cell::OPAQUE | cell::PROXIMITY) == 0)
+            .unwrap();
+        let edits: [(usize, u8); 3] = [
+            (opaque[opaque.len() / 2], 0x3f << cell::DISTANCE_SHIFT),
+            (opaque[0], cell::OPAQUE),
+            (clear, cell::OPAQUE),
+        ];
+        for (i, bits) in edits {
+            let mut t = built(BuildOptions::new(37));
+            t.plane[i] ^= bits;
+            assert!(!matches(&t), "cell {i} ^ {bits:#x}");
+            let b = bytes(&t, Trust::Built);
+            assert_eq!(b, bytes(&t, Trust::Any));
+            let back = load_bytes(Path::new("t.rrt"), &b).unwrap();
+            assert_eq!(&back.plane[..], &t.plane[..]);
         }
     }
 

@@ -201,43 +201,93 @@ pub fn derive_plane(
     let z1 = slices[1].saturating_add(DERIVE_MARGIN).min(nz).max(z0 + 1);
     let sub = Extent::new(nx, ny, z1 - z0).map_err(std::io::Error::other)?;
     let mut plane = Plane::zeroed(sub.len())?;
-    // The records of the brick layers of slices z0..z1, in storage order,
-    // each with its index in the sub-plane and its rank hint.
-    let [bx, by, _] = brick_dims(extent).map(|b| b as usize);
-    let dir_at = |b: usize| directory.get(b).map_or(records.len(), |&d| d as usize);
-    let first_brick = (z0 / BRICK) as usize * bx * by;
-    let end_brick = (z1.div_ceil(BRICK) as usize * bx * by).min(directory.len().saturating_sub(1));
-    // Every brick's records (positions checked by the store against the
-    // extent), each at its index in the sub-plane, with its rank hint.
-    let cells = || {
-        (first_brick..end_brick)
-            .filter(move |&b| dir_at(b) < dir_at(b + 1))
-            .flat_map(move |b| {
-                let (lo, hi) = (dir_at(b), dir_at(b + 1));
-                let origin = [b % bx, (b / bx) % by, b / (bx * by)].map(|c| c as u32 * BRICK);
-                let len = hi.saturating_sub(lo);
-                records
-                    .get(lo..hi)
-                    .unwrap_or(&[])
-                    .iter()
-                    .enumerate()
-                    .filter_map(move |(j, r)| {
-                        let p = u32::from(r.position());
-                        let v = [p & 7, (p >> 3) & 7, p >> 6];
-                        let v = [0, 1, 2].map(|a| origin[a] + v[a]);
-                        let i = sub.index([v[0], v[1], v[2].checked_sub(z0)?])?;
-                        Some((i, rank_hint(j, len)))
-                    })
-            })
-    };
+    let cells = || record_cells(extent, directory, records, [z0, z1]);
+    // Indices in the sub-plane: the slices from z0 on.
+    let offset = sub.len() / (z1 - z0) as usize * z0 as usize;
     for (i, _) in cells() {
-        plane[i] = cell::OPAQUE;
+        plane[i - offset] = cell::OPAQUE;
     }
     distance_field(sub, &mut plane);
     for (i, hint) in cells() {
+        let i = i - offset;
         plane[i] = (plane[i] & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
     }
     Ok((plane, z0))
+}
+
+/// The voxels of the records in the brick layers of slices
+/// `slices[0]..slices[1]` (`slices[0]` a multiple of the brick edge), in
+/// storage order, each as its index in the whole raster's plane with its
+/// record's rank hint; records whose position lies outside the extent or
+/// the slices are left out (a valid store has none of the former).
+fn record_cells<'a>(
+    extent: Extent,
+    directory: &'a [u32],
+    records: &'a [VoxelRecord],
+    slices: [u32; 2],
+) -> impl Iterator<Item = (usize, u8)> + 'a {
+    let [bx, by, _] = brick_dims(extent).map(|b| b as usize);
+    let dir_at = move |b: usize| directory.get(b).map_or(records.len(), |&d| d as usize);
+    let first_brick = (slices[0] / BRICK) as usize * bx * by;
+    let end_brick =
+        (slices[1].div_ceil(BRICK) as usize * bx * by).min(directory.len().saturating_sub(1));
+    (first_brick..end_brick)
+        .filter(move |&b| dir_at(b) < dir_at(b + 1))
+        .flat_map(move |b| {
+            let (lo, hi) = (dir_at(b), dir_at(b + 1));
+            let origin = [b % bx, (b / bx) % by, b / (bx * by)].map(|c| c as u32 * BRICK);
+            let len = hi.saturating_sub(lo);
+            records
+                .get(lo..hi)
+                .unwrap_or(&[])
+                .iter()
+                .enumerate()
+                .filter_map(move |(j, r)| {
+                    let p = u32::from(r.position());
+                    let v = [p & 7, (p >> 3) & 7, p >> 6];
+                    let v = [0, 1, 2].map(|a| origin[a] + v[a]);
+                    if v[2] < slices[0] || v[2] >= slices[1] {
+                        return None;
+                    }
+                    Some((extent.index(v)?, rank_hint(j, len)))
+                })
+        })
+}
+
+/// Whether `plane` is the plane [`derive_plane`] makes from the records
+/// (`directory`, `records`, `lists` a valid store over `extent`), given
+/// that its transparent cells are the distance field
+/// ([`finish_plane`]) of its opaque ones, as the builder leaves a plane:
+/// then it is exactly when the opaque cells are the records' voxels, each
+/// with its rank hint. One pass over the records and one over the plane,
+/// on the current rayon pool, instead of making the plane again.
+#[must_use]
+pub fn plane_matches_records(
+    extent: Extent,
+    plane: &[u8],
+    directory: &[u32],
+    records: &[VoxelRecord],
+    lists: &[u32],
+) -> bool {
+    if plane.len() != extent.len()
+        || RecordStore::with_lists(extent, directory, records, lists).is_err()
+    {
+        return false;
+    }
+    let finished = cell::OPAQUE | cell::PROXIMITY;
+    let [_, _, nz] = extent.dims();
+    let mut count = 0usize;
+    for (i, hint) in record_cells(extent, directory, records, [0, nz]) {
+        if plane.get(i) != Some(&(finished | (hint << cell::DISTANCE_SHIFT))) {
+            return false;
+        }
+        count += 1;
+    }
+    let opaque: usize = plane
+        .par_chunks(1 << 20)
+        .map(|c| c.iter().filter(|&&b| b & cell::OPAQUE != 0).count())
+        .sum();
+    count == records.len() && opaque == count
 }
 
 /// Boxes of fewer cells than this are relaxed on one thread.
