@@ -212,8 +212,8 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
          rasters interleaved round by round (medians of {reps}). **Voxelize s** is that whole \
          process, with its phases from its summary line (light visibility: the shadow \
          classification of every surface voxel for every light, which a saved raster keeps \
-         for renders from any view; save: the file written, which makes the plane again from \
-         the records to check it); **file**, the saved raster (format version 3: the records, the plane made \
+         for renders from any view; save: the file written, after checking that the plane's \
+         opaque cells are the records' voxels); **file**, the saved raster (format version 3: the records, the plane made \
          again on load); **load** and **render**, the phases of rrt's summary line (load: \
          mapping, checksums, decoding, making the plane); **render / {reference}**, the render \
          phase against the one at raster {reference}; **steps per ray** over all rays traced and \
@@ -259,8 +259,7 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
             "What bounds these figures: the plane, one byte per voxel of the raster's box ({} \
              GiB at raster {}), made in full when a raster is built and again when it is \
              loaded. It is most of the peak memory, and its derivation (the distance field, \
-             the line level) most of the load time. Saving makes the plane again, slab by slab \
-             with 64 slices of margin on either side, to check it against the records. The \
+             the line level) most of the load time. The \
              light visibility phase walks the tube of every surface voxel towards every light: \
              the surface voxels grow with the square of the raster's side and the walks with \
              the side. The render takes more steps per ray as the voxels shrink (jumps through \
