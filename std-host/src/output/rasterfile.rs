@@ -481,20 +481,11 @@ pub fn save(scene: &VoxelScene, path: &Path) -> Result<u64, RasterFileError> {
 /// [`RasterFileError::Io`] naming the target; the target is untouched.
 pub fn save_to(
     scene: &VoxelScene,
-    mut out: AtomicFile,
+    out: AtomicFile,
     progress: &ProgressBar,
     format: Format,
 ) -> Result<u64, RasterFileError> {
-    let path = out.target().to_path_buf();
-    refuse_direct(scene, &path)?;
-    let io = |source| RasterFileError::Io {
-        path: path.clone(),
-        what: "cannot write",
-        source,
-    };
-    let len = write_raster(scene, out.file(), progress, format, Trust::Any).map_err(io)?;
-    out.commit().map_err(io)?;
-    Ok(len)
+    save_trusting(scene, out, progress, format, Trust::Any)
 }
 
 /// [`save_to`] for a scene exactly as [`build`](crate::voxelize::build)
@@ -509,9 +500,21 @@ pub fn save_to(
 /// As [`save_to`].
 pub fn save_built_to(
     scene: &VoxelScene,
+    out: AtomicFile,
+    progress: &ProgressBar,
+    format: Format,
+) -> Result<u64, RasterFileError> {
+    save_trusting(scene, out, progress, format, Trust::Built)
+}
+
+/// [`save_to`] and [`save_built_to`], with what the writer may assume of
+/// the plane.
+fn save_trusting(
+    scene: &VoxelScene,
     mut out: AtomicFile,
     progress: &ProgressBar,
     format: Format,
+    trust: Trust,
 ) -> Result<u64, RasterFileError> {
     let path = out.target().to_path_buf();
     refuse_direct(scene, &path)?;
@@ -520,7 +523,7 @@ pub fn save_built_to(
         what: "cannot write",
         source,
     };
-    let len = write_raster(scene, out.file(), progress, format, Trust::Built).map_err(io)?;
+    let len = write_raster(scene, out.file(), progress, format, trust).map_err(io)?;
     out.commit().map_err(io)?;
     Ok(len)
 }
