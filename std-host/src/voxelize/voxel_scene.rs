@@ -203,7 +203,7 @@ pub fn derive_plane(
     let mut plane = Plane::zeroed(sub.len())?;
     let cells = || record_cells(extent, directory, records, [z0, z1]);
     // Indices in the sub-plane: the slices from z0 on.
-    let offset = sub.len() / (z1 - z0) as usize * z0 as usize;
+    let offset = nx as usize * ny as usize * z0 as usize;
     for (i, _) in cells() {
         plane[i - offset] = cell::OPAQUE;
     }
