@@ -8,7 +8,7 @@
 use rrt_core::check::{check_adaptive_matches_six, check_lattice_counts, check_skipping};
 use rrt_core::discrete_ray::Connectivity;
 use rrt_core::fixed::{VOXEL, voxel_centre};
-use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+use rrt_core::proximity::{coarse_extent, distance_field, flag_neighbourhood, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 use rrt_tests::oracle::{Case, check_exact, make_ray};
 use rrt_tests::{Rng, env_count, random_opaque, replay_seed};
@@ -351,7 +351,8 @@ fn skipping_changes_nothing_but_the_step_count() {
         distance_field(&mut rm);
         let r = rm.as_raster();
         let mut lines = vec![0u8; line_count(e.len())];
-        line_distances(&r, &mut lines).unwrap();
+        let mut bricks = vec![0u8; coarse_extent(e).unwrap().len()];
+        line_distances(&r, &mut bricks, &mut lines).unwrap();
         let rl = r.with_lines(&lines).unwrap();
         let Some(ray) = make_ray(&case) else { continue };
         for (raster, what) in [(r, "plane"), (rl, "line level")] {
@@ -369,13 +370,15 @@ fn skipping_changes_nothing_but_the_step_count() {
         skipping_steps += u64::from(b.steps());
         line_steps += u64::from(c.steps());
     }
-    // Guard against a generator whose rays never get to jump.
+    // Guard against a generator whose rays never get to jump (the plane
+    // alone jumps only near surfaces, where the field stores distances;
+    // the line level far from them too).
     println!(
         "adaptive first hits: {plain_steps} steps plain, {skipping_steps} skipping, \
          {line_steps} skipping through the line level"
     );
     assert!(
-        plain_steps > 2 * skipping_steps && plain_steps > 2 * line_steps,
+        plain_steps > skipping_steps + skipping_steps / 2 && plain_steps > 4 * line_steps,
         "skipping saved too little: {plain_steps} vs {skipping_steps} / {line_steps} steps"
     );
 }

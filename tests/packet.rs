@@ -10,7 +10,7 @@ use rrt_core::check_packet::{Walk, check_packet, check_packet_script};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::packet::{LANES, RayPacket8};
-use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+use rrt_core::proximity::{coarse_extent, distance_field, flag_neighbourhood, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 use rrt_tests::{Rng, env_count, random_opaque, replay_seed};
 
@@ -120,7 +120,8 @@ fn random_plane(rng: &mut Rng, e: Extent) -> (Vec<u8>, Vec<u8>) {
             distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
             if rng.chance(1, 2) {
                 lines = vec![0; line_count(plane.len())];
-                line_distances(&Raster::new(e, &plane).unwrap(), &mut lines).unwrap();
+                let mut bricks = vec![0; coarse_extent(e).unwrap().len()];
+                line_distances(&Raster::new(e, &plane).unwrap(), &mut bricks, &mut lines).unwrap();
             }
             if rng.chance(1, 3) {
                 for c in &mut plane {

@@ -42,7 +42,7 @@ use criterion::{BenchmarkId, Criterion, Throughput};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::fixed::VOXEL;
 use rrt_core::packet::{LANES, RayPacket8};
-use rrt_core::proximity::{distance_field, line_distances};
+use rrt_core::proximity::{coarse_extent, distance_field, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 
 /// A sphere in scene units.
@@ -166,7 +166,13 @@ fn voxelize(spheres: &[Sphere], n: u32) -> Scene {
     // Writes every cell: every page of the plane is touched.
     distance_field(&mut RasterMut::new(extent, &mut plane).unwrap());
     let mut lines = vec![0; line_count(plane.len())];
-    line_distances(&Raster::new(extent, &plane).unwrap(), &mut lines).unwrap();
+    let mut bricks = vec![0; coarse_extent(extent).unwrap().len()];
+    line_distances(
+        &Raster::new(extent, &plane).unwrap(),
+        &mut bricks,
+        &mut lines,
+    )
+    .unwrap();
     Scene {
         n,
         extent,

@@ -25,10 +25,13 @@ pub const MAX_AXIS: u32 = 1 << 16;
 ///   bit 0      OPAQUE     the voxel is non-transparent (holds an object)
 ///   bit 1      PROXIMITY  the voxel is near a non-transparent voxel: adaptive
 ///                         rays take 6-connected steps here
-///   bits 2..8  DISTANCE   in a transparent voxel: a saturating proximity
-///                         distance (empty-space skipping), 0 meaning
-///                         "unknown / none"; in an OPAQUE voxel: the rank
-///                         hint of its record (crate::store::rank_hint)
+///   bits 2..8  DISTANCE   in a transparent voxel: a lower bound on the
+///                         proximity distance (empty-space skipping), 0
+///                         meaning "unknown / none" (the distance field
+///                         stores distances below proximity::NEAR_LIMIT
+///                         and leaves farther cells EMPTY); in an OPAQUE
+///                         voxel: the rank hint of its record
+///                         (crate::store::rank_hint)
 /// ```
 pub mod cell {
     /// The voxel is non-transparent: the default hit test.
@@ -228,10 +231,15 @@ impl<'a> Raster<'a> {
     /// distance 8 or more from every non-transparent voxel: the level is
     /// 1/64 of the plane and stays in cache where the plane does not.
     ///
-    /// **Contract:** every stand-in must be [`cell::EMPTY`] or a transparent,
-    /// unflagged cell whose distance is at most that of every cell of its
-    /// line. Otherwise skipping walks may report other hits than plain
-    /// walks (never a panic).
+    /// Through a line level, an [`cell::EMPTY`] plane cell reads as at
+    /// distance [`crate::proximity::NEAR_LIMIT`], which is what the
+    /// distance field ([`crate::proximity::distance_field`]) leaves empty.
+    ///
+    /// **Contract:** the plane holds its distance field, and every stand-in
+    /// must be [`cell::EMPTY`] or a transparent, unflagged cell whose
+    /// distance is at most that of every cell of its line. Otherwise
+    /// skipping walks may report other hits than plain walks (never a
+    /// panic).
     ///
     /// # Errors
     /// [`RasterError::LineLength`] unless `lines.len()` is

@@ -8,7 +8,7 @@ use rrt_core::check::{check_adaptive_matches_six, check_skipping};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::error::RayError;
 use rrt_core::fixed::VOXEL;
-use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+use rrt_core::proximity::{coarse_extent, distance_field, flag_neighbourhood, line_distances};
 use rrt_core::raster::{Extent, RasterMut, cell, line_count};
 
 use crate::oracle::{Case, check_exact};
@@ -142,7 +142,8 @@ pub fn run_ray_case(case: &RayCase) {
     distance_field(&mut raster);
     let r = raster.as_raster();
     let mut lines = vec![0u8; line_count(r.plane().len())];
-    line_distances(&r, &mut lines).expect("line level length");
+    let mut bricks = vec![0u8; coarse_extent(extent).expect("coarse extent").len()];
+    line_distances(&r, &mut bricks, &mut lines).expect("line level length");
     let with_lines = r.with_lines(&lines).expect("line level length");
     if let Ok(Some(ray)) = set_up {
         for raster in [r, with_lines] {

@@ -8,7 +8,7 @@ use rrt_core::check_packet::{Walk, check_packet, check_packet_script};
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
 use rrt_core::error::RayError;
 use rrt_core::packet::{LANES, RayPacket8};
-use rrt_core::proximity::{distance_field, flag_neighbourhood, line_distances};
+use rrt_core::proximity::{coarse_extent, distance_field, flag_neighbourhood, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut, line_count};
 
 use crate::fuzz::{Component, Coord, decode_ray, repeated_cells};
@@ -104,7 +104,8 @@ pub fn run_packet_case(case: &PacketCase) {
     let mut lines = vec![0; line_count(plane.len())];
     let raster = Raster::new(extent, &plane).expect("plane length");
     let raster = if case.field & 8 != 0 {
-        line_distances(&raster, &mut lines).expect("line count");
+        let mut bricks = vec![0; coarse_extent(extent).expect("coarse extent").len()];
+        line_distances(&raster, &mut bricks, &mut lines).expect("line count");
         raster.with_lines(&lines).expect("line count")
     } else {
         raster

@@ -28,7 +28,7 @@ use rrt_core::light::{ExactRecords, LightError, LightParams, LightReport, illumi
 use rrt_core::object_table::{
     Light, Lights, Material, Materials, Object, ObjectTable, SCALAR_ONE, Shape, VolumeRef,
 };
-use rrt_core::proximity::{distance_field, line_distances};
+use rrt_core::proximity::{coarse_cells, distance_field, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut};
 use rrt_core::store::{
     BuildError, Counter, FillReport, Limits, ObjectAttrs, RecordStore, StoreError, directory_len,
@@ -44,6 +44,8 @@ pub const DIMS: [u32; 3] = [48, 48, 40];
 pub const PLANE_LEN: usize = (DIMS[0] * DIMS[1] * DIMS[2]) as usize;
 /// Line-level cells.
 pub const LINES_LEN: usize = rrt_core::raster::line_count(PLANE_LEN);
+/// Coarse-level cells (scratch for [`line_distances`]).
+pub const BRICKS_LEN: usize = coarse_cells(DIMS);
 /// Directory entries: one per 8×8×8 brick plus one.
 pub const DIR_LEN: usize = ((DIMS[0] / 8) * (DIMS[1] / 8) * (DIMS[2] / 8) + 1) as usize;
 /// Record storage the integrator provides (the count pass says how much of
@@ -512,7 +514,8 @@ pub fn build_with(
         distance_field(&mut raster);
         write_rank_hints(&mut raster, &store.as_store());
     });
-    line_distances(&raster.as_raster(), st.lines)?;
+    let mut bricks = [0u8; BRICKS_LEN];
+    line_distances(&raster.as_raster(), &mut bricks, st.lines)?;
     // Light pass.
     let raster = raster.as_raster().with_lines(st.lines)?;
     let mut table = ObjectTable::new(st.objects, st.patches);

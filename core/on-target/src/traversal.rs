@@ -8,7 +8,7 @@ use rrt_core::error::{RasterError, RayError};
 use rrt_core::fixed::{VOXEL, voxel_centre};
 use rrt_core::geometry::{Cuboid, Sphere};
 use rrt_core::packet::{LANES, RayPacket8};
-use rrt_core::proximity::{distance_field, line_distances};
+use rrt_core::proximity::{coarse_cells, distance_field, line_distances};
 use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 use rrt_core::voxelize::{Separation, cuboid, sphere};
 
@@ -27,6 +27,8 @@ pub const DIMS: [u32; 3] = [41, 35, 27];
 pub const PLANE_LEN: usize = (DIMS[0] * DIMS[1] * DIMS[2]) as usize;
 /// Cells of its line level.
 pub const LINES_LEN: usize = line_count(PLANE_LEN);
+/// Cells of its coarse level (scratch for [`line_distances`]).
+pub const BRICKS_LEN: usize = coarse_cells(DIMS);
 
 /// The traversal raster's extent.
 ///
@@ -73,7 +75,8 @@ pub fn fill_raster(plane: &mut [u8], lines: &mut [u8]) -> Result<(), RasterError
         }
     }
     distance_field(&mut r);
-    line_distances(&r.as_raster(), lines)
+    let mut bricks = [0u8; BRICKS_LEN];
+    line_distances(&r.as_raster(), &mut bricks, lines)
 }
 
 struct Mark<'a, 'p>(&'a mut RasterMut<'p>);

@@ -369,10 +369,13 @@ impl DiscreteRay {
     /// `steps` differs: it counts the voxels actually visited, one per jump.
     /// A plane without distances (all distance bits 0) never skips.
     ///
-    /// With a line level ([`Raster::with_lines`]) a voxel whose line is at
-    /// distance 8 or more from every non-transparent voxel is decided from
-    /// the line's stand-in cell, without reading the plane; its jump is the
-    /// line's (smaller or equal) distance less one.
+    /// The distance field stores distances only near surfaces (below
+    /// [`crate::proximity::NEAR_LIMIT`]), so far from them the plane alone
+    /// gives no jumps. With a line level ([`Raster::with_lines`]) a voxel
+    /// whose line is at distance 8 or more from every non-transparent voxel
+    /// is decided from the line's stand-in cell, without reading the plane;
+    /// its jump is the line's (smaller or equal) distance less one; in a
+    /// nearer line an empty plane cell reads as at the near limit.
     ///
     /// # Errors
     /// As [`DiscreteRay::walk`].
@@ -461,8 +464,8 @@ impl DiscreteRay {
     /// ```
     /// use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
     /// use rrt_core::fixed::{voxel_centre, VOXEL};
-    /// use rrt_core::proximity::distance_field;
-    /// use rrt_core::raster::{cell, Extent, RasterMut};
+    /// use rrt_core::proximity::{coarse_extent, distance_field, line_distances};
+    /// use rrt_core::raster::{cell, line_count, Extent, RasterMut};
     ///
     /// let e = Extent::cube(64).unwrap();
     /// let mut plane = vec![cell::EMPTY; e.len()];
@@ -470,6 +473,11 @@ impl DiscreteRay {
     /// let mut r = RasterMut::new(e, &mut plane).unwrap();
     /// distance_field(&mut r);
     /// let r = r.as_raster();
+    /// // The line level: jumps far from surfaces.
+    /// let mut bricks = vec![0; coarse_extent(e).unwrap().len()];
+    /// let mut lines = vec![0; line_count(e.len())];
+    /// line_distances(&r, &mut bricks, &mut lines).unwrap();
+    /// let r = r.with_lines(&lines).unwrap();
     /// let origin = [0, voxel_centre(9), voxel_centre(9)];
     /// let ray = DiscreteRay::new(e, origin, [VOXEL as i32, 1, 0]).unwrap().unwrap();
     /// let (mut plain, mut skipping) = (ray, ray);

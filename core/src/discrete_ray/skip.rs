@@ -42,15 +42,30 @@ pub(crate) fn skip_count(cur: u8, todo: u32) -> u32 {
     }
 }
 
+/// An [`cell::EMPTY`](crate::raster::cell::EMPTY) plane cell as a walk
+/// with a line level reads it: at
+/// [`NEAR_LIMIT`](crate::proximity::NEAR_LIMIT), where the distance field
+/// leaves cells empty.
+const NEAR_CELL: u8 = crate::proximity::NEAR_LIMIT << crate::raster::cell::DISTANCE_SHIFT;
+
 /// The cell a skipping walk reads for voxel `index`: the stand-in of its
 /// line ([`crate::raster::Raster::with_lines`], empty `lines`: none) when
-/// that is at least [`LINE_JUMP`], else the plane's cell; `None` outside
-/// the plane.
+/// that is at least [`LINE_JUMP`], else the plane's cell, an empty one at
+/// [`NEAR_LIMIT`](crate::proximity::NEAR_LIMIT) when there is a line
+/// level (whose contract is a plane with its distance field); `None`
+/// outside the plane.
 #[inline(always)]
 pub(crate) fn skip_cell(plane: &[u8], lines: &[u8], index: usize) -> Option<u8> {
     match lines.get(index >> crate::raster::LINE_BITS) {
         Some(&l) if l >= LINE_JUMP => Some(l),
-        _ => plane.get(index).copied(),
+        Some(_) => plane.get(index).map(|&c| {
+            if c == crate::raster::cell::EMPTY {
+                NEAR_CELL
+            } else {
+                c
+            }
+        }),
+        None => plane.get(index).copied(),
     }
 }
 

@@ -432,8 +432,8 @@ impl RayPacket8 {
     /// use rrt_core::discrete_ray::{Connectivity, DiscreteRay};
     /// use rrt_core::fixed::{voxel_centre, VOXEL};
     /// use rrt_core::packet::RayPacket8;
-    /// use rrt_core::proximity::distance_field;
-    /// use rrt_core::raster::{cell, Extent, RasterMut};
+    /// use rrt_core::proximity::{coarse_extent, distance_field, line_distances};
+    /// use rrt_core::raster::{cell, line_count, Extent, RasterMut};
     ///
     /// let e = Extent::cube(64).unwrap();
     /// let mut plane = vec![cell::EMPTY; e.len()];
@@ -441,6 +441,11 @@ impl RayPacket8 {
     /// let mut r = RasterMut::new(e, &mut plane).unwrap();
     /// distance_field(&mut r);
     /// let r = r.as_raster();
+    /// // The line level: jumps far from surfaces.
+    /// let mut bricks = vec![0; coarse_extent(e).unwrap().len()];
+    /// let mut lines = vec![0; line_count(e.len())];
+    /// line_distances(&r, &mut bricks, &mut lines).unwrap();
+    /// let r = r.with_lines(&lines).unwrap();
     /// let origins = core::array::from_fn(|l| [0, voxel_centre(9), voxel_centre(9) + l as i64]);
     /// let mut packet = RayPacket8::new(e, origins, [[VOXEL as i32, 1, 0]; 8]).unwrap();
     /// assert_eq!(packet.first_hit_skipping(&r, Connectivity::Adaptive).unwrap(), 0xff);

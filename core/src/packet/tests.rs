@@ -8,7 +8,7 @@ use super::lanes::{I64x8, Mask8};
 use super::*;
 use crate::check_packet::{Walk, check_packet, check_packet_script};
 use crate::fixed::{VOXEL, voxel_centre};
-use crate::proximity::{distance_field, flag_neighbourhood, line_distances};
+use crate::proximity::{coarse_extent, distance_field, flag_neighbourhood, line_distances};
 use crate::raster::{RasterMut, line_count};
 use crate::testkit::Rng;
 
@@ -231,8 +231,8 @@ fn small_random_packets_match_their_scalar_rays() {
     }
 }
 
-/// A sparse plane with its distance field (jumps of up to `DISTANCE_LIMIT`
-/// voxels), its line level, and some cells disturbed so that the field is
+/// A sparse plane with its distance field, its line level (jumps of up to
+/// `DISTANCE_LIMIT` voxels), and some cells disturbed so that the field is
 /// no longer exact: lanes must still equal their scalar skipping walks.
 fn skipping_plane(e: Extent, rng: &mut Rng, per_mille: u64, disturb: bool) -> (Vec<u8>, Vec<u8>) {
     let mut plane: Vec<u8> = (0..e.len())
@@ -246,7 +246,9 @@ fn skipping_plane(e: Extent, rng: &mut Rng, per_mille: u64, disturb: bool) -> (V
         .collect();
     distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
     let mut lines = vec![0u8; line_count(plane.len())];
-    line_distances(&Raster::new(e, &plane).unwrap(), &mut lines).unwrap();
+    let raster = Raster::new(e, &plane).unwrap();
+    let mut bricks = vec![0u8; coarse_extent(e).unwrap().len()];
+    line_distances(&raster, &mut bricks, &mut lines).unwrap();
     if disturb {
         for c in plane.iter_mut() {
             if rng.chance(1, 50) {
@@ -285,7 +287,8 @@ fn skipping_packets_match_their_scalar_skipping_walks() {
 }
 
 /// Skipping lanes really jump: a camera block through empty space visits
-/// few voxels, each lane as many as its scalar skipping walk.
+/// few voxels (through the line level, as the renderer walks), each lane
+/// as many as its scalar skipping walk.
 #[test]
 fn skipping_lanes_jump() {
     let e = Extent::cube(96).unwrap();
@@ -297,6 +300,10 @@ fn skipping_lanes_jump() {
     }
     distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
     let r = Raster::new(e, &plane).unwrap();
+    let mut bricks = vec![0u8; coarse_extent(e).unwrap().len()];
+    let mut lines = vec![0u8; line_count(plane.len())];
+    line_distances(&r, &mut bricks, &mut lines).unwrap();
+    let r = r.with_lines(&lines).unwrap();
     let origin = [0, voxel_centre(47), voxel_centre(47)];
     let dirs = core::array::from_fn(|l| [1 << 28, (l as i32 - 4) << 20, 3 << 18]);
     let mut p = RayPacket8::new(e, [origin; LANES], dirs).unwrap();

@@ -1,13 +1,16 @@
 //! The proximity distance field by slices: exact, in place, in work that a
-//! caller can share among threads, and next to nothing far from surfaces.
+//! caller can share among threads, and nothing written far from surfaces.
 //!
-//! The field of a cell is `min(DISTANCE_LIMIT, min over opaque voxels q of
-//! max(|dx|, |dy|, |dz|))`. It is computed in three steps, each exact:
+//! The field of a cell is `min over opaque voxels q of max(|dx|, |dy|,
+//! |dz|)`, stored where it is below [`NEAR_LIMIT`]; a transparent cell at
+//! that distance or more is left [`cell::EMPTY`], so the plane's memory far
+//! from surfaces is never written (an anonymous map keeps such pages
+//! unbacked). It is computed in three steps, each exact:
 //! 1. [`slice_distances`], per z-slice on its own: the distance to the
 //!    nearest opaque voxel *of the same slice*, `d2`. Per row, the distance
 //!    along the row (a ramp written only within the limit of each opaque
-//!    run; a row without one is filled with the limit), then the rows
-//!    relaxed from their neighbours, up the slice and down again.
+//!    run), then the rows relaxed from their neighbours, up the slice and
+//!    down again.
 //! 2. Up the slices: `F(z) = min(d2(z), 1 + min over the 3×3 cells around
 //!    (x, y) of F(z − 1))` ([`relax_rows`] with the slice below) is the
 //!    exact distance to the opaque voxels at or below `z`: the chessboard
@@ -20,33 +23,38 @@
 //!    above).
 //!
 //! The same holds for the rows within a slice (step 1) with 1×3
-//! neighbourhoods. Since distances saturate at [`DISTANCE_LIMIT`], a
-//! relaxation from a neighbour changes nothing unless an opaque voxel lies
-//! within [`FIELD_REACH`] slices (rows) on that side: such slices and rows
-//! are skipped, so far from surfaces the work is the first step's fill.
+//! neighbourhoods. Since distances from [`NEAR_LIMIT`] on are all one
+//! value, a relaxation from a neighbour changes nothing unless an opaque
+//! voxel lies within [`FIELD_REACH`] slices (rows) on that side: such
+//! slices and rows are skipped, and a relaxation writes only the runs of
+//! cells it changes.
 //!
 //! Cells hold their finished form from the first step on: the distance in
-//! the distance bits, [`cell::PROXIMITY`] at distance 0 and 1, and
-//! [`cell::OPAQUE`] at 0 (the map is increasing, so minima commute with
-//! it). Steps 2 and 3 read one whole neighbouring slice and write rows of
-//! another, so a caller may hand out the rows of a slice to threads; step
-//! 1 is independent per slice.
+//! the distance bits, [`cell::PROXIMITY`] at distance 0 and 1,
+//! [`cell::OPAQUE`] at 0 and [`cell::EMPTY`] from [`NEAR_LIMIT`] on (the
+//! map is increasing once `EMPTY` is ordered last, [`nearer`], so minima
+//! commute with it). Steps 2 and 3 read one whole neighbouring slice and
+//! write rows of another, so a caller may hand out the rows of a slice to
+//! threads; step 1 is independent per slice.
 
-use super::DISTANCE_LIMIT;
+use super::NEAR_LIMIT;
 use crate::raster::cell;
 
 /// How far an opaque voxel's influence reaches through the relaxations:
 /// relaxing a slice (row) from its neighbour on one side changes it only
 /// if an opaque voxel lies within this many slices (rows) on that side.
-/// A distance of `DISTANCE_LIMIT − 1` or less in the neighbour is needed
-/// for `1 + distance` to lower anything, and the neighbour itself counts.
-pub const FIELD_REACH: u32 = DISTANCE_LIMIT as u32 - 1;
+/// A distance of `NEAR_LIMIT − 2` or less in the neighbour is needed for
+/// `1 + distance` to be stored, and the neighbour itself counts.
+pub const FIELD_REACH: u32 = NEAR_LIMIT as u32 - 1;
 
 /// One distance step in the distance bits.
 const STEP: u8 = 1 << cell::DISTANCE_SHIFT;
-/// The saturated distance in the distance bits: the cell far from
-/// everything.
-pub(super) const FAR: u8 = DISTANCE_LIMIT << cell::DISTANCE_SHIFT;
+/// The finished cell of a transparent voxel [`NEAR_LIMIT`] or more from
+/// every opaque one: [`cell::EMPTY`], ordered after every other finished
+/// cell ([`nearer`]).
+pub(super) const FAR: u8 = cell::EMPTY;
+/// The distance bits of [`NEAR_LIMIT`]: finished distances lie below.
+const NEAR_BITS: u8 = NEAR_LIMIT << cell::DISTANCE_SHIFT;
 /// The finished form of an opaque cell (rank hints are written later).
 pub(super) const OPAQUE_CELL: u8 = cell::OPAQUE | cell::PROXIMITY;
 /// Distance bits of a finished cell.
@@ -54,28 +62,50 @@ const DISTANCE_BITS: u8 = cell::DISTANCE_MASK << cell::DISTANCE_SHIFT;
 /// Columns handled at once by [`relax_row`]'s stack buffer.
 const CHUNK: usize = 256;
 
+/// The nearer of two finished cells: the smaller, with [`FAR`] (0) ordered
+/// after all others (`c − 1` wrapping is an order-preserving key).
+#[inline]
+pub(super) const fn nearer(a: u8, b: u8) -> u8 {
+    let (ka, kb) = (a.wrapping_sub(1), b.wrapping_sub(1));
+    if ka <= kb { a } else { b }
+}
+
 /// The finished cell of a transparent voxel at distance `d ≥ 1`.
 #[inline]
 const fn at_distance(d: u8) -> u8 {
-    let d = if d > DISTANCE_LIMIT {
-        DISTANCE_LIMIT
-    } else {
-        d
-    };
+    if d >= NEAR_LIMIT {
+        return FAR;
+    }
     let bits = d << cell::DISTANCE_SHIFT;
     if d <= 1 { bits | cell::PROXIMITY } else { bits }
 }
 
 /// The finished cell one step beyond a neighbour whose finished cell is
-/// `n`: distance `distance(n) + 1`, saturated (with PROXIMITY at 1).
+/// `n`: distance `distance(n) + 1` ([`FAR`] from [`NEAR_LIMIT`] on, and
+/// beyond a far cell), with PROXIMITY at 1.
 #[inline]
 const fn one_beyond(n: u8) -> u8 {
+    if n == FAR {
+        return FAR;
+    }
     let bits = (n & DISTANCE_BITS).saturating_add(STEP);
-    let bits = if bits > FAR { FAR } else { bits };
-    if bits == STEP {
+    if bits >= NEAR_BITS {
+        FAR
+    } else if bits == STEP {
         bits | cell::PROXIMITY
     } else {
         bits
+    }
+}
+
+/// `seg[j] = nearer(seg[j], offer[j])`, writing `seg` only if a cell
+/// changes (so unchanged memory is only read).
+#[inline]
+fn lower(seg: &mut [u8], offer: &[u8]) {
+    if seg.iter().zip(offer).any(|(&c, &o)| nearer(c, o) != c) {
+        for (c, &o) in seg.iter_mut().zip(offer) {
+            *c = nearer(*c, o);
+        }
     }
 }
 
@@ -151,6 +181,15 @@ impl Area {
 /// (empty without one). A slice whose length is not a multiple of `nx`
 /// (or `nx` = 0) is left as it is.
 pub fn slice_distances(slice: &mut [u8], nx: usize) -> Area {
+    slice_distances_in(slice, nx, |_| true)
+}
+
+/// [`slice_distances`] for a slice whose rows `y` with `may_hold(y)`
+/// false are known to hold only [`cell::EMPTY`] cells (a fresh plane
+/// where the caller knows which rows its opaque voxels lie in): those rows
+/// are not read unless an opaque row is within reach. The same result as
+/// [`slice_distances`] when that holds.
+pub fn slice_distances_in(slice: &mut [u8], nx: usize, may_hold: impl Fn(usize) -> bool) -> Area {
     if nx == 0 || !slice.len().is_multiple_of(nx) {
         return Area::EMPTY;
     }
@@ -166,7 +205,11 @@ pub fn slice_distances(slice: &mut [u8], nx: usize) -> Area {
             break;
         };
         let row = rest.get_mut(..nx).unwrap_or(&mut []);
-        let opaque = row_distances(row);
+        let opaque = if may_hold(y) {
+            row_distances(row)
+        } else {
+            None
+        };
         if let Some(l) = last
             && reaches(y.wrapping_sub(l))
         {
@@ -197,7 +240,7 @@ pub fn slice_distances(slice: &mut [u8], nx: usize) -> Area {
             relax_row(head.get_mut(start..).unwrap_or(&mut []), above, columns);
         }
         let row = slice.get(start..start.wrapping_add(nx)).unwrap_or(&[]);
-        if row.contains(&OPAQUE_CELL) {
+        if (seen.y[0]..seen.y[1]).contains(&y) && may_hold(y) && row.contains(&OPAQUE_CELL) {
             next = Some(y);
         }
     }
@@ -269,9 +312,11 @@ pub fn relax_rows(rows: &mut [u8], neighbour: &[u8], nx: usize, y0: usize, area:
                 r1.get(..len).unwrap_or(&[]),
                 r2.get(..len).unwrap_or(&[]),
             );
-            for (((cell, &a), &b), &c) in seg.iter_mut().zip(r0).zip(r1).zip(r2) {
-                *cell = (*cell).min(a.min(b).min(c));
+            let mut offer = [FAR; CHUNK];
+            for (((o, &a), &b), &c) in offer.iter_mut().zip(r0).zip(r1).zip(r2) {
+                *o = nearer(a, nearer(b, c));
             }
+            lower(seg, offer.get(..len).unwrap_or(&[]));
         }
         start = chunk_end;
     }
@@ -302,7 +347,7 @@ fn beyond(row: &[u8], start: usize, end: usize, out: &mut [u8; CHUNK]) {
         t.get(2..len.wrapping_add(2)).unwrap_or(&[]),
     );
     for (((o, &a), &b), &c) in out.iter_mut().zip(a).zip(b).zip(c) {
-        *o = one_beyond(a.min(b).min(c));
+        *o = one_beyond(nearer(a, nearer(b, c)));
     }
 }
 
@@ -326,9 +371,7 @@ fn relax_row(row: &mut [u8], neighbour: &[u8], [x0, x1]: [usize; 2]) {
         let end = start.saturating_add(CHUNK).min(stop);
         beyond(neighbour, start, end, &mut offered);
         if let Some(seg) = row.get_mut(start..end) {
-            for (cell, &o) in seg.iter_mut().zip(&offered) {
-                *cell = (*cell).min(o);
-            }
+            lower(seg, &offered);
         }
         start = end;
     }
@@ -383,11 +426,11 @@ fn next_opaque(row: &[u8], from: usize) -> Option<usize> {
 
 /// The cells between two opaque ones (`left`, `right`: whether there is
 /// one just before, just after the gap): the finished form of the distance
-/// to the nearer. Only the cells within [`DISTANCE_LIMIT`] of an end are
-/// computed; the rest are set far.
+/// to the nearer. Only the cells within [`FIELD_REACH`] of an end are
+/// computed; the rest are far, written only where they are not already.
 fn fill_gap(gap: &mut [u8], left: bool, right: bool) {
     let n = gap.len();
-    let reach = usize::from(DISTANCE_LIMIT);
+    let reach = reach();
     let head = if left { reach.min(n) } else { 0 };
     let tail = if right {
         reach.min(n.wrapping_sub(head))
@@ -401,13 +444,15 @@ fn fill_gap(gap: &mut [u8], left: bool, right: bool) {
     for (i, c) in a.iter_mut().enumerate() {
         let from_left = i.wrapping_add(1);
         let from_right = if right { n.wrapping_sub(i) } else { usize::MAX };
-        *c = at_distance(u8::try_from(from_left.min(from_right)).unwrap_or(DISTANCE_LIMIT));
+        *c = at_distance(u8::try_from(from_left.min(from_right)).unwrap_or(NEAR_LIMIT));
     }
-    m.fill(FAR);
+    if m.iter().any(|&c| c != FAR) {
+        m.fill(FAR);
+    }
     // Distances …, 2, 1 to the right end (the left one is farther here).
     let t = b.len();
     for (i, c) in b.iter_mut().enumerate() {
         let d = t.wrapping_sub(i);
-        *c = at_distance(u8::try_from(d).unwrap_or(DISTANCE_LIMIT));
+        *c = at_distance(u8::try_from(d).unwrap_or(NEAR_LIMIT));
     }
 }

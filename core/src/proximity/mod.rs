@@ -11,16 +11,19 @@
 //! each reading only bytes the same sweep has not yet written, so it needs no
 //! scratch memory and touches each cell a constant number of times.
 //!
-//! [`distance_field`] generalizes the flag to a saturating chessboard
-//! distance (Cohen & Sheffer's proximity clouds) for empty-space skipping,
-//! and [`line_distances`] condenses it into the raster's line level: one
-//! stand-in cell per 64 plane cells, which skipping walks read instead of
-//! the plane far from surfaces.
+//! [`distance_field`] generalizes the flag to a chessboard distance
+//! (Cohen & Sheffer's proximity clouds) for empty-space skipping, stored
+//! near surfaces only (below [`NEAR_LIMIT`]), so that the plane's memory
+//! far from them is never written. Farther jumps come from the coarse
+//! level ([`coarse_level`]: the same field over bricks of [`COARSE_EDGE`]³
+//! voxels), and [`line_distances`] condenses both into the raster's line
+//! level: one stand-in cell per 64 plane cells, which skipping walks read
+//! instead of the plane far from surfaces.
 
 pub mod field;
 
 use crate::error::RasterError;
-use crate::raster::{LINE_CELLS, Raster, RasterMut, cell, check_line_count, to_usize};
+use crate::raster::{Extent, LINE_CELLS, Raster, RasterMut, cell, check_line_count, to_usize};
 
 /// Sets [`cell::PROXIMITY`] on every voxel within chessboard distance 1 of an
 /// [`cell::OPAQUE`] voxel, and clears it everywhere else.
@@ -113,14 +116,23 @@ fn or_proximity(dst: &mut [u8], src: &[u8]) {
     }
 }
 
-/// Largest proximity distance the plane stores (6 bits); larger distances
+/// Largest proximity distance a cell can hold (6 bits): line stand-ins
 /// saturate to it.
 pub const DISTANCE_LIMIT: u8 = cell::DISTANCE_MASK;
 
+/// The distance field ([`distance_field`]) stores the distances below
+/// this in the plane; a transparent cell at this distance or more from
+/// every opaque voxel is left [`cell::EMPTY`]. A skipping walk through a
+/// line level reads such a cell as this distance
+/// ([`Raster::with_lines`]).
+pub const NEAR_LIMIT: u8 = 16;
+
 /// The proximity distance stored in a cell: a lower bound on the chessboard
 /// distance from the voxel to the nearest [`cell::OPAQUE`] voxel (0 = no
-/// information). Always 0 for an opaque cell, whose distance bits hold its
-/// record's rank hint instead ([`crate::store::rank_hint`]).
+/// information; in a plane with its distance field, an [`cell::EMPTY`]
+/// cell is at [`NEAR_LIMIT`] or more). Always 0 for an opaque cell, whose
+/// distance bits hold its record's rank hint instead
+/// ([`crate::store::rank_hint`]).
 ///
 /// ```
 /// use rrt_core::proximity::distance;
@@ -146,8 +158,9 @@ pub const fn distance(c: u8) -> u8 {
 /// that distance less one. A cell with no distance (0) reads as flagged,
 /// never skipped. For a plane with its distance field, or any line
 /// stand-in, this is the dilated raster's cell exactly (or with a smaller
-/// distance where the stored one saturated), so walks over the view keep
-/// the guarantees they have over a plane
+/// distance where the stored one is a bound: a stand-in, or an empty cell
+/// read through the line level), so walks over the view keep the
+/// guarantees they have over a plane
 /// ([`DiscreteRay::walk_dilated`](crate::discrete_ray::DiscreteRay::walk_dilated)).
 ///
 /// ```
@@ -170,67 +183,320 @@ pub const fn dilated(c: u8) -> u8 {
     }
 }
 
-/// Computes the raster's line level ([`Raster::with_lines`]): per line of
-/// [`LINE_CELLS`] consecutive plane cells, a stand-in cell carrying the
-/// smallest proximity distance of the line's cells when that is at least 2
-/// and no cell of the line is opaque or flagged, else [`cell::EMPTY`] (read
-/// the plane). O(plane), after [`distance_field`].
+/// Edge of the coarse level's bricks, in voxels ([`coarse_level`]).
+pub const COARSE_EDGE: u32 = 8;
+
+/// Bricks of the coarse level of `extent` per axis: `ceil(n / 8)`.
+#[must_use]
+pub fn coarse_dims(extent: Extent) -> [u32; 3] {
+    extent.dims().map(|n| n.div_ceil(COARSE_EDGE))
+}
+
+/// Cells of the coarse level of a raster of `dims` voxels (saturating):
+/// the length of the `bricks` buffer [`line_distances`] takes, as a
+/// constant for static storage.
 ///
 /// ```
-/// use rrt_core::proximity::{distance, distance_field, line_distances};
-/// use rrt_core::raster::{cell, line_count, Extent, RasterMut};
-/// let e = Extent::new(128, 4, 4).unwrap();
+/// use rrt_core::proximity::coarse_cells;
+/// assert_eq!(coarse_cells([41, 35, 27]), 6 * 5 * 4);
+/// ```
+#[must_use]
+pub const fn coarse_cells(dims: [u32; 3]) -> usize {
+    let [x, y, z] = dims;
+    (x.div_ceil(COARSE_EDGE) as usize)
+        .saturating_mul(y.div_ceil(COARSE_EDGE) as usize)
+        .saturating_mul(z.div_ceil(COARSE_EDGE) as usize)
+}
+
+/// The coarse level's extent ([`coarse_dims`]; never empty).
+///
+/// # Errors
+/// None for a valid extent (kept fallible for the checked constructor).
+pub fn coarse_extent(extent: Extent) -> Result<Extent, RasterError> {
+    let [x, y, z] = coarse_dims(extent);
+    Extent::new(x, y, z)
+}
+
+/// Computes the raster's coarse level: per brick of [`COARSE_EDGE`]³
+/// voxels (x fastest, as the plane), [`cell::OPAQUE`] where the brick holds
+/// an opaque voxel, then the distance field of those marks over the bricks
+/// ([`coarse_field`]). A voxel of a brick at coarse distance `k ≥ 1` is at
+/// least `8·(k − 1) + 1` voxels from every opaque voxel
+/// ([`line_distances`] turns that into jumps).
+///
+/// ```
+/// use rrt_core::proximity::{coarse_extent, coarse_level, distance};
+/// use rrt_core::raster::{cell, Extent, Raster};
+/// let e = Extent::new(64, 8, 8).unwrap();
 /// let mut plane = vec![cell::EMPTY; e.len()];
-/// plane[e.index([100, 0, 0]).unwrap()] = cell::OPAQUE;
+/// plane[e.index([3, 0, 0]).unwrap()] = cell::OPAQUE;
+/// let mut bricks = vec![0u8; coarse_extent(e).unwrap().len()];
+/// coarse_level(&Raster::new(e, &plane).unwrap(), &mut bricks).unwrap();
+/// assert_ne!(bricks[0] & cell::OPAQUE, 0);
+/// assert_eq!(distance(bricks[5]), 5);
+/// ```
+///
+/// # Errors
+/// [`RasterError::LineLength`] unless `bricks.len()` is the coarse
+/// extent's length.
+pub fn coarse_level(raster: &Raster<'_>, bricks: &mut [u8]) -> Result<(), RasterError> {
+    let extent = raster.extent();
+    let coarse = coarse_extent(extent)?;
+    check_len(coarse.len(), bricks.len())?;
+    bricks.fill(cell::EMPTY);
+    let [nx, ny, _] = extent.dims().map(to_usize);
+    let [cx, cy, _] = coarse.dims().map(to_usize);
+    let edge = to_usize(COARSE_EDGE);
+    for (row, cells) in raster.plane().chunks(nx.max(1)).enumerate() {
+        let base = brick_row(row, [ny, cx, cy]);
+        for (x, &c) in cells.iter().enumerate() {
+            if c & cell::OPAQUE != 0
+                && let Some(b) = bricks.get_mut(base.wrapping_add(div(x, edge)))
+            {
+                *b = cell::OPAQUE;
+            }
+        }
+    }
+    coarse_field(extent, bricks)
+}
+
+/// `a / b`, 0 for `b = 0`.
+#[inline]
+const fn div(a: usize, b: usize) -> usize {
+    match a.checked_div(b) {
+        Some(q) => q,
+        None => 0,
+    }
+}
+
+/// The index in the coarse level of the first brick of plane row `row`
+/// (rows of `ny` per slice; `cx × cy` bricks per coarse slice).
+#[inline]
+const fn brick_row(row: usize, [ny, cx, cy]: [usize; 3]) -> usize {
+    let edge = COARSE_EDGE as usize;
+    let (y, z) = (
+        match row.checked_rem(ny) {
+            Some(r) => r,
+            None => 0,
+        },
+        div(row, ny),
+    );
+    div(z, edge)
+        .wrapping_mul(cy)
+        .wrapping_add(div(y, edge))
+        .wrapping_mul(cx)
+}
+
+/// The coarse level from its marks: `bricks` holds [`cell::OPAQUE`] in the
+/// bricks of `extent` that hold an opaque voxel (other bits ignored), and
+/// gets their distance field ([`distance_field`] over the bricks). A
+/// caller that knows the occupied bricks (a record store's directory)
+/// marks them and calls this.
+///
+/// # Errors
+/// [`RasterError::LineLength`] unless `bricks.len()` is the coarse
+/// extent's length.
+pub fn coarse_field(extent: Extent, bricks: &mut [u8]) -> Result<(), RasterError> {
+    let coarse = coarse_extent(extent)?;
+    check_len(coarse.len(), bricks.len())?;
+    distance_field(&mut RasterMut::new(coarse, bricks)?);
+    Ok(())
+}
+
+/// [`RasterError::LineLength`] unless `found == expected`.
+const fn check_len(expected: usize, found: usize) -> Result<(), RasterError> {
+    if expected == found {
+        Ok(())
+    } else {
+        Err(RasterError::LineLength { expected, found })
+    }
+}
+
+/// The least distance from a voxel of a brick whose coarse cell is `c` to
+/// an opaque voxel: 0 in an occupied brick, `8·(k − 1) + 1` at coarse
+/// distance `k` (`k` from [`NEAR_LIMIT`] on for an [`cell::EMPTY`] cell),
+/// at most [`DISTANCE_LIMIT`].
+#[inline]
+fn brick_bound(c: u8) -> u8 {
+    let k = if c & cell::OPAQUE != 0 {
+        0
+    } else if c == cell::EMPTY {
+        NEAR_LIMIT
+    } else {
+        distance(c)
+    };
+    if k == 0 {
+        return 0;
+    }
+    let d = COARSE_EDGE
+        .saturating_mul(u32::from(k).saturating_sub(1))
+        .saturating_add(1);
+    u8::try_from(d.min(u32::from(DISTANCE_LIMIT))).unwrap_or(DISTANCE_LIMIT)
+}
+
+/// Computes the raster's coarse level into `bricks` ([`coarse_level`])
+/// and its line level ([`Raster::with_lines`]) from a plane with its
+/// distance field ([`distance_field`]): per line of [`LINE_CELLS`] consecutive plane cells,
+/// a stand-in cell with no flags carrying a lower bound on the distance of
+/// every cell of the line, at least 2, or [`cell::EMPTY`] (read the plane)
+/// when a cell of the line is opaque or flagged. The bound is the larger
+/// of the coarse level's (the least over the bricks the line crosses) and
+/// the line's least cell, an [`cell::EMPTY`] cell counting as
+/// [`NEAR_LIMIT`]; a line the coarse level puts [`NEAR_LIMIT`] or more
+/// from every opaque voxel is decided without reading its cells.
+///
+/// **Contract:** the plane holds its distance field; a skipping walk
+/// through the line level relies on it (it reads an [`cell::EMPTY`] plane
+/// cell as [`NEAR_LIMIT`]).
+///
+/// ```
+/// use rrt_core::proximity::{coarse_extent, distance, distance_field, line_distances};
+/// use rrt_core::raster::{cell, line_count, Extent, RasterMut};
+/// let e = Extent::new(256, 4, 4).unwrap();
+/// let mut plane = vec![cell::EMPTY; e.len()];
+/// plane[e.index([200, 0, 0]).unwrap()] = cell::OPAQUE;
 /// let mut r = RasterMut::new(e, &mut plane).unwrap();
 /// distance_field(&mut r);
+/// let r = r.as_raster();
+/// let mut bricks = vec![0u8; coarse_extent(e).unwrap().len()];
 /// let mut lines = vec![0u8; line_count(e.len())];
-/// line_distances(&r.as_raster(), &mut lines).unwrap();
+/// line_distances(&r, &mut bricks, &mut lines).unwrap();
 /// let line = |v| lines[e.index(v).unwrap() / 64];
-/// // x = 64..128 of row (y, z) = (0, 3): 3 to 36 voxels from the opaque one.
-/// assert_eq!(distance(line([64, 0, 3])), 3);
-/// // x = 0..64 of that row: 37 voxels and more.
-/// assert_eq!(distance(line([0, 0, 3])), 37);
+/// // x = 128..192 of row (y, z) = (0, 3): 9 to 72 voxels from the opaque one.
+/// assert_eq!(distance(line([128, 0, 3])), 9);
+/// // x = 0..64 of that row: 137 voxels and more; the coarse level bounds
+/// // it by the most a cell can hold.
+/// assert_eq!(distance(line([0, 0, 3])), 63);
 /// // The opaque voxel's own line: read the plane.
-/// assert_eq!(line([64, 0, 0]), cell::EMPTY);
+/// assert_eq!(line([192, 0, 0]), cell::EMPTY);
 /// ```
 ///
 /// # Errors
 /// [`RasterError::LineLength`] unless `lines.len()` is
-/// [`line_count`](crate::raster::line_count)`(plane length)`.
-pub fn line_distances(raster: &Raster<'_>, lines: &mut [u8]) -> Result<(), RasterError> {
+/// [`line_count`](crate::raster::line_count)`(plane length)` and
+/// `bricks.len()` the coarse extent's length.
+pub fn line_distances(
+    raster: &Raster<'_>,
+    bricks: &mut [u8],
+    lines: &mut [u8],
+) -> Result<(), RasterError> {
+    check_line_count(raster.plane().len(), lines.len())?;
+    coarse_level(raster, bricks)?;
+    line_stand_ins(raster, bricks, 0, lines)
+}
+
+/// The stand-ins of the lines `first..first + lines.len()` of the line
+/// level ([`line_distances`]) from the raster's coarse level `bricks`
+/// ([`coarse_level`], or [`coarse_field`] of the occupied bricks), into
+/// `lines`; lines beyond the plane's are left alone. A caller with threads
+/// hands out parts.
+///
+/// # Errors
+/// [`RasterError::LineLength`] unless `bricks.len()` is the coarse
+/// extent's length.
+pub fn line_stand_ins(
+    raster: &Raster<'_>,
+    bricks: &[u8],
+    first: usize,
+    lines: &mut [u8],
+) -> Result<(), RasterError> {
+    let extent = raster.extent();
+    let coarse = coarse_extent(extent)?;
+    check_len(coarse.len(), bricks.len())?;
     let plane = raster.plane();
-    check_line_count(plane.len(), lines.len())?;
-    line_stand_ins(plane, lines);
+    let [nx, ny, _] = extent.dims().map(to_usize);
+    let [cx, cy, _] = coarse.dims().map(to_usize);
+    let edge = to_usize(COARSE_EDGE);
+    let len = plane.len();
+    let Some(mut start) = first.checked_mul(LINE_CELLS) else {
+        return Ok(());
+    };
+    if nx == 0 {
+        return Ok(());
+    }
+    // Each coarse cell's bound, looked up.
+    let mut bounds = [0u8; 256];
+    for (c, b) in (0..=u8::MAX).zip(bounds.iter_mut()) {
+        *b = brick_bound(c);
+    }
+    // The first cell's position, then advanced line by line (no division
+    // per line).
+    let (mut x, row) = (start.checked_rem(nx).unwrap_or(0), div(start, nx));
+    let (mut y, mut z) = (row.checked_rem(ny).unwrap_or(0), div(row, ny));
+    for out in lines.iter_mut() {
+        if start >= len {
+            break;
+        }
+        let end = start.saturating_add(LINE_CELLS).min(len);
+        // The coarse bound: the least over the bricks of each row piece.
+        let mut bound = DISTANCE_LIMIT;
+        let (mut at, mut px, mut py, mut pz) = (start, x, y, z);
+        while at < end {
+            let piece = nx.saturating_sub(px).min(end.wrapping_sub(at)).max(1);
+            let base = div(pz, edge)
+                .wrapping_mul(cy)
+                .wrapping_add(div(py, edge))
+                .wrapping_mul(cx);
+            let first_brick = base.wrapping_add(div(px, edge));
+            let last_brick = base.wrapping_add(div(px.wrapping_add(piece).wrapping_sub(1), edge));
+            for &b in bricks.get(first_brick..=last_brick).unwrap_or(&[]) {
+                bound = bound.min(bounds.get(usize::from(b)).copied().unwrap_or(0));
+            }
+            at = at.wrapping_add(piece);
+            px = 0;
+            (py, pz) = next_row(py, pz, ny);
+        }
+        *out = if bound >= NEAR_LIMIT {
+            bound << cell::DISTANCE_SHIFT
+        } else {
+            let cells = plane.get(start..end).unwrap_or(&[]);
+            // Without OPAQUE or PROXIMITY in any cell, every cell is its
+            // distance bits alone (EMPTY the farthest), and the nearest cell
+            // holds the least distance.
+            let any = cells.iter().fold(0u8, |a, &c| a | c);
+            let least = cells.iter().fold(field::FAR, |a, &c| field::nearer(a, c));
+            let d = if least == cell::EMPTY {
+                NEAR_LIMIT
+            } else {
+                distance(least)
+            };
+            let d = d.max(bound);
+            if any & (cell::OPAQUE | cell::PROXIMITY) != 0 || d < 2 {
+                cell::EMPTY
+            } else {
+                d << cell::DISTANCE_SHIFT
+            }
+        };
+        start = end;
+        x = x.wrapping_add(LINE_CELLS);
+        while x >= nx {
+            x = x.wrapping_sub(nx);
+            (y, z) = next_row(y, z, ny);
+        }
+    }
     Ok(())
 }
 
-/// The line level of a part of a plane: `cells` are consecutive cells of
-/// a plane with its distance field, starting at a line boundary, and
-/// `lines` gets one stand-in per [`LINE_CELLS`] of them (the last line may
-/// be shorter), as [`line_distances`] computes them; stand-ins beyond the
-/// cells are left alone. A caller with threads hands out aligned parts.
-pub fn line_stand_ins(cells: &[u8], lines: &mut [u8]) {
-    for (out, line) in lines.iter_mut().zip(cells.chunks(LINE_CELLS)) {
-        // Without OPAQUE or PROXIMITY in any cell, every cell is its distance
-        // bits alone, and the smallest cell holds the smallest distance.
-        let any = line.iter().fold(0u8, |a, &c| a | c);
-        let least = line.iter().fold(u8::MAX, |a, &c| a.min(c));
-        *out = if any & (cell::OPAQUE | cell::PROXIMITY) != 0 || distance(least) < 2 {
-            cell::EMPTY
-        } else {
-            least
-        };
+/// The row after row `y` of slice `z` (rows of `ny` per slice).
+#[inline]
+const fn next_row(y: usize, z: usize, ny: usize) -> (usize, usize) {
+    let y = y.wrapping_add(1);
+    if y >= ny {
+        (0, z.wrapping_add(1))
+    } else {
+        (y, z)
     }
 }
 
-/// Computes the proximity distance field: every cell gets the chessboard
-/// (L∞) distance from its voxel to the nearest [`cell::OPAQUE`] voxel,
-/// saturated at [`DISTANCE_LIMIT`], in its distance bits, and
-/// [`cell::PROXIMITY`] where that distance is at most 1 (exactly what
-/// [`flag_neighbourhood`] sets). A raster without opaque voxels gets the
-/// limit everywhere. Opaque cells get distance bits 0, which clears their
-/// rank hints: write them afterwards ([`crate::store::write_rank_hints`]).
+/// Computes the proximity distance field: every cell whose voxel lies
+/// within [`NEAR_LIMIT`]` − 1` (chessboard, L∞) of a [`cell::OPAQUE`]
+/// voxel gets that distance in its distance bits, and [`cell::PROXIMITY`]
+/// where it is at most 1 (exactly what [`flag_neighbourhood`] sets); every
+/// other transparent cell is [`cell::EMPTY`], and is written only if it
+/// was not (so a zeroed plane's memory far from surfaces stays untouched).
+/// A raster without opaque voxels is all empty. Opaque cells get distance
+/// bits 0, which clears their rank hints: write them afterwards
+/// ([`crate::store::write_rank_hints`]).
 ///
 /// Cohen & Sheffer's proximity clouds, generalizing the paper's one-bit flag:
 /// a 26-connected ray at a voxel of distance `d` can take `d − 1` steps at
@@ -239,11 +505,10 @@ pub fn line_stand_ins(cells: &[u8], lines: &mut [u8]) {
 ///
 /// Computed by slices ([`field`]: the distances within each slice, then up
 /// and down the slices), in place, with no scratch memory beyond a small
-/// stack buffer. Every cell is written once; beyond that the work follows
+/// stack buffer. Every cell is read; the writes and the relaxations follow
 /// the opaque voxels: rows and slices with no opaque voxel within
-/// [`field::FIELD_REACH`] are only filled with the limit. A caller with
-/// threads runs the same steps on its own ([`field`]), with the same
-/// result.
+/// [`field::FIELD_REACH`] are only read. A caller with threads runs the
+/// same steps on its own ([`field`]), with the same result.
 ///
 /// ```
 /// use rrt_core::proximity::{distance, distance_field};

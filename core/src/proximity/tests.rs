@@ -4,8 +4,8 @@ use std::vec;
 use std::vec::Vec;
 
 use super::*;
-use crate::raster::Extent;
 use crate::raster::line_count;
+use crate::raster::{Extent, Raster};
 use crate::testkit::Rng;
 
 /// Chessboard distance to the nearest opaque voxel, by brute force.
@@ -48,12 +48,17 @@ fn distance_field_is_the_exact_chessboard_distance() {
         distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
         let want = brute(e, &opaque);
         for (i, (&c, &w)) in plane.iter().zip(&want).enumerate() {
+            // Stored below the near limit; empty from it on.
+            let stored = if w < NEAR_LIMIT { w } else { 0 };
             assert_eq!(
                 distance(c),
-                w,
+                stored,
                 "case {case} dims {dims:?} voxel {:?}",
                 e.coord(i)
             );
+            if w >= NEAR_LIMIT {
+                assert_eq!(c, cell::EMPTY, "case {case}");
+            }
             assert_eq!(c & cell::OPAQUE != 0, w == 0, "case {case}");
             // The flag is exactly what flag_neighbourhood sets.
             assert_eq!(
@@ -62,50 +67,102 @@ fn distance_field_is_the_exact_chessboard_distance() {
                 "case {case}"
             );
         }
-        // The line level: each line's smallest distance when that is at
-        // least 2, else EMPTY.
-        let mut lines = vec![0xffu8; line_count(e.len())];
-        line_distances(
-            &RasterMut::new(e, &mut plane).unwrap().as_raster(),
-            &mut lines,
-        )
-        .unwrap();
-        for (l, &got) in lines.iter().enumerate() {
-            let m = want
-                .iter()
-                .skip(l * LINE_CELLS)
-                .take(LINE_CELLS)
-                .min()
-                .copied()
-                .unwrap();
-            let expect = if m >= 2 {
-                m << cell::DISTANCE_SHIFT
-            } else {
-                cell::EMPTY
-            };
-            assert_eq!(got, expect, "case {case} line {l}");
-        }
+        check_line_level(e, &plane, &want, &std::format!("case {case}"));
+    }
+}
+
+/// The coarse level and line level of a finished `plane` of `e` whose
+/// exact distances (saturated at [`DISTANCE_LIMIT`]) are `want`: each
+/// brick's coarse distance is the brute-force chessboard distance over
+/// the bricks, and each stand-in is the larger of the coarse bound and the
+/// line's least stored distance (EMPTY at [`NEAR_LIMIT`]), EMPTY where a
+/// cell is within 1 or the bound is below 2; never above the line's
+/// least exact distance.
+fn check_line_level(e: Extent, plane: &[u8], want: &[u8], what: &str) {
+    let raster = Raster::new(e, plane).unwrap();
+    let ce = coarse_extent(e).unwrap();
+    let mut bricks = vec![0xffu8; ce.len()];
+    let mut lines = vec![0xffu8; line_count(e.len())];
+    line_distances(&raster, &mut bricks, &mut lines).unwrap();
+    // Brute force over the bricks.
+    let occupied: Vec<[u32; 3]> = (0..e.len())
+        .filter(|&i| want[i] == 0)
+        .map(|i| e.coord(i).unwrap().map(|c| c / COARSE_EDGE))
+        .collect();
+    let brick_want = brute(ce, &occupied);
+    for (b, (&got, &w)) in bricks.iter().zip(&brick_want).enumerate() {
+        let stored = if w < NEAR_LIMIT { w } else { 0 };
+        assert_eq!(distance(got), stored, "{what}: brick {b}");
+        assert_eq!(got & cell::OPAQUE != 0, w == 0, "{what}: brick {b}");
+    }
+    let [nx, ny, _] = e.dims();
+    let [cx, cy, _] = ce.dims();
+    for (l, &got) in lines.iter().enumerate() {
+        let cells = l * LINE_CELLS..((l + 1) * LINE_CELLS).min(e.len());
+        let exact = cells.clone().map(|i| want[i]).min().unwrap();
+        let bound = cells
+            .clone()
+            .map(|i| {
+                let i = u32::try_from(i).unwrap();
+                let (x, y, z) = (i % nx, i / nx % ny, i / nx / ny);
+                let b = (z / 8 * cy + y / 8) * cx + x / 8;
+                let k = u32::from(brick_want[b as usize].min(NEAR_LIMIT));
+                if k == 0 { 0 } else { (8 * (k - 1) + 1).min(63) }
+            })
+            .min()
+            .unwrap();
+        let bound = u8::try_from(bound).unwrap();
+        let expect = if bound >= NEAR_LIMIT {
+            bound << cell::DISTANCE_SHIFT
+        } else if exact <= 1 {
+            cell::EMPTY
+        } else {
+            let d = exact.min(NEAR_LIMIT).max(bound);
+            d << cell::DISTANCE_SHIFT
+        };
+        assert_eq!(got, expect, "{what}: line {l}");
+        assert!(distance(got) <= exact, "{what}: line {l} above its cells");
     }
 }
 
 #[test]
-fn distances_saturate_at_the_limit() {
+fn distances_stop_at_the_near_limit() {
     let e = Extent::new(150, 3, 2).unwrap();
     let mut plane = vec![cell::EMPTY; e.len()];
     plane[e.index([0, 1, 1]).unwrap()] = cell::OPAQUE;
     distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
-    let at = |x| distance(plane[e.index([x, 0, 0]).unwrap()]);
+    let at = |x| plane[e.index([x, 0, 0]).unwrap()];
     assert_eq!(
-        (at(1), at(62), at(63), at(64), at(149)),
-        (1, 62, 63, 63, 63)
+        (at(1), at(15), at(16), at(149)),
+        (1 << 2 | cell::PROXIMITY, 15 << 2, cell::EMPTY, cell::EMPTY)
     );
     let mut empty = vec![cell::EMPTY; e.len()];
     distance_field(&mut RasterMut::new(e, &mut empty).unwrap());
-    assert!(
-        empty
-            .iter()
-            .all(|&c| distance(c) == DISTANCE_LIMIT && c & cell::PROXIMITY == 0)
-    );
+    assert!(empty.iter().all(|&c| c == cell::EMPTY));
+}
+
+/// A lone voxel in rasters larger than the near limit and several bricks
+/// wide: the field is empty from the limit on, and the line level bounds
+/// those lines from the coarse level (jumps up to the most a cell holds),
+/// including rasters whose rows are not whole lines.
+#[test]
+fn far_lines_are_bounded_by_the_coarse_level() {
+    for dims in [[64, 64, 64], [200, 30, 20], [37, 90, 41], [5, 7, 300]] {
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let at = [[3, 5, 6], [150, 2, 19], [36, 0, 20], [4, 6, 150]];
+        for v in at.into_iter().filter(|&v| e.contains(v)) {
+            let mut plane = vec![cell::EMPTY; e.len()];
+            plane[e.index(v).unwrap()] = cell::OPAQUE;
+            distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+            let want = brute(e, &[v]);
+            for (i, &c) in plane.iter().enumerate() {
+                if want[i] >= NEAR_LIMIT {
+                    assert_eq!(c, cell::EMPTY, "{dims:?} {v:?} {:?}", e.coord(i));
+                }
+            }
+            check_line_level(e, &plane, &want, &std::format!("{dims:?} {v:?}"));
+        }
+    }
 }
 
 /// The reference: the whole-plane two-pass sequential chamfer transform
@@ -130,7 +187,11 @@ fn chamfer_field(raster: &mut RasterMut<'_>) {
         let d = *c;
         let opaque = if d == 0 { cell::OPAQUE } else { 0 };
         let flag = if d <= 1 { cell::PROXIMITY } else { 0 };
-        *c = opaque | flag | (d << cell::DISTANCE_SHIFT);
+        *c = if d >= NEAR_LIMIT {
+            cell::EMPTY
+        } else {
+            opaque | flag | (d << cell::DISTANCE_SHIFT)
+        };
     }
 }
 
@@ -349,7 +410,10 @@ fn distance_field_is_exact_where_the_relaxations_are_skipped() {
         distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
         assert_eq!(plane, want, "{dims:?} {at:?}");
         assert_eq!(
-            brute(e, &at),
+            brute(e, &at)
+                .iter()
+                .map(|&d| if d < NEAR_LIMIT { d } else { 0 })
+                .collect::<Vec<_>>(),
             plane.iter().map(|&c| distance(c)).collect::<Vec<_>>()
         );
     }

@@ -111,7 +111,9 @@ use crate::render::MAX_SIDE;
 use crate::scene::{Material, SourceLoc, View, ViewDefect};
 use crate::shape::{SLOTS, Shape, Slots};
 use crate::voxelize::plane::Plane;
-use crate::voxelize::{MAX_MATERIALS, VoxelScene, derive_plane, line_level, plane_matches_records};
+use crate::voxelize::{
+    MAX_MATERIALS, VoxelScene, derive_plane, line_level, line_level_of_plane, plane_matches_records,
+};
 use crate::voxelize::{WorldLight, WorldObject};
 
 /// The file's first bytes.
@@ -1660,6 +1662,9 @@ struct Raster {
     directory: Vec<u32>,
     records: Vec<VoxelRecord>,
     lists: Vec<u32>,
+    /// Whether the plane is the records' derived plane, no brick stored
+    /// over it (its opaque voxels are then exactly the records').
+    derived: bool,
 }
 
 /// [`load_with`] from the bytes of a file, named `path` in errors.
@@ -1699,6 +1704,7 @@ fn load_from(
         directory,
         records,
         lists,
+        derived,
     } = if h.version == 3 {
         load_sparse(bytes, path, &h, &m, extent, progress, max_memory)?
     } else {
@@ -1743,6 +1749,7 @@ fn load_from(
                 .map(record_from)
                 .collect(),
             lists: words(raw(7)?),
+            derived: false,
         }
     };
     let materials = materials_from(raw(5)?).map_err(invalid)?;
@@ -1771,7 +1778,13 @@ fn load_from(
         separation: m.separation,
         exact: m.exact,
         exact_records: m.exact_records,
-        lines: line_level(extent, &plane),
+        // The coarse level from the records where they are the opaque
+        // voxels by construction, else from the plane's cells.
+        lines: if derived {
+            line_level(extent, &plane, &directory)
+        } else {
+            line_level_of_plane(extent, &plane)
+        },
         plane,
         directory,
         records,
@@ -1921,6 +1934,7 @@ fn load_sparse(
         directory,
         records,
         lists,
+        derived: bricks.is_empty(),
     })
 }
 
@@ -2095,7 +2109,7 @@ mod tests {
             let bytes = save_bytes_as(&s, Path::new("t.rrt"), format).unwrap();
             let back = load_bytes(Path::new("t.rrt"), &bytes).unwrap();
             assert_eq!(&back.plane[..], &s.plane[..]);
-            assert_eq!(back.lines, line_level(e, &s.plane));
+            assert_eq!(back.lines, line_level(e, &s.plane, &s.directory));
         }
     }
 

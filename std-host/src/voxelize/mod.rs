@@ -63,7 +63,7 @@ use rrt_core::voxelize::error::VoxelizeError;
 pub use self::materials::MAX_MATERIALS;
 pub use self::voxel_scene::{
     DERIVE_MARGIN, VoxelScene, WorldLight, WorldObject, derive_plane, finish_plane, line_level,
-    plane_matches_records,
+    line_level_of_plane, plane_matches_records,
 };
 
 use self::light::LightScene;

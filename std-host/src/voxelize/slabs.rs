@@ -386,10 +386,14 @@ impl Passes<'_> {
             let rows = pc.rows.end.saturating_sub(pc.rows.start) as usize;
             for (z, layer) in pc.layers.clone().zip(own.chunks_exact(row * rows)) {
                 let at = (z as usize * ny as usize + pc.rows.start as usize) * row;
-                plane
-                    .get_mut(at..at + layer.len())
-                    .ok_or_else(bad)?
-                    .copy_from_slice(layer);
+                let dst = plane.get_mut(at..at + layer.len()).ok_or_else(bad)?;
+                // Only the pages that hold something: the raster's are
+                // zero, and untouched pages stay unbacked.
+                for (d, s) in dst.chunks_mut(4096).zip(layer.chunks(4096)) {
+                    if s.iter().any(|&c| c != 0) {
+                        d.copy_from_slice(s);
+                    }
+                }
             }
         }
         drop(band_planes);

@@ -9,8 +9,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rrt_core::light::ExactRecords;
 use rrt_core::proximity::field::{self, Area};
-use rrt_core::proximity::line_stand_ins;
-use rrt_core::raster::{Extent, LINE_CELLS, Raster, RasterMut, cell, line_count};
+use rrt_core::proximity::{coarse_extent, coarse_level, line_stand_ins};
+use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 use rrt_core::store::{BRICK, RecordStore, StoreError, brick_dims, rank_hint, write_rank_hints};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
@@ -156,21 +156,22 @@ pub fn finish_plane(
     if plane.len() != extent.len() {
         return Vec::new();
     }
-    distance_field(extent, plane);
+    let rows = BrickRows::of(extent, directory, 0);
+    distance_field(extent, plane, rows.as_ref());
     if let Ok(mut raster) = RasterMut::new(extent, plane)
         && let Ok(store) = RecordStore::with_lists(extent, directory, records, lists)
     {
         write_rank_hints(&mut raster, &store);
     }
-    line_level(extent, plane)
+    line_level(extent, plane, directory)
 }
 
 /// Slices around a run of slices whose opaque voxels decide the run's
-/// finished cells: the distance field saturates at
-/// [`DISTANCE_LIMIT`](rrt_core::proximity::DISTANCE_LIMIT), so an opaque
-/// voxel this many slices away or more changes nothing (a multiple of the
-/// brick edge, so that the slices are whole brick layers).
-pub const DERIVE_MARGIN: u32 = 64;
+/// finished cells: the distance field stops at
+/// [`NEAR_LIMIT`](rrt_core::proximity::NEAR_LIMIT), so an opaque voxel
+/// this many slices away or more changes nothing (a multiple of the brick
+/// edge, so that the slices are whole brick layers).
+pub const DERIVE_MARGIN: u32 = 16;
 
 /// The finished plane ([`finish_plane`]) of the raster whose opaque voxels
 /// are exactly the records' (`directory`, `records` and `lists` a valid
@@ -207,7 +208,8 @@ pub fn derive_plane(
     for (i, _) in cells() {
         plane[i - offset] = cell::OPAQUE;
     }
-    distance_field(sub, &mut plane);
+    let rows = BrickRows::of(extent, directory, z0);
+    distance_field(sub, &mut plane, rows.as_ref());
     for (i, hint) in cells() {
         let i = i - offset;
         plane[i] = (plane[i] & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
@@ -293,16 +295,74 @@ pub fn plane_matches_records(
 /// Boxes of fewer cells than this are relaxed on one thread.
 const PARALLEL_CELLS: usize = 1 << 15;
 
+/// The brick rows (a z-layer and y-row of bricks) of a raster that hold a
+/// record or lie beside one that does, from its store's directory: the
+/// plane rows outside them hold no opaque voxel, and in a plane as the
+/// builder or the loader leaves it (opaque cells and the PROXIMITY flags
+/// around them) nothing at all.
+struct BrickRows {
+    /// Per brick row, `bz · by + by_row`: whether a brick of it, or of a
+    /// brick row beside it (±1 in y and z), holds a record.
+    held: Vec<bool>,
+    /// Brick rows per brick layer.
+    by: usize,
+    /// The first slice of the plane the field is computed over (a
+    /// multiple of the brick edge).
+    z0: usize,
+}
+
+impl BrickRows {
+    /// From a valid directory over `extent`, for a plane starting at
+    /// slice `z0`; `None` if the directory does not match.
+    fn of(extent: Extent, directory: &[u32], z0: u32) -> Option<Self> {
+        let [bx, by, bz] = brick_dims(extent).map(|b| b as usize);
+        if directory.len() != bx * by * bz + 1 {
+            return None;
+        }
+        let own: Vec<bool> = directory
+            .windows(2)
+            .collect::<Vec<_>>()
+            .chunks(bx)
+            .map(|row| row.iter().any(|w| w[0] < w[1]))
+            .collect();
+        let at = |y: usize, z: usize| own.get(z * by + y).copied().unwrap_or(false);
+        let held = (0..bz * by)
+            .map(|b| {
+                let (y, z) = (b % by, b / by);
+                (y.saturating_sub(1)..=(y + 1).min(by - 1))
+                    .any(|yy| (z.saturating_sub(1)..=(z + 1).min(bz - 1)).any(|zz| at(yy, zz)))
+            })
+            .collect();
+        Some(Self {
+            held,
+            by,
+            z0: z0 as usize,
+        })
+    }
+
+    /// Whether row `y` of slice `z` (of the plane) may hold an opaque voxel.
+    fn may_hold(&self, z: usize, y: usize) -> bool {
+        let b = (self.z0 + z) / BRICK as usize * self.by + y / BRICK as usize;
+        self.held.get(b).copied().unwrap_or(true)
+    }
+}
+
 /// The distance field of `plane` (as long as `extent`) on the current
 /// rayon pool: the core's steps ([`field`]) with the slices of step 1
 /// shared out, then the rows of each slice in steps 2 and 3, each slice
-/// relaxed only over the box its neighbours' opaque voxels reach.
-fn distance_field(extent: Extent, plane: &mut [u8]) {
+/// relaxed only over the box its neighbours' opaque voxels reach. With
+/// `rows`, a fresh plane whose opaque voxels lie in those brick rows: the
+/// other rows are not read where no opaque voxel is near.
+fn distance_field(extent: Extent, plane: &mut [u8], rows: Option<&BrickRows>) {
     let [nx, ny, nz] = extent.dims().map(|d| d as usize);
     let slice = nx * ny;
     let opaque: Vec<Area> = plane
         .par_chunks_mut(slice)
-        .map(|s| field::slice_distances(s, nx))
+        .enumerate()
+        .map(|(z, s)| match rows {
+            Some(r) => field::slice_distances_in(s, nx, |y| r.may_hold(z, y)),
+            None => field::slice_distances(s, nx),
+        })
         .collect();
     let reach = field::FIELD_REACH as usize;
     let reached = |zs: std::ops::Range<usize>| {
@@ -349,24 +409,66 @@ fn relax_slice(plane: &mut [u8], [nx, ny]: [usize; 2], z: usize, from: usize, ar
         .for_each(|(i, rows)| field::relax_rows(rows, src, nx, y0 + i * band, area));
 }
 
-/// The line level of a plane over `extent`
-/// ([`line_distances`](rrt_core::proximity::line_distances)): one
-/// stand-in cell per 64 cells, which lets skipping walks stay off the plane
-/// far from surfaces; on the current rayon pool. Empty if the plane does
-/// not match the extent.
+/// The line level of a plane over `extent` with its distance field
+/// ([`line_stand_ins`]): one stand-in cell per 64 cells, which lets
+/// skipping walks stay off the plane far from surfaces, from the coarse
+/// level of the bricks holding records (`directory`, the record store's:
+/// a built or derived plane's opaque voxels are exactly its records'); on
+/// the current rayon pool. Empty if the plane or the directory does not
+/// match the extent.
 #[must_use]
-pub fn line_level(extent: Extent, plane: &[u8]) -> Vec<u8> {
-    if plane.len() != extent.len() {
+pub fn line_level(extent: Extent, plane: &[u8], directory: &[u32]) -> Vec<u8> {
+    let Ok(coarse) = coarse_extent(extent) else {
+        return Vec::new();
+    };
+    if plane.len() != extent.len()
+        || coarse.dims() != brick_dims(extent)
+        || directory.len() != coarse.len() + 1
+    {
         return Vec::new();
     }
+    let mut bricks: Vec<u8> = directory
+        .windows(2)
+        .map(|w| {
+            if w[0] < w[1] {
+                cell::OPAQUE
+            } else {
+                cell::EMPTY
+            }
+        })
+        .collect();
+    distance_field(coarse, &mut bricks, None);
+    stand_ins(extent, plane, &bricks)
+}
+
+/// [`line_level`] for a plane whose opaque voxels are not known to be the
+/// records' (a dense saved plane): the coarse level from the plane's own
+/// cells.
+#[must_use]
+pub fn line_level_of_plane(extent: Extent, plane: &[u8]) -> Vec<u8> {
+    let (Ok(coarse), Ok(raster)) = (coarse_extent(extent), Raster::new(extent, plane)) else {
+        return Vec::new();
+    };
+    let mut bricks = vec![cell::EMPTY; coarse.len()];
+    if coarse_level(&raster, &mut bricks).is_err() {
+        return Vec::new();
+    }
+    stand_ins(extent, plane, &bricks)
+}
+
+/// The stand-ins of every line from the coarse level `bricks`, in parts
+/// on the current rayon pool.
+fn stand_ins(extent: Extent, plane: &[u8], bricks: &[u8]) -> Vec<u8> {
+    let Ok(raster) = Raster::new(extent, plane) else {
+        return Vec::new();
+    };
     let mut lines = vec![0u8; line_count(plane.len())];
-    // Parts of whole lines.
     const LINES_PER_PART: usize = 1 << 12;
-    lines
+    let ok = lines
         .par_chunks_mut(LINES_PER_PART)
-        .zip(plane.par_chunks(LINES_PER_PART * LINE_CELLS))
-        .for_each(|(l, cells)| line_stand_ins(cells, l));
-    lines
+        .enumerate()
+        .all(|(k, l)| line_stand_ins(&raster, bricks, k * LINES_PER_PART, l).is_ok());
+    if ok { lines } else { Vec::new() }
 }
 
 /// One entry of the world object table.

@@ -165,7 +165,10 @@ mod firmware {
             let (_, b) = stack_use(WINDOW, || distance_field(&mut r));
             worst.note("distance_field", b);
             let mut l = [0u8; traversal::LINES_LEN];
-            let (_, b) = stack_use(WINDOW, || line_distances(&r.as_raster(), &mut l));
+            let mut bricks = [0u8; traversal::BRICKS_LEN];
+            let (_, b) = stack_use(WINDOW, || {
+                line_distances(&r.as_raster(), &mut bricks, &mut l)
+            });
             worst.note("line_distances", b);
         }
         scene::voxelizer_probe(&mut |name, f| {
