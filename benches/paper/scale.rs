@@ -256,15 +256,18 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
             .map(|d| d.parse::<f64>().unwrap_or(f64::NAN))
             .product();
         md.para(&format!(
-            "What bounds these figures: the plane, one byte per voxel of the raster's box ({} \
-             GiB at raster {}), made in full when a raster is built and again when it is \
-             loaded. It is most of the peak memory, and its derivation (the distance field, \
-             the line level) most of the load time. The \
-             light visibility phase walks the tube of every surface voxel towards every light: \
-             the surface voxels grow with the square of the raster's side and the walks with \
-             the side. The render takes more steps per ray as the voxels shrink (jumps through \
-             empty space are bounded by the distance field's 63 voxels) and its plane reads \
-             miss the caches more often.",
+            "What bounds these figures: the plane is one byte per voxel of the raster's box \
+             in address space ({} GiB at raster {}), but only its pages within 16 voxels of a \
+             surface are ever written (the distance field leaves farther cells empty; skipping \
+             there reads the line level and the coarse level over 8³ bricks). The plane asks \
+             the kernel for 2 MiB pages, so a written cell brings its whole 2 MiB page in: that \
+             resident part of the plane is still most of the peak memory, and the kernel's \
+             zeroing of those pages the largest part of the load time, before the line level \
+             (profiled at 4096). The light visibility phase walks the tube of every surface \
+             voxel towards every light: the surface voxels grow with the square of the raster's \
+             side and the walks with the side. The render takes more steps per ray as the \
+             voxels shrink (jumps through empty space are bounded by the line level's 63 \
+             voxels) and its plane reads miss the caches more often.",
             f(cells / f64::from(1u32 << 30), 1),
             largest.raster
         ));

@@ -67,7 +67,8 @@ const CHUNK: usize = 256;
 #[inline]
 pub(super) const fn nearer(a: u8, b: u8) -> u8 {
     let (ka, kb) = (a.wrapping_sub(1), b.wrapping_sub(1));
-    if ka <= kb { a } else { b }
+    // The smaller key, mapped back: a minimum, which vectorizes.
+    (if ka <= kb { ka } else { kb }).wrapping_add(1)
 }
 
 /// The finished cell of a transparent voxel at distance `d ≥ 1`.
@@ -85,16 +86,17 @@ const fn at_distance(d: u8) -> u8 {
 /// beyond a far cell), with PROXIMITY at 1.
 #[inline]
 const fn one_beyond(n: u8) -> u8 {
-    if n == FAR {
-        return FAR;
-    }
-    let bits = (n & DISTANCE_BITS).saturating_add(STEP);
-    if bits >= NEAR_BITS {
-        FAR
-    } else if bits == STEP {
+    // Selects only (no early return), so that it vectorizes.
+    let bits = (n & DISTANCE_BITS).wrapping_add(STEP);
+    let flagged = if bits == STEP {
         bits | cell::PROXIMITY
     } else {
         bits
+    };
+    if n != FAR && bits < NEAR_BITS {
+        flagged
+    } else {
+        FAR
     }
 }
 
@@ -102,7 +104,12 @@ const fn one_beyond(n: u8) -> u8 {
 /// changes (so unchanged memory is only read).
 #[inline]
 fn lower(seg: &mut [u8], offer: &[u8]) {
-    if seg.iter().zip(offer).any(|(&c, &o)| nearer(c, o) != c) {
+    // Whether an offer is nearer than its cell, without an early exit (a
+    // reduction, which vectorizes).
+    let changed = seg.iter().zip(offer).fold(false, |acc, (&c, &o)| {
+        acc | (o.wrapping_sub(1) < c.wrapping_sub(1))
+    });
+    if changed {
         for (c, &o) in seg.iter_mut().zip(offer) {
             *c = nearer(*c, o);
         }
@@ -446,7 +453,7 @@ fn fill_gap(gap: &mut [u8], left: bool, right: bool) {
         let from_right = if right { n.wrapping_sub(i) } else { usize::MAX };
         *c = at_distance(u8::try_from(from_left.min(from_right)).unwrap_or(NEAR_LIMIT));
     }
-    if m.iter().any(|&c| c != FAR) {
+    if m.iter().fold(0u8, |acc, &c| acc | c) != FAR {
         m.fill(FAR);
     }
     // Distances …, 2, 1 to the right end (the left one is farther here).

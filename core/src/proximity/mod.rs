@@ -218,22 +218,23 @@ pub fn coarse_extent(extent: Extent) -> Result<Extent, RasterError> {
 }
 
 /// Computes the raster's coarse level: per brick of [`COARSE_EDGE`]³
-/// voxels (x fastest, as the plane), [`cell::OPAQUE`] where the brick holds
-/// an opaque voxel, then the distance field of those marks over the bricks
-/// ([`coarse_field`]). A voxel of a brick at coarse distance `k ≥ 1` is at
-/// least `8·(k − 1) + 1` voxels from every opaque voxel
-/// ([`line_distances`] turns that into jumps).
+/// voxels (x fastest, as the plane), a lower bound on the chessboard
+/// distance from each of its voxels to an opaque voxel, at most
+/// [`DISTANCE_LIMIT`]: 0 where the brick holds one, `8·(k − 1) + 1` at
+/// brick distance `k ≥ 1` from the nearest brick that does (the marks'
+/// distance field over the bricks, [`coarse_field`]). [`line_distances`]
+/// turns it into jumps.
 ///
 /// ```
-/// use rrt_core::proximity::{coarse_extent, coarse_level, distance};
+/// use rrt_core::proximity::{coarse_extent, coarse_level};
 /// use rrt_core::raster::{cell, Extent, Raster};
 /// let e = Extent::new(64, 8, 8).unwrap();
 /// let mut plane = vec![cell::EMPTY; e.len()];
 /// plane[e.index([3, 0, 0]).unwrap()] = cell::OPAQUE;
 /// let mut bricks = vec![0u8; coarse_extent(e).unwrap().len()];
 /// coarse_level(&Raster::new(e, &plane).unwrap(), &mut bricks).unwrap();
-/// assert_ne!(bricks[0] & cell::OPAQUE, 0);
-/// assert_eq!(distance(bricks[5]), 5);
+/// // Bricks 0..8 along x: the opaque voxel's, then 1, 9, 17, … voxels away.
+/// assert_eq!(bricks, [0, 1, 9, 17, 25, 33, 41, 49]);
 /// ```
 ///
 /// # Errors
@@ -289,8 +290,9 @@ const fn brick_row(row: usize, [ny, cx, cy]: [usize; 3]) -> usize {
 
 /// The coarse level from its marks: `bricks` holds [`cell::OPAQUE`] in the
 /// bricks of `extent` that hold an opaque voxel (other bits ignored), and
-/// gets their distance field ([`distance_field`] over the bricks). A
-/// caller that knows the occupied bricks (a record store's directory)
+/// gets the coarse level ([`coarse_level`]): their distance field
+/// ([`distance_field`] over the bricks) made bounds ([`coarse_bounds`]).
+/// A caller that knows the occupied bricks (a record store's directory)
 /// marks them and calls this.
 ///
 /// # Errors
@@ -300,7 +302,18 @@ pub fn coarse_field(extent: Extent, bricks: &mut [u8]) -> Result<(), RasterError
     let coarse = coarse_extent(extent)?;
     check_len(coarse.len(), bricks.len())?;
     distance_field(&mut RasterMut::new(coarse, bricks)?);
+    coarse_bounds(bricks);
     Ok(())
+}
+
+/// Turns the bricks' distance field (cells of [`distance_field`] over the
+/// bricks) into the coarse level's bounds in voxels ([`coarse_level`]), in
+/// place. A caller computing the field its own way (on threads) ends with
+/// this.
+pub fn coarse_bounds(bricks: &mut [u8]) {
+    for b in bricks {
+        *b = brick_bound(*b);
+    }
 }
 
 /// [`RasterError::LineLength`] unless `found == expected`.
@@ -414,11 +427,6 @@ pub fn line_stand_ins(
     if nx == 0 {
         return Ok(());
     }
-    // Each coarse cell's bound, looked up.
-    let mut bounds = [0u8; 256];
-    for (c, b) in (0..=u8::MAX).zip(bounds.iter_mut()) {
-        *b = brick_bound(c);
-    }
     // The first cell's position, then advanced line by line (no division
     // per line).
     let (mut x, row) = (start.checked_rem(nx).unwrap_or(0), div(start, nx));
@@ -439,9 +447,8 @@ pub fn line_stand_ins(
                 .wrapping_mul(cx);
             let first_brick = base.wrapping_add(div(px, edge));
             let last_brick = base.wrapping_add(div(px.wrapping_add(piece).wrapping_sub(1), edge));
-            for &b in bricks.get(first_brick..=last_brick).unwrap_or(&[]) {
-                bound = bound.min(bounds.get(usize::from(b)).copied().unwrap_or(0));
-            }
+            let least = bricks.get(first_brick..=last_brick).unwrap_or(&[]);
+            bound = least.iter().fold(bound, |a, &b| a.min(b));
             at = at.wrapping_add(piece);
             px = 0;
             (py, pz) = next_row(py, pz, ny);
@@ -454,7 +461,12 @@ pub fn line_stand_ins(
             // distance bits alone (EMPTY the farthest), and the nearest cell
             // holds the least distance.
             let any = cells.iter().fold(0u8, |a, &c| a | c);
-            let least = cells.iter().fold(field::FAR, |a, &c| field::nearer(a, c));
+            // `nearer` over the line, as a plain minimum of `c − 1`
+            // (wrapping: EMPTY last), which vectorizes.
+            let least = cells
+                .iter()
+                .fold(u8::MAX, |a, &c| a.min(c.wrapping_sub(1)))
+                .wrapping_add(1);
             let d = if least == cell::EMPTY {
                 NEAR_LIMIT
             } else {

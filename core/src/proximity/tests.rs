@@ -90,10 +90,12 @@ fn check_line_level(e: Extent, plane: &[u8], want: &[u8], what: &str) {
         .map(|i| e.coord(i).unwrap().map(|c| c / COARSE_EDGE))
         .collect();
     let brick_want = brute(ce, &occupied);
+    let brick_bound = |k: u8| {
+        let k = u32::from(k.min(NEAR_LIMIT));
+        u8::try_from(if k == 0 { 0 } else { (8 * (k - 1) + 1).min(63) }).unwrap()
+    };
     for (b, (&got, &w)) in bricks.iter().zip(&brick_want).enumerate() {
-        let stored = if w < NEAR_LIMIT { w } else { 0 };
-        assert_eq!(distance(got), stored, "{what}: brick {b}");
-        assert_eq!(got & cell::OPAQUE != 0, w == 0, "{what}: brick {b}");
+        assert_eq!(got, brick_bound(w), "{what}: brick {b}");
     }
     let [nx, ny, _] = e.dims();
     let [cx, cy, _] = ce.dims();
@@ -106,12 +108,10 @@ fn check_line_level(e: Extent, plane: &[u8], want: &[u8], what: &str) {
                 let i = u32::try_from(i).unwrap();
                 let (x, y, z) = (i % nx, i / nx % ny, i / nx / ny);
                 let b = (z / 8 * cy + y / 8) * cx + x / 8;
-                let k = u32::from(brick_want[b as usize].min(NEAR_LIMIT));
-                if k == 0 { 0 } else { (8 * (k - 1) + 1).min(63) }
+                brick_bound(brick_want[b as usize])
             })
             .min()
             .unwrap();
-        let bound = u8::try_from(bound).unwrap();
         let expect = if bound >= NEAR_LIMIT {
             bound << cell::DISTANCE_SHIFT
         } else if exact <= 1 {

@@ -9,7 +9,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rrt_core::light::ExactRecords;
 use rrt_core::proximity::field::{self, Area};
-use rrt_core::proximity::{coarse_extent, coarse_level, line_stand_ins};
+use rrt_core::proximity::{coarse_bounds, coarse_extent, coarse_level, line_stand_ins};
 use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
 use rrt_core::store::{BRICK, RecordStore, StoreError, brick_dims, rank_hint, write_rank_hints};
 use rrt_core::voxel::VoxelRecord;
@@ -438,6 +438,7 @@ pub fn line_level(extent: Extent, plane: &[u8], directory: &[u32]) -> Vec<u8> {
         })
         .collect();
     distance_field(coarse, &mut bricks, None);
+    coarse_bounds(&mut bricks);
     stand_ins(extent, plane, &bricks)
 }
 
