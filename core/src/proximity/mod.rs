@@ -186,12 +186,6 @@ pub const fn dilated(c: u8) -> u8 {
 /// Edge of the coarse level's bricks, in voxels ([`coarse_level`]).
 pub const COARSE_EDGE: u32 = 8;
 
-/// Bricks of the coarse level of `extent` per axis: `ceil(n / 8)`.
-#[must_use]
-pub fn coarse_dims(extent: Extent) -> [u32; 3] {
-    extent.dims().map(|n| n.div_ceil(COARSE_EDGE))
-}
-
 /// Cells of the coarse level of a raster of `dims` voxels (saturating):
 /// the length of the `bricks` buffer [`line_distances`] takes, as a
 /// constant for static storage.
@@ -208,12 +202,13 @@ pub const fn coarse_cells(dims: [u32; 3]) -> usize {
         .saturating_mul(z.div_ceil(COARSE_EDGE) as usize)
 }
 
-/// The coarse level's extent ([`coarse_dims`]; never empty).
+/// The coarse level's extent: `ceil(n / 8)` bricks per axis (never
+/// empty).
 ///
 /// # Errors
 /// None for a valid extent (kept fallible for the checked constructor).
 pub fn coarse_extent(extent: Extent) -> Result<Extent, RasterError> {
-    let [x, y, z] = coarse_dims(extent);
+    let [x, y, z] = extent.dims().map(|n| n.div_ceil(COARSE_EDGE));
     Extent::new(x, y, z)
 }
 

@@ -295,6 +295,11 @@ pub fn plane_matches_records(
 /// Boxes of fewer cells than this are relaxed on one thread.
 const PARALLEL_CELLS: usize = 1 << 15;
 
+/// Per brick of a record store's directory, whether it holds a record.
+fn holds_records(directory: &[u32]) -> impl Iterator<Item = bool> + '_ {
+    directory.windows(2).map(|w| w[0] < w[1])
+}
+
 /// The brick rows (a z-layer and y-row of bricks) of a raster that hold a
 /// record or lie beside one that does, from its store's directory: the
 /// plane rows outside them hold no opaque voxel, and in a plane as the
@@ -319,12 +324,8 @@ impl BrickRows {
         if directory.len() != bx * by * bz + 1 {
             return None;
         }
-        let own: Vec<bool> = directory
-            .windows(2)
-            .collect::<Vec<_>>()
-            .chunks(bx)
-            .map(|row| row.iter().any(|w| w[0] < w[1]))
-            .collect();
+        let bricks: Vec<bool> = holds_records(directory).collect();
+        let own: Vec<bool> = bricks.chunks(bx).map(|row| row.contains(&true)).collect();
         let at = |y: usize, z: usize| own.get(z * by + y).copied().unwrap_or(false);
         let held = (0..bz * by)
             .map(|b| {
@@ -427,15 +428,8 @@ pub fn line_level(extent: Extent, plane: &[u8], directory: &[u32]) -> Vec<u8> {
     {
         return Vec::new();
     }
-    let mut bricks: Vec<u8> = directory
-        .windows(2)
-        .map(|w| {
-            if w[0] < w[1] {
-                cell::OPAQUE
-            } else {
-                cell::EMPTY
-            }
-        })
+    let mut bricks: Vec<u8> = holds_records(directory)
+        .map(|held| if held { cell::OPAQUE } else { cell::EMPTY })
         .collect();
     distance_field(coarse, &mut bricks, None);
     coarse_bounds(&mut bricks);
