@@ -15,6 +15,7 @@ use rrt_host::render::{Image, RenderOptions, render};
 use rrt_host::scene::Scene;
 use rrt_host::shape::{Shape, Surface};
 use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+use rrt_host::voxelize::light::ShadowLevel;
 use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
 use rrt_host::world::Ray;
 use rrt_tests::Rng;
@@ -218,6 +219,9 @@ fn on_demand_classification_is_the_pass_classification() {
         let vs = exact(&nff, 40, ExactRecords::Classify);
         let raster = vs.raster().unwrap();
         let store = vs.store().unwrap();
+        let level = ShadowLevel::of(&store).unwrap();
+        let bricks = level.bricks(&store);
+        assert!(bricks.is_some());
         let lights: Vec<[i64; 3]> = vs
             .lights
             .iter()
@@ -236,8 +240,16 @@ fn on_demand_classification_is_the_pass_classification() {
                     Shape::Sphere(s) => s.to_fixed(&vs.frame).ok(),
                     _ => None,
                 };
-                let got = classify_voxel(&raster, &store, shape, v, rec, light).unwrap();
+                let got = classify_voxel(&raster, &store, None, shape, v, rec, light).unwrap();
                 assert_eq!(got, rec.light(k), "seed {seed}: voxel {v:?}, light {k}");
+                // With the brick level, as a renderer asks: the same.
+                let got =
+                    classify_voxel(&raster, &store, bricks.as_ref(), shape, v, rec, light).unwrap();
+                assert_eq!(
+                    got,
+                    rec.light(k),
+                    "seed {seed}: voxel {v:?}, light {k}, bricks"
+                );
                 compared += 1;
             }
         }

@@ -154,6 +154,7 @@ pub fn build(
                         &mats,
                         &lights,
                         &params,
+                        None,
                     )
                 })
                 .collect()

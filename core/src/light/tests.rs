@@ -504,6 +504,7 @@ fn runs_in_any_order_equal_the_serial_pass() {
             &w.materials,
             &w.lights,
             &LightParams::default(),
+            None,
         )
         .unwrap();
         report.add(&r);
@@ -600,7 +601,8 @@ fn classification_is_the_tube_rule() {
                     };
                     for &light in &lights {
                         // No shapes: the tube rule alone.
-                        let got = classify_voxel(&raster, &store, |_| None, v, rec, light).unwrap();
+                        let got =
+                            classify_voxel(&raster, &store, None, |_| None, v, rec, light).unwrap();
                         let want = tube_rule(&raster, &store, v, light);
                         assert_eq!(
                             got == LightVisibility::Visible,
@@ -620,6 +622,201 @@ fn classification_is_the_tube_rule() {
     assert!(
         lit > 1000 && undecided > 1000,
         "{lit} lit, {undecided} undecided"
+    );
+}
+
+/// The brick level changes no classification and spares walks: on random
+/// scenes of a few large balls (surfaces of one object over many bricks)
+/// and small ones beside them, in rasters of several bricks whose sides
+/// are not multiples of the brick edge, with lights inside and outside,
+/// [`classify_voxel`] with the level gives the tube rule's answer for
+/// every voxel and light, and the level proves a good part of them lit.
+#[test]
+fn brick_level_changes_no_classification() {
+    use super::bricks::{NO_RECORD, SEVERAL, ShadowBricks, shadow_bricks};
+    let mut rng = testkit::Rng(0xb1c4_5ead);
+    let (mut proven, mut lit, mut pairs) = (0u32, 0u32, 0u32);
+    for _ in 0..12 {
+        let dims = [0; 3].map(|_| 20 + rng.below_u32(21));
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let mut balls: Vec<([i64; 3], i64)> = Vec::new();
+        for big in 0..2 + rng.below(4) {
+            let c = dims.map(|n| rng.range(0, i64::from(n) * VOXEL));
+            let r = if big < 2 {
+                rng.range(6 * VOXEL, 14 * VOXEL)
+            } else {
+                rng.range(VOXEL / 2, 2 * VOXEL)
+            };
+            balls.push((c, r));
+        }
+        let shapes: Vec<_> = balls
+            .iter()
+            .map(|&(c, r)| {
+                move |s: &mut dyn VoxelSink| testkit::sphere(e, c, r, Separation::TwentySix, s)
+            })
+            .collect();
+        let objects: Vec<Voxelize<'_>> = shapes
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (attrs(i as u32, 0), f as &dyn Fn(&mut dyn VoxelSink)))
+            .collect();
+        let mut scene = testkit::build(e, &objects, LIM);
+        crate::proximity::distance_field(
+            &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
+        );
+        let raster = Raster::new(e, &scene.plane).unwrap();
+        let store = scene.store();
+        let n = crate::proximity::coarse_extent(e).unwrap().len();
+        let (mut owners, mut plane) = (vec![0u32; n], vec![0u8; n]);
+        assert!(shadow_bricks(&store, &mut owners, &mut plane));
+        assert!(!shadow_bricks(&store, &mut owners[1..], &mut plane[1..]));
+        let bricks = ShadowBricks::new(e, &plane, &owners).unwrap();
+        // The owners are the records' objects, brick by brick.
+        for (v, rec) in store.iter() {
+            let o = bricks.owner(bricks.brick_of(v).unwrap());
+            assert_ne!(o, NO_RECORD);
+            assert!(o == SEVERAL || store.objects(rec) == [o - 1], "{v:?}");
+        }
+        let lights: Vec<[i64; 3]> = (0..3)
+            .map(|_| {
+                dims.map(|n| {
+                    let n = i64::from(n) * VOXEL;
+                    rng.range(-2 * n, 3 * n)
+                })
+            })
+            .collect();
+        for (v, rec) in store.iter() {
+            for &light in &lights {
+                let with = classify_voxel(&raster, &store, Some(&bricks), |_| None, v, rec, light);
+                let want = tube_rule(&raster, &store, v, light);
+                assert_eq!(
+                    with.unwrap() == LightVisibility::Visible,
+                    want,
+                    "{dims:?} {balls:?} voxel {v:?} light {light:?}"
+                );
+                pairs += 1;
+                lit += u32::from(want);
+                proven += u32::from(bricks.proves_lit(v, light).unwrap());
+            }
+        }
+    }
+    assert!(
+        proven > pairs / 20 && proven < lit,
+        "{proven} proven by bricks, {lit} lit, {pairs} pairs"
+    );
+}
+
+/// The light pass with the brick level gives the records it gives without
+/// (runs in any order), and its count of brick proofs.
+#[test]
+fn light_pass_with_bricks_is_the_pass_without() {
+    use super::bricks::{ShadowBricks, shadow_bricks};
+    let e = Extent::new(43, 37, 29).unwrap();
+    let w = World::new(&[
+        [-30 * VOXEL, 20 * VOXEL, 80 * VOXEL],
+        [20 * VOXEL, -40 * VOXEL, 10 * VOXEL],
+    ]);
+    let big = |s: &mut dyn VoxelSink| {
+        testkit::sphere(
+            e,
+            [20 * VOXEL, 18 * VOXEL, 14 * VOXEL],
+            11 * VOXEL,
+            Separation::TwentySix,
+            s,
+        )
+    };
+    let small = |s: &mut dyn VoxelSink| {
+        testkit::sphere(
+            e,
+            [36 * VOXEL, 8 * VOXEL, 24 * VOXEL],
+            3 * VOXEL,
+            Separation::TwentySix,
+            s,
+        )
+    };
+    let objects: Vec<Voxelize<'_>> = vec![
+        (attrs(0, 0), &big as &dyn Fn(&mut dyn VoxelSink)),
+        (attrs(1, 0), &small as &dyn Fn(&mut dyn VoxelSink)),
+    ];
+    let mut scene = testkit::build(e, &objects, LIM);
+    crate::proximity::distance_field(
+        &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
+    );
+    let mut storage = vec![Object::UNUSED; 2];
+    let mut table = ObjectTable::new(&mut storage, &mut []);
+    for (centre, radius) in [([20, 18, 14], 11), ([36, 8, 24], 3)] {
+        table
+            .push(Object {
+                shape: Shape::Sphere(Sphere {
+                    centre: vox(centre),
+                    radius: radius * VOXEL,
+                }),
+                material: 0,
+            })
+            .unwrap();
+    }
+    let raster = Raster::new(e, &scene.plane).unwrap();
+    let store = scene.store();
+    let n = crate::proximity::coarse_extent(e).unwrap().len();
+    let (mut owners, mut plane) = (vec![0u32; n], vec![0u8; n]);
+    assert!(shadow_bricks(&store, &mut owners, &mut plane));
+    let bricks = ShadowBricks::new(e, &plane, &owners).unwrap();
+    let params = LightParams {
+        exact_records: ExactRecords::Classify,
+        ..LightParams::default()
+    };
+    let pass = |level: Option<&ShadowBricks<'_>>| {
+        let mut out = store.records().to_vec();
+        let mut report = LightReport::default();
+        let starts: Vec<usize> = (0..out.len()).step_by(97).collect();
+        for &first in starts.iter().rev() {
+            let end = (first + 97).min(out.len());
+            let r = illuminate_run(
+                &raster,
+                &store,
+                first,
+                &mut out[first..end],
+                &table,
+                &w.materials,
+                &w.lights,
+                &params,
+                level,
+            )
+            .unwrap();
+            report.add(&r);
+        }
+        (out, report)
+    };
+    let (plain, plain_report) = pass(None);
+    let (fast, fast_report) = pass(Some(&bricks));
+    assert_eq!(plain, fast);
+    assert_eq!(plain_report.brick_proofs, 0);
+    assert!(fast_report.brick_proofs > 0, "{fast_report:?}");
+    assert_eq!(
+        fast_report.rays + fast_report.brick_proofs,
+        plain_report.rays,
+        "{fast_report:?} {plain_report:?}"
+    );
+    assert_eq!(fast_report.visible, plain_report.visible);
+    // A level of another raster is refused.
+    let other = Extent::new(44, 37, 29).unwrap();
+    let m = crate::proximity::coarse_extent(other).unwrap().len();
+    let (o2, p2) = (vec![0u32; m], vec![0u8; m]);
+    let wrong = ShadowBricks::new(other, &p2, &o2).unwrap();
+    let mut out = store.records().to_vec();
+    assert_eq!(
+        illuminate_run(
+            &raster,
+            &store,
+            0,
+            &mut out,
+            &table,
+            &w.materials,
+            &w.lights,
+            &params,
+            Some(&wrong)
+        ),
+        Err(LightError::ExtentMismatch)
     );
 }
 
@@ -742,7 +939,7 @@ fn classification_leaves_the_dark_side_undecided() {
     let (mut dark, mut walked) = (0u32, 0u32);
     for light in [vox([200, 90, 30]), vox([24, 24, -40]), vox([30, 20, 26])] {
         for (v, rec) in store.iter() {
-            let got = classify_voxel(&raster, &store, shape, v, rec, light).unwrap();
+            let got = classify_voxel(&raster, &store, None, shape, v, rec, light).unwrap();
             if cube_beyond_terminator(&sphere, v, light) {
                 assert_eq!(got, LightVisibility::Translucent, "voxel {v:?}");
                 dark += 1;

@@ -17,6 +17,9 @@ pub const RECORD_BYTES: u64 = size_of::<VoxelRecord>() as u64;
 pub const BRICK_VOXELS: u64 = store::BRICK_VOXELS as u64;
 /// Bytes per brick directory entry (a `u32` record offset).
 pub const BRICK_ENTRY_BYTES: u64 = size_of::<u32>() as u64;
+/// Bytes per brick of the shadow classification's brick level (a plane
+/// byte and a `u32` owner, [`rrt_core::light::bricks`]).
+pub const BRICK_LEVEL_BYTES: u64 = 1 + size_of::<u32>() as u64;
 /// Upper bound on the voxels per voxel² of surface for the thickest
 /// (26-tunnel-free) voxelization: a standard digital surface is
 /// `|nx| + |ny| + |nz| ≤ √3` voxels thick.
@@ -64,7 +67,9 @@ pub struct MemoryEstimate {
     pub plane: u64,
     /// The plane's line level: one byte per 64 voxels.
     pub lines: u64,
-    /// The brick directory: [`BRICK_ENTRY_BYTES`] per [`BRICK_VOXELS`] voxels.
+    /// The brick directory and the shadow classification's brick level:
+    /// [`BRICK_ENTRY_BYTES`] + [`BRICK_LEVEL_BYTES`] per [`BRICK_VOXELS`]
+    /// voxels.
     pub directory: u64,
     /// Upper bound on the non-transparent voxels (at most `voxels`).
     pub record_voxels: u64,
@@ -87,7 +92,7 @@ impl fmt::Display for MemoryEstimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "plane {}, line level {}, brick directory {}, records for up to {} voxels {}",
+            "plane {}, line level {}, brick directory and level {}, records for up to {} voxels {}",
             Bytes(self.plane),
             Bytes(self.lines),
             Bytes(self.directory),
@@ -166,7 +171,7 @@ impl SurfaceMeasure {
 /// computed from the world geometry without allocating.
 ///
 /// The plane takes 1 byte per voxel, its line level 1 byte per 64 voxels
-/// and the brick directory 4 bytes per 512 voxels. Non-transparent voxels are bounded by surface area `A`
+/// and the brick directory and brick level 9 bytes per 512 voxels. Non-transparent voxels are bounded by surface area `A`
 /// and boundary length `P` (in voxel units): a surface generates at most
 /// `1.8·(A + P + 3)` voxels in the thickest (26-tunnel-free)
 /// voxelization, the `P` and constant terms covering edges and tiny
@@ -196,7 +201,7 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
         lines: voxels.div_ceil(LINE_CELLS as u64),
         directory: voxels
             .div_ceil(BRICK_VOXELS)
-            .saturating_mul(BRICK_ENTRY_BYTES),
+            .saturating_mul(BRICK_ENTRY_BYTES + BRICK_LEVEL_BYTES),
         record_voxels,
         records: record_voxels.saturating_mul(RECORD_BYTES),
     }

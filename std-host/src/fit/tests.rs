@@ -235,7 +235,7 @@ fn memory_estimate_and_refusal() {
     assert_eq!(m.voxels, 104 * 104 * 4);
     assert_eq!(m.plane, m.voxels);
     assert_eq!(m.lines, m.voxels.div_ceil(64));
-    assert_eq!(m.directory, 4 * m.voxels.div_ceil(512));
+    assert_eq!(m.directory, (4 + 5) * m.voxels.div_ceil(512));
     // Two triangles of area 5000 and perimeter 100 + 100 + 141.4.
     let per_tri = 1.8 * (5000.0 + 200.0 + 100.0 * 2f64.sqrt() + 3.0);
     assert_eq!(m.record_voxels, (2.0 * per_tri).ceil() as u64);
@@ -245,8 +245,8 @@ fn memory_estimate_and_refusal() {
         "at least one layer of the square"
     );
 
-    // 43264 + 676 + 340 + 19240·20 = 429080 bytes = 419.0 KiB.
-    assert_eq!(m.total(), 429_080);
+    // 43264 + 676 + 765 + 19240·20 = 429505 bytes = 419.4 KiB.
+    assert_eq!(m.total(), 429_505);
     let e = fit(
         &s,
         &FitOptions {
@@ -257,8 +257,8 @@ fn memory_estimate_and_refusal() {
     .unwrap_err();
     assert_eq!(
         e.to_string(),
-        "raster 104×104×4: needs about 419.0 KiB (plane 42.2 KiB, line level 676 B, brick \
-         directory 340 B, records for up to 19240 voxels 375.8 KiB), more than the limit of 256.0 KiB; use a \
+        "raster 104×104×4: needs about 419.4 KiB (plane 42.2 KiB, line level 676 B, brick \
+         directory and level 765 B, records for up to 19240 voxels 375.8 KiB), more than the limit of 256.0 KiB; use a \
          smaller raster or a larger memory limit"
     );
     assert!(

@@ -492,7 +492,16 @@ enum Classification {
     /// [`Classification::LIT`] or [`Classification::UNDECIDED`]. The
     /// answer is a function of the record and the light alone, so the
     /// order in which threads fill it in changes nothing.
-    OnDemand(Arc<[AtomicU16]>),
+    OnDemand(Arc<OnDemand>),
+}
+
+/// The classification computed on demand: the memo (two bits per light
+/// and record, [`Classification::OnDemand`]) and the raster's brick level,
+/// which spares the walks of voxels it proves lit (`None` if its buffers
+/// could not be allocated: the same answers, from the voxels' walks).
+struct OnDemand {
+    memo: Box<[AtomicU16]>,
+    level: Option<crate::voxelize::light::ShadowLevel>,
 }
 
 impl fmt::Debug for Classification {
@@ -500,7 +509,7 @@ impl fmt::Debug for Classification {
         match self {
             Self::Unavailable => f.write_str("Unavailable"),
             Self::Records => f.write_str("Records"),
-            Self::OnDemand(memo) => write!(f, "OnDemand({} records)", memo.len()),
+            Self::OnDemand(d) => write!(f, "OnDemand({} records)", d.memo.len()),
         }
     }
 }
@@ -518,7 +527,10 @@ impl Classification {
         match scene.exact_records {
             ExactRecords::Classify => Self::Records,
             ExactRecords::Skip if opts.classify_on_demand && opts.mode.exact_shadows() => {
-                Self::OnDemand((0..store.len()).map(|_| AtomicU16::new(0)).collect())
+                Self::OnDemand(Arc::new(OnDemand {
+                    memo: (0..store.len()).map(|_| AtomicU16::new(0)).collect(),
+                    level: crate::voxelize::light::ShadowLevel::of(store).ok(),
+                }))
             }
             _ => Self::Unavailable,
         }

@@ -281,10 +281,12 @@ impl Tracer<'_> {
         let lit = match &self.classification {
             Classification::Unavailable => false,
             Classification::Records => o.rec.light(k) == LightVisibility::Visible,
-            Classification::OnDemand(memo) => {
-                let (Some(slot), Some(Some(light)), Ok(shift)) =
-                    (memo.get(o.at), self.lights_fx.get(k), u32::try_from(2 * k))
-                else {
+            Classification::OnDemand(d) => {
+                let (Some(slot), Some(Some(light)), Ok(shift)) = (
+                    d.memo.get(o.at),
+                    self.lights_fx.get(k),
+                    u32::try_from(2 * k),
+                ) else {
                     return None;
                 };
                 if shift >= 16 {
@@ -298,9 +300,16 @@ impl Tracer<'_> {
                         Shape::Sphere(s) => s.to_fixed(&self.frame).ok(),
                         _ => None,
                     };
-                    let lit =
-                        classify_voxel(&self.raster, &self.store, shape, o.voxel, o.rec, *light)
-                            == Ok(LightVisibility::Visible);
+                    let bricks = d.level.as_ref().and_then(|l| l.bricks(&self.store));
+                    let lit = classify_voxel(
+                        &self.raster,
+                        &self.store,
+                        bricks.as_ref(),
+                        shape,
+                        o.voxel,
+                        o.rec,
+                        *light,
+                    ) == Ok(LightVisibility::Visible);
                     let answer = if lit {
                         Classification::LIT
                     } else {

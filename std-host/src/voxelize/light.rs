@@ -12,8 +12,10 @@
 
 use indicatif::ProgressBar;
 use rayon::prelude::*;
+use rrt_core::light::bricks::{ShadowBricks, shadow_bricks};
 use rrt_core::light::{LightError, LightParams, LightReport, illuminate_run};
 use rrt_core::object_table::{Light, Lights, Materials, Object, ObjectTable};
+use rrt_core::proximity::coarse_extent;
 use rrt_core::raster::Raster;
 use rrt_core::store::RecordStore;
 use rrt_core::voxel::VoxelRecord;
@@ -42,6 +44,39 @@ fn run_length(records: usize, threads: usize) -> usize {
     records
         .div_ceil(threads.max(1) * RUNS_PER_THREAD)
         .clamp(LIGHT_RUN_MIN, LIGHT_RUN)
+}
+
+/// The shadow classification's brick level of a raster
+/// ([`rrt_core::light::bricks`]): one byte and one owner per 8³ brick,
+/// made from the records. The light pass and a renderer that classifies on
+/// demand try it before a voxel's own walk; it changes no answer.
+#[derive(Debug)]
+pub struct ShadowLevel {
+    plane: Vec<u8>,
+    owners: Vec<u32>,
+}
+
+impl ShadowLevel {
+    /// The level of `store`'s raster.
+    ///
+    /// # Errors
+    /// [`BuildError::Alloc`] when its buffers cannot be allocated.
+    pub fn of(store: &RecordStore<'_>) -> Result<Self, BuildError> {
+        let n = coarse_extent(store.extent()).map_or(0, |e| e.len());
+        let mut plane = super::try_vec(n, "shadow brick level")?;
+        plane.resize(n, 0);
+        let mut owners = super::try_vec(n, "shadow brick owners")?;
+        owners.resize(n, 0);
+        // The buffers have the brick count's length: this fills them.
+        shadow_bricks(store, &mut owners, &mut plane);
+        Ok(Self { plane, owners })
+    }
+
+    /// The core's view of the level for a raster of `store`'s extent.
+    #[must_use]
+    pub fn bricks(&self, store: &RecordStore<'_>) -> Option<ShadowBricks<'_>> {
+        ShadowBricks::new(store.extent(), &self.plane, &self.owners)
+    }
 }
 
 /// What the light pass reads besides the raster: the core's object-table
@@ -92,6 +127,7 @@ impl LightScene {
 
     /// The lit copy of `store`'s records, computed on `pool`'s threads, and
     /// the pass's counts; `progress` counts records as their runs finish.
+    /// `level`, the raster's brick level, spares classification walks.
     ///
     /// # Errors
     /// The core's [`LightError`].
@@ -100,9 +136,11 @@ impl LightScene {
         raster: &Raster<'_>,
         store: &RecordStore<'_>,
         params: &LightParams,
+        level: Option<&ShadowLevel>,
         pool: &rayon::ThreadPool,
         progress: &ProgressBar,
     ) -> Result<(Vec<VoxelRecord>, LightReport), BuildError> {
+        let bricks = level.and_then(|l| l.bricks(store));
         let mut storage = vec![Object::UNUSED; self.entries.len()];
         let mut table = ObjectTable::new(&mut storage, &mut []);
         for o in &self.entries {
@@ -145,6 +183,7 @@ impl LightScene {
                                 &self.materials,
                                 &self.lights,
                                 params,
+                                bricks.as_ref(),
                             )?);
                         }
                         start += len;

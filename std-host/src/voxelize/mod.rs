@@ -66,7 +66,7 @@ pub use self::voxel_scene::{
     line_level_of_plane, plane_matches_records,
 };
 
-use self::light::LightScene;
+use self::light::{LightScene, ShadowLevel};
 use self::materials::MaterialTable;
 use self::plane::Plane;
 use self::slabs::{Counted, Passes, Voxelized};
@@ -343,7 +343,9 @@ pub fn build(
             extent
                 .len()
                 .saturating_add(c.band_planes)
-                .saturating_add(c.directory.saturating_mul(size_of::<u32>()))
+                // The directory and the shadow classification's brick
+                // level (a byte and an owner per brick).
+                .saturating_add(c.directory.saturating_mul(2 * size_of::<u32>() + 1))
                 // The records, and the light pass's lit copy of them.
                 .saturating_add(c.records.saturating_mul(2 * size_of::<VoxelRecord>()))
                 .saturating_add(c.list_entries.saturating_mul(size_of::<u32>())),
@@ -387,8 +389,19 @@ pub fn build(
         .map_err(|e| BuildError::Raster(e.to_string()))?;
     let store = rrt_core::store::RecordStore::with_lists(extent, &directory, &records, &lists)
         .map_err(|e| BuildError::Raster(e.to_string()))?;
-    let (lit, light_report) = LightScene::new(&objects, &materials, &fitted.lights)
-        .illuminate(&raster, &store, &light, &pool, progress)?;
+    // The brick level serves the shadow classification only.
+    let level = match light.exact_records {
+        ExactRecords::Classify => Some(ShadowLevel::of(&store)?),
+        ExactRecords::Paper | ExactRecords::Skip => None,
+    };
+    let (lit, light_report) = LightScene::new(&objects, &materials, &fitted.lights).illuminate(
+        &raster,
+        &store,
+        &light,
+        level.as_ref(),
+        &pool,
+        progress,
+    )?;
     records = lit;
     let lights_time = t1.elapsed();
 
