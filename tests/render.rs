@@ -29,7 +29,7 @@ fn balls2() -> PathBuf {
 }
 
 /// A fresh temporary folder for one test.
-fn temp_dir(test: &str) -> PathBuf {
+fn temp_dir(test: &str) -> rrt_tests::Scratch {
     rrt_tests::fresh_dir("rrt-test", test)
 }
 
@@ -177,7 +177,8 @@ fn png_is_identical_for_every_thread_count() {
 #[test]
 fn alpha_is_the_coverage_for_every_thread_count() {
     // A matte sphere and a mirror sphere, background all around.
-    let nff = temp_dir("alpha").join("two.nff");
+    let dir = temp_dir("alpha");
+    let nff = dir.join("two.nff");
     std::fs::write(
         &nff,
         "b 0.1 0.3 0.7\nv\nfrom 0 -6 1\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\nresolution 70 45\n\

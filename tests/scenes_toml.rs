@@ -17,7 +17,7 @@ fn scenes_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes")
 }
 
-fn temp_dir(test: &str) -> PathBuf {
+fn temp_dir(test: &str) -> rrt_tests::Scratch {
     rrt_tests::fresh_dir("rrt-toml", test)
 }
 
@@ -136,7 +136,7 @@ material = "red"
 csg = { difference = ["ball", "cut"] }
 "#;
 
-fn features_dir(test: &str) -> PathBuf {
+fn features_dir(test: &str) -> rrt_tests::Scratch {
     let d = temp_dir(test);
     let bpt = "1\n3 3\n".to_string()
         + &(0..16)

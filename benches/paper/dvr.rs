@@ -182,6 +182,7 @@ pub(crate) fn dvr(ctx: &mut Ctx) -> Res<()> {
         }
         Err(_) => (f64::NAN, false),
     };
+    let _ = std::fs::remove_dir_all(&tmp);
     let med = |v: &[f64]| median(v);
     let mut rows = Vec::new();
     for (ti, &th) in threads.iter().enumerate() {

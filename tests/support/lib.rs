@@ -68,16 +68,38 @@ pub fn psnr(a: &[u8], b: &[u8]) -> f64 {
     }
 }
 
-/// A fresh, empty temporary folder `<prefix>-<process id>-<test>`.
+/// A test's temporary folder, removed with everything in it when dropped
+/// (at the end of the test, whether it passes or panics); a path through
+/// `Deref`.
+#[derive(Debug)]
+pub struct Scratch(tempfile::TempDir);
+
+impl std::ops::Deref for Scratch {
+    type Target = std::path::Path;
+    fn deref(&self) -> &std::path::Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<std::path::Path> for Scratch {
+    fn as_ref(&self) -> &std::path::Path {
+        self.0.path()
+    }
+}
+
+/// A fresh, empty temporary folder `<prefix>-<test>-<random>`, removed
+/// when the returned guard is dropped.
 ///
 /// # Panics
 /// If it cannot be made.
 #[must_use]
-pub fn fresh_dir(prefix: &str, test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("{prefix}-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+pub fn fresh_dir(prefix: &str, test: &str) -> Scratch {
+    Scratch(
+        tempfile::Builder::new()
+            .prefix(&format!("{prefix}-{test}-"))
+            .tempdir()
+            .unwrap(),
+    )
 }
 
 /// `../shared/data` beside the repository, if present.
