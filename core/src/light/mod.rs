@@ -424,8 +424,16 @@ fn shade_record<const N: usize>(
             continue;
         }
         let to_light = sub(light.position, c0);
-        let l = normalize(to_light);
-        let ndl = l.map_or(0, |l| dot_unit(normal, l));
+        // N·L from the unit direction to the light; without it where the
+        // stored normal clearly faces away (any negative N·L decides as
+        // this one would: no light, occluded on a closed shape, the back
+        // side's ray on an open one).
+        let (lit_dir, ndl) = if facing_away(normal, to_light) {
+            (true, -1)
+        } else {
+            let l = normalize(to_light);
+            (l.is_some(), l.map_or(0, |l| dot_unit(normal, l)))
+        };
         let front = ndl > 0;
         let vis = match (exact, params.exact_records) {
             (true, _)
@@ -454,7 +462,7 @@ fn shade_record<const N: usize>(
                 let side = if ndl > 0 {
                     normal
                 } else if closed || ndl == 0 {
-                    if l.is_some() {
+                    if lit_dir {
                         report.facing_away = report.facing_away.saturating_add(1);
                         rec.set_light(i, LightVisibility::Occluded);
                         continue;
@@ -474,7 +482,7 @@ fn shade_record<const N: usize>(
                     c0,
                     light.position,
                     side,
-                    rec.normal,
+                    (rec.normal, normal),
                     owner,
                 )?
             }
@@ -575,6 +583,22 @@ fn cube_beyond_terminator(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
     f.saturating_add(margin) <= r.saturating_mul(r)
 }
 
+/// Whether the unit normal `n` ([`NORMAL_ONE`]-scaled) surely faces away
+/// from direction `d`: `n·d < −2·|d|₁`. Then `dot_unit(n, normalize(d))`
+/// is negative: each component of `normalize(d)` is within one unit of
+/// `2^30·d/|d|` (and 2^-9 more for the truncation of components beyond
+/// 40 bits), which moves the sum of products by at most `1.01·|n|₁ <
+/// 2^31`, while `2^30·n·d/|d| < −2^31` (as `|d| ≤ |d|₁`).
+fn facing_away(n: [i32; 3], d: [i64; 3]) -> bool {
+    let (mut dot, mut l1) = (0i128, 0i128);
+    for (a, b) in n.iter().zip(d.iter()) {
+        // |a| ≤ 2^30, |b| < 2^63: each product below 2^93.
+        dot = dot.saturating_add(i128::from(*a).saturating_mul(i128::from(*b)));
+        l1 = l1.saturating_add(i128::from(b.unsigned_abs()));
+    }
+    dot < l1.saturating_mul(-2)
+}
+
 /// `a − b` per axis, saturating.
 fn sub(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
     [
@@ -608,7 +632,7 @@ fn shadow_ray<const N: usize>(
     c0: [i64; 3],
     light: [i64; 3],
     side: [i32; 3],
-    stored: [i16; 2],
+    (stored, stored_normal): ([i16; 2], [i32; 3]),
     object: u32,
 ) -> Result<LightVisibility, LightError> {
     let extent = raster.extent();
@@ -618,6 +642,7 @@ fn shadow_ray<const N: usize>(
         c0,
         side,
         stored,
+        stored_normal: Some(stored_normal),
         object,
         slab: params.slab,
         same_surface_cos: params.same_surface_cos,
@@ -918,6 +943,9 @@ pub struct LeavingSurface {
     /// [`VoxelRecord::normal`] (for the same-surface test; decoded only
     /// when a voxel of another object is met).
     pub stored: [i16; 2],
+    /// `stored` decoded ([`decode_normal`]), when the caller has it at
+    /// hand; `None` decodes it when needed.
+    pub stored_normal: Option<[i32; 3]>,
     /// The owner of the voxel left ([`RecordStore::owner`]).
     pub object: u32,
     /// Height above the tangent plane, fixed units, below which voxels of
@@ -959,6 +987,7 @@ impl LeavingSurface {
             c0: v.map(voxel_centre),
             side,
             stored: rec.normal,
+            stored_normal: None,
             object: store.owner(rec),
             slab: params.slab,
             same_surface_cos: params.same_surface_cos,
@@ -1001,7 +1030,11 @@ impl LeavingSurface {
             return false;
         }
         store.owner(b) == self.object
-            || dot_unit(b.normal_vector(), decode_normal(self.stored)) >= self.same_surface_cos
+            || dot_unit(
+                b.normal_vector(),
+                self.stored_normal
+                    .unwrap_or_else(|| decode_normal(self.stored)),
+            ) >= self.same_surface_cos
     }
 }
 

@@ -625,6 +625,42 @@ fn classification_is_the_tube_rule() {
     );
 }
 
+/// The facing-away shortcut is sound: where it fires, the normalized
+/// direction's N·L is negative, as the pass would have found it; over
+/// directions of every magnitude (2^0 to 2^62 units) and stored normals,
+/// grazing ones included, it fires for most of the directions facing away.
+#[test]
+fn facing_away_implies_a_negative_n_dot_l() {
+    let mut rng = testkit::Rng(0xface_a3a7);
+    let (mut fired, mut away) = (0u32, 0u32);
+    for case in 0..200_000u32 {
+        let n = crate::voxel::decode_normal([
+            rng.range(-32768, 32768) as i16,
+            rng.range(-32768, 32768) as i16,
+        ]);
+        let bits = case % 63;
+        let mut d: [i64; 3] = [0; 3].map(|_| rng.range(-(1i64 << bits), 1i64 << bits));
+        if case % 5 == 0 {
+            // Nearly in the tangent plane: d minus its part along n.
+            let dn: i128 = (0..3).map(|k| i128::from(d[k]) * i128::from(n[k])).sum();
+            for k in 0..3 {
+                d[k] -= i64::try_from((dn * i128::from(n[k])) >> 60).unwrap_or(0);
+            }
+        }
+        let Some(l) = normalize(d) else { continue };
+        let ndl = dot_unit(n, l);
+        if facing_away(n, d) {
+            fired += 1;
+            assert!(ndl < 0, "n {n:?} d {d:?}: N·L {ndl}");
+        }
+        away += u32::from(ndl < -(1 << 20));
+    }
+    assert!(
+        fired > away / 2 && away > 50_000,
+        "{fired} fired, {away} facing away"
+    );
+}
+
 /// The brick level changes no classification and spares walks: on random
 /// scenes of a few large balls (surfaces of one object over many bricks)
 /// and small ones beside them, in rasters of several bricks whose sides
