@@ -488,27 +488,7 @@ fn runs_in_any_order_equal_the_serial_pass() {
     }
     let raster = Raster::new(e, &scene.plane).unwrap();
     let store = RecordStore::with_lists(e, &scene.dir, &unlit, &scene.lists).unwrap();
-    let mut out = unlit.clone();
-    let run = 97; // not a divisor of the record count, not a brick size
-    let mut report = LightReport::default();
-    // Last run first, to show the order does not matter.
-    let starts: Vec<usize> = (0..out.len()).step_by(run).collect();
-    for &first in starts.iter().rev() {
-        let end = (first + run).min(out.len());
-        let r = illuminate_run(
-            &raster,
-            &store,
-            first,
-            &mut out[first..end],
-            &table,
-            &w.materials,
-            &w.lights,
-            &LightParams::default(),
-            None,
-        )
-        .unwrap();
-        report.add(&r);
-    }
+    let (out, report) = pass_in_runs(&raster, &store, &table, &w, &LightParams::default(), None);
     assert_eq!(out, serial);
     assert_eq!(report, serial_report);
     assert!(report.translucent > 0 && report.visible > 0);
@@ -549,6 +529,74 @@ fn tube_rule(raster: &Raster<'_>, store: &RecordStore<'_>, v: [u32; 3], light: [
     true
 }
 
+/// The light pass over `store` by [`illuminate_run`] in runs of 97
+/// records (not a divisor of the record count, not a brick size), the last
+/// run first, to show the order does not matter: the lit records and the
+/// added reports.
+fn pass_in_runs(
+    raster: &Raster<'_>,
+    store: &RecordStore<'_>,
+    table: &ObjectTable<'_>,
+    w: &World,
+    params: &LightParams,
+    level: Option<&bricks::ShadowBricks<'_>>,
+) -> (Vec<VoxelRecord>, LightReport) {
+    let mut out = store.records().to_vec();
+    let mut report = LightReport::default();
+    let starts: Vec<usize> = (0..out.len()).step_by(97).collect();
+    for &first in starts.iter().rev() {
+        let end = (first + 97).min(out.len());
+        let r = illuminate_run(
+            raster,
+            store,
+            first,
+            &mut out[first..end],
+            table,
+            &w.materials,
+            &w.lights,
+            params,
+            level,
+        )
+        .unwrap();
+        report.add(&r);
+    }
+    (out, report)
+}
+
+/// The exact raster of `balls` (centre, radius; object `i` for ball `i`)
+/// in `e`, with its distance field.
+fn balls_scene(e: Extent, balls: &[([i64; 3], i64)]) -> Scene {
+    let shapes: Vec<_> = balls
+        .iter()
+        .map(|&(c, r)| {
+            move |s: &mut dyn VoxelSink| testkit::sphere(e, c, r, Separation::TwentySix, s)
+        })
+        .collect();
+    let objects: Vec<Voxelize<'_>> = shapes
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (attrs(i as u32, 0), f as &dyn Fn(&mut dyn VoxelSink)))
+        .collect();
+    let mut scene = testkit::build(e, &objects, LIM);
+    crate::proximity::distance_field(
+        &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
+    );
+    scene
+}
+
+/// Three lights inside a raster of `dims` voxels, or up to twice its size
+/// away.
+fn random_lights(rng: &mut testkit::Rng, dims: [u32; 3]) -> Vec<[i64; 3]> {
+    (0..3)
+        .map(|_| {
+            dims.map(|n| {
+                let n = i64::from(n) * VOXEL;
+                rng.range(-2 * n, 3 * n)
+            })
+        })
+        .collect()
+}
+
 /// [`classify_voxel`] is the tube rule, on random overlapping balls cut by
 /// the faces of small rasters (voxels on the faces, where the walk's test
 /// clips the neighbourhood, and inside), with lights inside the raster and
@@ -566,32 +614,10 @@ fn classification_is_the_tube_rule() {
                 (c, rng.range(VOXEL / 2, 4 * VOXEL))
             })
             .collect();
-        let shapes: Vec<_> = balls
-            .iter()
-            .map(|&(c, r)| {
-                move |s: &mut dyn VoxelSink| testkit::sphere(e, c, r, Separation::TwentySix, s)
-            })
-            .collect();
-        let objects: Vec<Voxelize<'_>> = shapes
-            .iter()
-            .enumerate()
-            .map(|(i, f)| (attrs(i as u32, 0), f as &dyn Fn(&mut dyn VoxelSink)))
-            .collect();
-        let mut scene = testkit::build(e, &objects, LIM);
-        crate::proximity::distance_field(
-            &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
-        );
+        let scene = balls_scene(e, &balls);
         let raster = Raster::new(e, &scene.plane).unwrap();
         let store = scene.store();
-        let lights: Vec<[i64; 3]> = (0..3)
-            .map(|_| {
-                // Inside the raster, or up to twice its size away.
-                dims.map(|n| {
-                    let n = i64::from(n) * VOXEL;
-                    rng.range(-2 * n, 3 * n)
-                })
-            })
-            .collect();
+        let lights = random_lights(&mut rng, dims);
         for z in 0..dims[2] {
             for y in 0..dims[1] {
                 for x in 0..dims[0] {
@@ -685,21 +711,7 @@ fn brick_level_changes_no_classification() {
             };
             balls.push((c, r));
         }
-        let shapes: Vec<_> = balls
-            .iter()
-            .map(|&(c, r)| {
-                move |s: &mut dyn VoxelSink| testkit::sphere(e, c, r, Separation::TwentySix, s)
-            })
-            .collect();
-        let objects: Vec<Voxelize<'_>> = shapes
-            .iter()
-            .enumerate()
-            .map(|(i, f)| (attrs(i as u32, 0), f as &dyn Fn(&mut dyn VoxelSink)))
-            .collect();
-        let mut scene = testkit::build(e, &objects, LIM);
-        crate::proximity::distance_field(
-            &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
-        );
+        let scene = balls_scene(e, &balls);
         let raster = Raster::new(e, &scene.plane).unwrap();
         let store = scene.store();
         let n = crate::proximity::coarse_extent(e).unwrap().len();
@@ -713,14 +725,7 @@ fn brick_level_changes_no_classification() {
             assert_ne!(o, NO_RECORD);
             assert!(o == SEVERAL || store.objects(rec) == [o - 1], "{v:?}");
         }
-        let lights: Vec<[i64; 3]> = (0..3)
-            .map(|_| {
-                dims.map(|n| {
-                    let n = i64::from(n) * VOXEL;
-                    rng.range(-2 * n, 3 * n)
-                })
-            })
-            .collect();
+        let lights = random_lights(&mut rng, dims);
         for (v, rec) in store.iter() {
             for &light in &lights {
                 let with = classify_voxel(&raster, &store, Some(&bricks), |_| None, v, rec, light);
@@ -752,41 +757,17 @@ fn light_pass_with_bricks_is_the_pass_without() {
         [-30 * VOXEL, 20 * VOXEL, 80 * VOXEL],
         [20 * VOXEL, -40 * VOXEL, 10 * VOXEL],
     ]);
-    let big = |s: &mut dyn VoxelSink| {
-        testkit::sphere(
-            e,
-            [20 * VOXEL, 18 * VOXEL, 14 * VOXEL],
-            11 * VOXEL,
-            Separation::TwentySix,
-            s,
-        )
-    };
-    let small = |s: &mut dyn VoxelSink| {
-        testkit::sphere(
-            e,
-            [36 * VOXEL, 8 * VOXEL, 24 * VOXEL],
-            3 * VOXEL,
-            Separation::TwentySix,
-            s,
-        )
-    };
-    let objects: Vec<Voxelize<'_>> = vec![
-        (attrs(0, 0), &big as &dyn Fn(&mut dyn VoxelSink)),
-        (attrs(1, 0), &small as &dyn Fn(&mut dyn VoxelSink)),
+    let balls = [
+        (vox([20, 18, 14]), 11 * VOXEL),
+        (vox([36, 8, 24]), 3 * VOXEL),
     ];
-    let mut scene = testkit::build(e, &objects, LIM);
-    crate::proximity::distance_field(
-        &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
-    );
+    let scene = balls_scene(e, &balls);
     let mut storage = vec![Object::UNUSED; 2];
     let mut table = ObjectTable::new(&mut storage, &mut []);
-    for (centre, radius) in [([20, 18, 14], 11), ([36, 8, 24], 3)] {
+    for (centre, radius) in balls {
         table
             .push(Object {
-                shape: Shape::Sphere(Sphere {
-                    centre: vox(centre),
-                    radius: radius * VOXEL,
-                }),
+                shape: Shape::Sphere(Sphere { centre, radius }),
                 material: 0,
             })
             .unwrap();
@@ -801,28 +782,7 @@ fn light_pass_with_bricks_is_the_pass_without() {
         exact_records: ExactRecords::Classify,
         ..LightParams::default()
     };
-    let pass = |level: Option<&ShadowBricks<'_>>| {
-        let mut out = store.records().to_vec();
-        let mut report = LightReport::default();
-        let starts: Vec<usize> = (0..out.len()).step_by(97).collect();
-        for &first in starts.iter().rev() {
-            let end = (first + 97).min(out.len());
-            let r = illuminate_run(
-                &raster,
-                &store,
-                first,
-                &mut out[first..end],
-                &table,
-                &w.materials,
-                &w.lights,
-                &params,
-                level,
-            )
-            .unwrap();
-            report.add(&r);
-        }
-        (out, report)
-    };
+    let pass = |level| pass_in_runs(&raster, &store, &table, &w, &params, level);
     let (plain, plain_report) = pass(None);
     let (fast, fast_report) = pass(Some(&bricks));
     assert_eq!(plain, fast);
