@@ -725,7 +725,28 @@ fn brick_level_changes_no_classification() {
             assert_ne!(o, NO_RECORD);
             assert!(o == SEVERAL || store.objects(rec) == [o - 1], "{v:?}");
         }
-        let lights = random_lights(&mut rng, dims);
+        let mut lights = random_lights(&mut rng, dims);
+        // And one at the centre of a brick of one object beside a brick
+        // of another: a brick segment of length 0, where only the brick's
+        // neighbourhood can tell.
+        let ce = crate::proximity::coarse_extent(e).unwrap();
+        let beside_another = |v: [u32; 3]| {
+            let o = bricks.owner(bricks.brick_of(v).unwrap());
+            let u = v.map(|c| c >> 3);
+            o != SEVERAL
+                && (0..27).any(|k| {
+                    let w = [k % 3, k / 3 % 3, k / 9].map(|d| d as i64 - 1);
+                    let n = [0, 1, 2].map(|a| u[a] as i64 + w[a]);
+                    n.iter().all(|&c| c >= 0)
+                        && ce.index(n.map(|c| c as u32)).is_some_and(|i| {
+                            let p = bricks.owner(i);
+                            p != NO_RECORD && p != o
+                        })
+                })
+        };
+        if let Some((v, _)) = store.iter().find(|(v, _)| beside_another(*v)) {
+            lights.push(v.map(|c| i64::from(c & !7) * VOXEL + 4 * VOXEL));
+        }
         for (v, rec) in store.iter() {
             for &light in &lights {
                 let with = classify_voxel(&raster, &store, Some(&bricks), |_| None, v, rec, light);
