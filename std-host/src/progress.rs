@@ -48,7 +48,7 @@ const TICK: Duration = Duration::from_millis(200);
 /// when known); position,
 /// elapsed time and ETA from zero. The bar is redrawn at once in its new
 /// style (never the previous phase's unit or length, nor indicatif's
-/// default style) and then every [`TICK`].
+/// default style) and then every `TICK`.
 pub fn phase(bar: &ProgressBar, message: &'static str, unit: Unit, len: u64) {
     if bar.is_hidden() {
         return;

@@ -32,7 +32,7 @@
 //! Cells hold their finished form from the first step on: the distance in
 //! the distance bits, [`cell::PROXIMITY`] at distance 0 and 1,
 //! [`cell::OPAQUE`] at 0 and [`cell::EMPTY`] from [`NEAR_LIMIT`] on (the
-//! map is increasing once `EMPTY` is ordered last, [`nearer`], so minima
+//! map is increasing once `EMPTY` is ordered last, `nearer`, so minima
 //! commute with it). Steps 2 and 3 read one whole neighbouring slice and
 //! write rows of another, so a caller may hand out the rows of a slice to
 //! threads; step 1 is independent per slice.

@@ -27,7 +27,7 @@ pub fn write(image: &Image, w: &mut impl Write) -> Result<(), exr::error::Error>
 
 /// Writes `width × height` pixels of linear floats (rows top to bottom)
 /// as OpenEXR, with `band` in the [`BAND_ATTRIBUTE`] attribute when
-/// given. Without `band`, the bytes are [`write`]'s for an image with
+/// given. Without `band`, the bytes are [`write()`]'s for an image with
 /// these values.
 ///
 /// # Errors

@@ -28,7 +28,7 @@ pub fn write(image: &Image, enc: Encoding, w: &mut impl Write) -> Result<(), png
 /// Encodes `width × height` pixels of integer codes (`enc`'s bits, sRGB
 /// or linear) as PNG into `w`, with `band` in a `tEXt` chunk
 /// ([`BAND_KEYWORD`]) when given. Without `band`, the bytes are
-/// [`write`]'s for an image with these codes.
+/// [`write()`]'s for an image with these codes.
 ///
 /// # Errors
 /// The encoder's or the writer's error.
@@ -61,7 +61,7 @@ pub fn write_codes(
 }
 
 /// Encodes `image` as linear 8-bit PNG bytes in memory, exactly as
-/// [`write`] with `linear` 8-bit does (for tests and comparisons).
+/// [`write()`] with `linear` 8-bit does (for tests and comparisons).
 ///
 /// # Errors
 /// The encoder's error.

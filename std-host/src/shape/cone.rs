@@ -111,7 +111,7 @@ impl Surface for Cone {
     ///
     /// A line that passes the axis line farther than the larger radius, by
     /// a relative margin far above the rounding of that test, is refused
-    /// first with products and sums only ([`clearly_misses`]); every other
+    /// first with products and sums only (`clearly_misses`); every other
     /// ray gets the answer of the full form.
     fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
         let rmax = self.base_radius.abs().max(self.apex_radius.abs());

@@ -69,7 +69,7 @@ impl Surface for Sphere {
     /// precision. A tangent ray hits at its point of contact. A line that
     /// passes the sphere by more than a relative margin far above the
     /// rounding of that form is refused first with products and sums
-    /// only ([`clearly_misses`]); every other ray gets the same answer as
+    /// only (`clearly_misses`); every other ray gets the same answer as
     /// from the full form.
     fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
         let Self { centre, radius } = *self;

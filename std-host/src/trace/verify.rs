@@ -127,7 +127,7 @@ pub(super) struct Mailbox {
     used: [u64; MAILBOX / 64],
 }
 
-/// Slots of a [`Mailbox`].
+/// Slots of a `Mailbox`.
 pub const MAILBOX: usize = 128;
 
 impl Default for Mailbox {

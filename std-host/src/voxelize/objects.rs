@@ -87,7 +87,7 @@ impl TableObject<'_> {
 
     /// The cells, per axis and inclusive, outside which the object's
     /// voxelizer offers nothing: its fixed-point geometry's box grown by
-    /// [`BOX_MARGIN`] voxels; `None` where that box is not known here
+    /// `BOX_MARGIN` voxels; `None` where that box is not known here
     /// (volumes, voxel models, CSG trees, Bézier patches): every cell.
     #[must_use]
     pub fn cells(&self) -> Option<[(i64, i64); 3]> {

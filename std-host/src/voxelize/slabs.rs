@@ -67,7 +67,7 @@ pub struct Piece {
 }
 
 /// The pieces for `threads` threads (at least 1) over a raster of `dims`,
-/// in raster order: about [`PIECES_PER_THREAD`] per thread, slabs of about
+/// in raster order: about `PIECES_PER_THREAD` per thread, slabs of about
 /// as many whole brick layers each; where the raster has no more than half
 /// as many brick layers, each brick layer cut into bands of about as many
 /// whole brick rows. One slab for one thread.
