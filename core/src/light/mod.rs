@@ -943,8 +943,10 @@ pub struct LeavingSurface {
     /// [`VoxelRecord::normal`] (for the same-surface test; decoded only
     /// when a voxel of another object is met).
     pub stored: [i16; 2],
-    /// `stored` decoded ([`decode_normal`]), when the caller has it at
-    /// hand; `None` decodes it when needed.
+    /// `decode_normal(stored)`, when the caller has it at hand (the light
+    /// pass, which decodes every record's normal anyway); `None` decodes
+    /// it when the same-surface test needs it. Any other value makes that
+    /// test wrong.
     pub stored_normal: Option<[i32; 3]>,
     /// The owner of the voxel left ([`RecordStore::owner`]).
     pub object: u32,

@@ -697,7 +697,7 @@ fn facing_away_implies_a_negative_n_dot_l() {
 fn brick_level_changes_no_classification() {
     use super::bricks::{NO_RECORD, SEVERAL, ShadowBricks, shadow_bricks};
     let mut rng = testkit::Rng(0xb1c4_5ead);
-    let (mut proven, mut lit, mut pairs) = (0u32, 0u32, 0u32);
+    let (mut proven, mut lit, mut pairs, mut centred) = (0u32, 0u32, 0u32, 0u32);
     for _ in 0..12 {
         let dims = [0; 3].map(|_| 20 + rng.below_u32(21));
         let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
@@ -746,6 +746,7 @@ fn brick_level_changes_no_classification() {
         };
         if let Some((v, _)) = store.iter().find(|(v, _)| beside_another(*v)) {
             lights.push(v.map(|c| i64::from(c & !7) * VOXEL + 4 * VOXEL));
+            centred += 1;
         }
         for (v, rec) in store.iter() {
             for &light in &lights {
@@ -763,8 +764,8 @@ fn brick_level_changes_no_classification() {
         }
     }
     assert!(
-        proven > pairs / 20 && proven < lit,
-        "{proven} proven by bricks, {lit} lit, {pairs} pairs"
+        proven > pairs / 20 && proven < lit && centred > 3,
+        "{proven} proven by bricks, {lit} lit, {pairs} pairs, {centred} lights at a brick's centre"
     );
 }
 
