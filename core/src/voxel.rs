@@ -435,7 +435,7 @@ pub fn decode_normal(e: [i16; 2]) -> [i32; 3] {
         .iter()
         .map(|c| c.unsigned_abs().saturating_mul(c.unsigned_abs()))
         .fold(0u64, u64::saturating_add);
-    let len = l2.checked_shl(34).unwrap_or(0).isqrt();
+    let len = crate::voxelize::isqrt_u64(l2.checked_shl(34).unwrap_or(0));
     if len == 0 {
         return [0, 0, NORMAL_ONE];
     }
@@ -450,7 +450,7 @@ pub fn decode_normal(e: [i16; 2]) -> [i32; 3] {
 }
 
 /// Normalizes `v` to a unit vector scaled by [`NORMAL_ONE`], in integer
-/// arithmetic ([`isqrt`](u128::isqrt) of the squared length after scaling
+/// arithmetic (the [`isqrt`](u128::isqrt) of the squared length after scaling
 /// the largest component to 40 bits). `None` for the zero vector.
 ///
 /// Each component is within one unit (2^-30) of the exact value, and the
@@ -483,7 +483,7 @@ pub fn normalize(v: [i64; 3]) -> Option<[i32; 3]> {
         .iter()
         .map(|c| c.unsigned_abs().saturating_mul(c.unsigned_abs()))
         .fold(0u128, u128::saturating_add);
-    let len = i128::try_from(len2.isqrt()).ok()?;
+    let len = i128::try_from(crate::voxelize::isqrt_u128(len2)).ok()?;
     if len == 0 {
         return None;
     }

@@ -126,6 +126,96 @@ pub(crate) fn split(lo: u32, hi: u32, ex_lo: i128, ex_hi: i128) -> [Option<(u32,
     ]
 }
 
+/// `⌊√x⌋` from an estimate `r` of it, in `r`'s and `x`'s unsigned type:
+/// down while `r² > x`, up while `(r + 1)² ≤ x`. Exact whatever the
+/// estimate; as many steps as it is off.
+macro_rules! floor_root {
+    ($r:expr, $x:expr) => {{
+        let (mut r, x) = ($r, $x);
+        while r.checked_mul(r).is_none_or(|q| q > x) {
+            r = r.wrapping_sub(1);
+        }
+        while r
+            .wrapping_add(1)
+            .checked_mul(r.wrapping_add(1))
+            .is_some_and(|q| q <= x)
+        {
+            r = r.wrapping_add(1);
+        }
+        r
+    }};
+}
+
+/// `⌊√(t·2^24)⌋` for the top byte `t = 64 + i` of a normalized
+/// argument of [`isqrt_u64`]: a root good to 8 bits, in `[2^15, 2^16)`.
+const ROOTS: [u16; 192] = {
+    let mut t = [0u16; 192];
+    let mut i = 0;
+    while i < t.len() {
+        let v = ((i as u64) + 64) << 24;
+        // v < 2^32: the root < 2^16.
+        #[allow(clippy::cast_possible_truncation)]
+        {
+            t[i] = v.isqrt() as u16;
+        }
+        i += 1;
+    }
+    t
+};
+
+/// `⌊√x⌋`, always equal to [`u64::isqrt`]: a guess from the top byte of
+/// the argument shifted to `[2^62, 2^64)` (a table), two integer Newton
+/// steps (about 7 → 14 → 28 good bits, two divisions), the shift undone,
+/// and a correction that moves the estimate to the exact floor whatever
+/// it was (so the answer never depends on the estimate's precision, only
+/// the number of correction steps does).
+#[inline]
+pub(crate) fn isqrt_u64(x: u64) -> u64 {
+    if x < 4 {
+        return u64::from(x != 0);
+    }
+    // An even shift, so that the root shifts back by half of it.
+    let lz = x.leading_zeros() & !1;
+    let xn = x << lz;
+    // xn ≥ 2^62: its top byte is 64..=255.
+    let top = usize::from(u8::try_from(xn >> 56).unwrap_or(u8::MAX));
+    let guess = ROOTS.get(top.wrapping_sub(64)).copied().unwrap_or(u16::MAX);
+    // Within 1/128 of √xn ∈ [2^31, 2^32); s ∈ (2^31, 2^32].
+    let mut s = u64::from(guess).wrapping_add(1) << 16;
+    for _ in 0..2 {
+        // A Newton step from any s > 0 lands at or above ⌊√xn⌋ ≥ 2^31, so
+        // s stays nonzero, and s + xn/s < 2^32 + 2^33.
+        s = s.wrapping_add(xn.checked_div(s).unwrap_or(0)) >> 1;
+    }
+    // Within a few units of ⌊√x⌋, made exact.
+    floor_root!(s >> (lz >> 1), x)
+}
+
+/// `⌊√n⌋`, always equal to [`u128::isqrt`]: [`isqrt_u64`] below 2^64;
+/// above, the root of the argument's top 62 to 64 bits shifted back
+/// (`r₀ ≤ √n`, good to 31 bits), one Newton step (in 64-bit division
+/// while the remainder `n − r₀²` fits, as it does below 2^94) and the
+/// correction to the exact floor.
+#[inline]
+pub(crate) fn isqrt_u128(n: u128) -> u128 {
+    if let Ok(small) = u64::try_from(n) {
+        return u128::from(isqrt_u64(small));
+    }
+    // n ≥ 2^64: an even shift leaves 63 or 64 bits.
+    let bits = 128u32.saturating_sub(n.leading_zeros());
+    let s = bits.saturating_sub(63) & !1;
+    let hi = u128::from(isqrt_u64(u64::try_from(n >> s).unwrap_or(u64::MAX)));
+    // hi ≥ 2^31 and hi² ≤ n >> s: r0² ≤ n, r0 ≥ 2^31.
+    let r0 = hi << (s >> 1);
+    let rem = n.wrapping_sub(r0.wrapping_mul(r0));
+    // ⌊(r0 + n/r0)/2⌋ = r0 + ⌊rem/(2·r0)⌋: at or above ⌊√n⌋.
+    let step = match (u64::try_from(rem), u64::try_from(r0 << 1)) {
+        (Ok(a), Ok(b)) => u128::from(a.checked_div(b).unwrap_or(0)),
+        _ => rem.checked_div(r0 << 1).unwrap_or(0),
+    };
+    floor_root!(r0.wrapping_add(step), n)
+}
+
 /// `floor(sqrt(n))`, 0 for negative `n`.
 #[inline]
 pub(crate) fn isqrt(n: i128) -> i128 {
@@ -133,9 +223,9 @@ pub(crate) fn isqrt(n: i128) -> i128 {
         return 0;
     }
     match u64::try_from(n) {
-        Ok(small) => i128::from(small.isqrt()),
+        Ok(small) => i128::from(isqrt_u64(small)),
         // n < 2^127, so its root is < 2^64 and fits.
-        Err(_) => i128::try_from(n.unsigned_abs().isqrt()).unwrap_or(i128::MAX),
+        Err(_) => i128::try_from(isqrt_u128(n.unsigned_abs())).unwrap_or(i128::MAX),
     }
 }
 
@@ -191,7 +281,7 @@ fn normalize64_len(w: [i64; 3]) -> (i64, Option<[i32; 3]>) {
     let len2 = w.iter().fold(0u64, |acc, c| {
         acc.wrapping_add(c.unsigned_abs().wrapping_mul(c.unsigned_abs()))
     });
-    let len = i64::try_from(len2.isqrt()).unwrap_or(i64::MAX);
+    let len = i64::try_from(isqrt_u64(len2)).unwrap_or(i64::MAX);
     (len, unit_of_len(w, len))
 }
 
@@ -232,7 +322,7 @@ pub(crate) fn radial(v: [i128; 3]) -> (i128, Option<[i32; 3]>) {
         let len2 = w.iter().fold(0u64, |acc, c| {
             acc.wrapping_add(c.unsigned_abs().wrapping_mul(c.unsigned_abs()))
         });
-        let len = i64::try_from(len2.isqrt()).unwrap_or(i64::MAX);
+        let len = i64::try_from(isqrt_u64(len2)).unwrap_or(i64::MAX);
         let one = i64::from(NORMAL_ONE);
         let mut out = [0i32; 3];
         for (o, c) in out.iter_mut().zip(w) {
@@ -507,6 +597,73 @@ mod tests {
         assert_eq!(split(4, 9, 3, 5), [None, Some((4, 5)), Some((6, 9))]);
         assert_eq!(split(0, 9, 1, 0), [Some((0, 9)), None, None]);
         assert_eq!(split(0, 2, -9, 99), [None, Some((0, 2)), None]);
+    }
+
+    #[test]
+    fn fast_root_is_the_floor_root() {
+        let mut rng = crate::testkit::Rng(0x15_9e7);
+        let near = |r: u64| {
+            [
+                r.wrapping_mul(r).wrapping_sub(1),
+                r.wrapping_mul(r),
+                r.wrapping_mul(r) + 1,
+            ]
+        };
+        for x in 0..200_000u64 {
+            assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+        }
+        for bits in 0..64u32 {
+            for _ in 0..20_000 {
+                let x = rng.next_u64() >> (63 - bits);
+                assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+            }
+            let r = 1u64 << (bits / 2);
+            for x in near(r).into_iter().chain(near(r.saturating_sub(1) | r)) {
+                assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+            }
+        }
+        for r in (u64::from(u32::MAX) - 2000)..u64::from(u32::MAX) {
+            for x in near(r) {
+                assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+            }
+        }
+        for x in [u64::MAX, u64::MAX - 1, 1 << 62, (1 << 62) - 1, 1 << 63] {
+            assert_eq!(isqrt_u64(x), x.isqrt(), "{x}");
+        }
+    }
+
+    #[test]
+    fn fast_wide_root_is_the_floor_root() {
+        let mut rng = crate::testkit::Rng(0x15_9e7_128);
+        let near = |r: u128| {
+            let sq = r.wrapping_mul(r);
+            [sq.wrapping_sub(1), sq, sq.wrapping_add(1)]
+        };
+        for bits in 0..128u32 {
+            for _ in 0..5_000 {
+                let x = ((u128::from(rng.next_u64()) << 64) | u128::from(rng.next_u64()))
+                    >> (127 - bits);
+                assert_eq!(isqrt_u128(x), x.isqrt(), "{x}");
+            }
+            let r = 1u128 << (bits / 2);
+            for x in near(r)
+                .into_iter()
+                .chain(near(r - 1))
+                .chain(near(r | (r >> 1)))
+            {
+                assert_eq!(isqrt_u128(x), x.isqrt(), "{x}");
+            }
+        }
+        for x in [
+            u128::MAX,
+            u128::MAX - 1,
+            1 << 64,
+            (1 << 64) - 1,
+            1 << 127,
+            (1 << 94) - 1,
+        ] {
+            assert_eq!(isqrt_u128(x), x.isqrt(), "{x}");
+        }
     }
 
     #[test]

@@ -148,7 +148,7 @@ pub mod cone;
 pub mod cuboid;
 pub mod error;
 mod fixmath;
-pub(crate) use fixmath::window_of;
+pub(crate) use fixmath::{isqrt_u64, isqrt_u128, window_of};
 pub mod line;
 pub mod patch;
 pub mod sphere;
