@@ -427,14 +427,20 @@ fn shade_record<const N: usize>(
         // N·L from the unit direction to the light; without it where the
         // stored normal clearly faces away (any negative N·L decides as
         // this one would: no light, occluded on a closed shape, the back
-        // side's ray on an open one).
-        let (lit_dir, ndl) = if facing_away(normal, to_light) {
-            (true, -1)
-        } else {
-            let l = normalize(to_light);
-            (l.is_some(), l.map_or(0, |l| dot_unit(normal, l)))
+        // side's ray on an open one). Computed when first needed: the
+        // shadow classification does not read it, only a lit voxel's
+        // illumination does.
+        let mut known = None;
+        let mut n_dot_l = || {
+            *known.get_or_insert_with(|| {
+                if facing_away(normal, to_light) {
+                    (true, -1)
+                } else {
+                    let l = normalize(to_light);
+                    (l.is_some(), l.map_or(0, |l| dot_unit(normal, l)))
+                }
+            })
         };
-        let front = ndl > 0;
         let vis = match (exact, params.exact_records) {
             (true, _)
                 if dark_side(
@@ -459,6 +465,7 @@ fn shade_record<const N: usize>(
                 classify(raster, view, v, own, c0, light.position)?
             }
             (false, _) => {
+                let (lit_dir, ndl) = n_dot_l();
                 let side = if ndl > 0 {
                     normal
                 } else if closed || ndl == 0 {
@@ -491,7 +498,8 @@ fn shade_record<const N: usize>(
         match vis {
             LightVisibility::Visible => {
                 report.visible = report.visible.saturating_add(1);
-                if front && ndl > 0 {
+                let (_, ndl) = n_dot_l();
+                if ndl > 0 {
                     let ndl = u128::from(ndl.unsigned_abs());
                     for (a, c) in acc.iter_mut().zip(light.color.iter()) {
                         // I·L (2^-32) · N·L (2^-30) >> 30: 2^-32, < 2^66.
