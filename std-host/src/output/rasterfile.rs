@@ -693,18 +693,54 @@ fn transposed(raw: &[u8], fields: &[usize]) -> Vec<u8> {
     let mut out = vec![0u8; m * len];
     let mut at = 0;
     for &w in fields {
-        let mut prev = 0u64;
-        for (e, entry) in raw.chunks_exact(len).enumerate() {
-            let v = le_value(&entry[at..at + w]);
-            let d = v.wrapping_sub(prev);
-            prev = v;
-            for i in 0..w {
-                out[(at + i) * m + e] = (d >> (8 * i)) as u8;
+        // The field's byte planes, filled entry by entry.
+        let planes = &mut out[at * m..(at + w) * m];
+        match w {
+            1 => differences::<1>(raw, len, at, planes),
+            2 => differences::<2>(raw, len, at, planes),
+            4 => differences::<4>(raw, len, at, planes),
+            8 => differences::<8>(raw, len, at, planes),
+            _ => {
+                let mut prev = 0u64;
+                for (e, entry) in raw.chunks_exact(len).enumerate() {
+                    let v = le_value(&entry[at..at + w]);
+                    let d = v.wrapping_sub(prev);
+                    prev = v;
+                    for i in 0..w {
+                        planes[i * m + e] = (d >> (8 * i)) as u8;
+                    }
+                }
             }
         }
         at += w;
     }
     out
+}
+
+/// The `W`-byte field at `at` of each entry (`len` bytes) of `raw` as
+/// its difference from the previous entry's, byte `i` of entry `e` into
+/// `planes[i·m + e]` (`m` entries): [`transposed`]'s work for one field.
+fn differences<const W: usize>(raw: &[u8], len: usize, at: usize, planes: &mut [u8]) {
+    let m = planes.len() / W;
+    let mut prev = 0u64;
+    let mut bytes: [&mut [u8]; W] = {
+        let mut rest = planes;
+        std::array::from_fn(|_| {
+            let (plane, tail) = std::mem::take(&mut rest).split_at_mut(m);
+            rest = tail;
+            plane
+        })
+    };
+    for (e, entry) in raw.chunks_exact(len).enumerate() {
+        let mut b = [0u8; 8];
+        b[..W].copy_from_slice(&entry[at..at + W]);
+        let v = u64::from_le_bytes(b);
+        let d = v.wrapping_sub(prev).to_le_bytes();
+        prev = v;
+        for (plane, byte) in bytes.iter_mut().zip(d) {
+            plane[e] = byte;
+        }
+    }
 }
 
 /// The entries [`transposed`] made `t` from, into `raw` (as long).
