@@ -217,3 +217,33 @@ fn an_spd_scene_is_identical_for_every_thread_count() {
         assert!(bytes(&vs, &dir, "two") == want, "exact {}", opts.exact);
     }
 }
+
+#[test]
+fn a_sparse_scene_is_identical_for_every_thread_count() {
+    // Small balls scattered through a raster of odd sizes (no side a
+    // multiple of the brick edge), some alone in their slices, some
+    // sharing brick rows or layers far apart: the field, worked out only
+    // where opaque voxels are near (rows and boxes of slices), must equal
+    // the core's passes over the whole plane.
+    let mut rng = rrt_core::rng::Rng::new(0x5ca7_7e4d);
+    let mut nff = String::from(
+        "v\nfrom 300 -200 250\nat 50 30 20\nup 0 0 1\nangle 40\nhither 1\nresolution 32 32\n\
+         l 400 -300 500\nf 0.8 0.6 0.4 1 0 0 0 1\n",
+    );
+    for _ in 0..40 {
+        let c = [rng.range(2, 98), rng.range(2, 58), rng.range(2, 38)];
+        let r = 0.3 + f64::from(rng.below_u32(12)) / 10.0;
+        nff.push_str(&format!("s {} {} {} {r}\n", c[0], c[1], c[2]));
+    }
+    let scene = Scene::parse("sparse.nff", nff.as_bytes()).unwrap();
+    let dir = fresh_dir("rrt-build-threads", "sparse");
+    for opts in [BuildOptions::paper(203), BuildOptions::new(203)] {
+        let one = build_on(&scene, opts, 1);
+        assert_same_cells(&one, "sparse");
+        let want = bytes(&one, &dir, "one");
+        for threads in [2, 3] {
+            let vs = build_on(&scene, opts, threads);
+            assert!(bytes(&vs, &dir, "more") == want, "exact {}", opts.exact);
+        }
+    }
+}
