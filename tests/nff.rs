@@ -407,6 +407,25 @@ fn nan_and_inf_are_refused() {
 }
 
 #[test]
+fn numbers_beyond_the_world_limit_are_refused() {
+    // Squares of such numbers overflow the exact arithmetic: refused at
+    // the number, whatever field it is; the limit itself is accepted.
+    assert_eq!(
+        err_body("s 0 0 0 1e61\n"),
+        r#"scene.nff:8:9: sphere radius: expected a number within ±1e60, found "1e61""#
+    );
+    assert_eq!(
+        err("v\nfrom 0 -2e100 0\n"),
+        r#"scene.nff:2:8: view from: expected a number within ±1e60, found "-2e100""#
+    );
+    assert_eq!(
+        err_body("l 1e300 0 0\n"),
+        r#"scene.nff:8:3: light position: expected a number within ±1e60, found "1e300""#
+    );
+    assert!(parse(&format!("{HEAD}s 0 0 0 1e60\n")).is_ok());
+}
+
+#[test]
 fn bad_counts() {
     const E: &str = "expected a whole number of vertices, at least 3";
     assert_eq!(

@@ -795,11 +795,25 @@ fn every_bad_value_is_located_at_itself() {
             "expected channels ≥ 0",
         ),
         (
+            "far sphere",
+            second_object("sphere = { centre = [0,0,0], radius = 3e60 }", ""),
+            "3e60",
+            "object[1].sphere.radius",
+            "expected a number > 0, at most 1e60",
+        ),
+        (
+            "far vertex",
+            second_object("polygon = [[0,0,0], [1,0,0], [0,1e61,0]]", ""),
+            "[0,1e61,0]",
+            "object[1].polygon[2]",
+            "expected finite numbers within ±1e60",
+        ),
+        (
             "polygon vertex",
             second_object("polygon = [[0,0,0], [1,0,0], [0,nan,0]]", ""),
             "[0,nan,0]",
             "object[1].polygon[2]",
-            "expected finite numbers",
+            "expected finite numbers within ±1e60",
         ),
         (
             "box",

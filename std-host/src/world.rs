@@ -8,6 +8,37 @@
 
 use glam::DVec3;
 
+/// The largest magnitude of a world coordinate a scene may use: every
+/// point of every object, every light and the eye lie within `±1e60` on
+/// every axis. Beyond it the squares and products of the exact
+/// intersections, of shading and of the camera (a torus's quartic reaches
+/// the fourth power of its coordinates) could overflow `f64`, and an image
+/// would lose objects or light without a word; so the scene readers,
+/// fitting a raster ([`crate::fit`]), the camera and the saved-raster
+/// loader refuse such scenes instead. Far beyond any physical scene (the
+/// observable universe is about `1e27` metres across) and beyond the
+/// `f32` range of tracers such as Embree. Messages spell it `±1e60`:
+///
+/// ```
+/// assert_eq!(format!("±{:e}", rrt_host::world::WORLD_LIMIT), "±1e60");
+/// ```
+pub const WORLD_LIMIT: f64 = 1e60;
+
+/// Whether every coordinate of `v` lies within [`WORLD_LIMIT`] (so is
+/// finite).
+///
+/// ```
+/// use glam::DVec3;
+/// use rrt_host::world::within_world;
+/// assert!(within_world(DVec3::new(1e60, -1e60, 0.0)));
+/// assert!(!within_world(DVec3::new(0.0, 2e60, 0.0)));
+/// assert!(!within_world(DVec3::new(f64::NAN, 0.0, 0.0)));
+/// ```
+#[must_use]
+pub fn within_world(v: DVec3) -> bool {
+    v.abs().cmple(DVec3::splat(WORLD_LIMIT)).all()
+}
+
 /// An axis-aligned box in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
@@ -18,6 +49,12 @@ pub struct Bounds {
 }
 
 impl Bounds {
+    /// Whether both corners lie within [`WORLD_LIMIT`] ([`within_world`]).
+    #[must_use]
+    pub fn within_world(&self) -> bool {
+        within_world(self.min) && within_world(self.max)
+    }
+
     /// The empty box (`min = +∞`, `max = −∞`): [`Bounds::include`] grows it.
     pub const EMPTY: Self = Self {
         min: DVec3::INFINITY,

@@ -16,7 +16,7 @@ use crate::output::rasterfile;
 use crate::scene::{Scene, View};
 use crate::trace::Mode;
 use crate::voxelize::{BuildOptions, BuildReport, VoxelScene, build};
-use crate::world::Bounds;
+use crate::world::{Bounds, WORLD_LIMIT};
 
 /// The built-in scene: SPD `balls2.nff`, the paper's 91-sphereflake.
 pub const DEFAULT_SCENE: &str = include_str!("../../scenes/balls2.nff");
@@ -144,8 +144,8 @@ pub fn parse_bounds(s: &str) -> Result<Bounds, String> {
             .trim()
             .parse::<f64>()
             .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("expected a finite number, found {p:?}"))?;
+            .filter(|x| x.abs() <= WORLD_LIMIT)
+            .ok_or_else(|| format!("expected a finite number within ±1e60, found {p:?}"))?;
     }
     let b = Bounds {
         min: DVec3::new(v[0], v[1], v[2]),
@@ -235,7 +235,7 @@ pub fn parse_angle(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Parses `X,Y,Z` as a finite world vector.
+/// Parses `X,Y,Z` as a world vector within [`WORLD_LIMIT`].
 ///
 /// # Errors
 /// A message naming the bad part.
@@ -244,8 +244,8 @@ pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
         p.trim()
             .parse::<f64>()
             .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("expected a finite number, found {p:?}"))
+            .filter(|x| x.abs() <= WORLD_LIMIT)
+            .ok_or_else(|| format!("expected a finite number within ±1e60, found {p:?}"))
     })?;
     Ok(DVec3::from(v))
 }

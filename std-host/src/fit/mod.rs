@@ -44,7 +44,7 @@ pub use self::size::{MAX_DEFAULT_RASTER, MIN_DEFAULT_RASTER, RasterNeed, default
 use crate::frame::{MAX_FIXED_VOXEL_BITS, RasterFrame};
 use crate::scene::{Object, Scene, SourceLoc};
 use crate::shape::{Shape, Surface, Unfit};
-use crate::world::Bounds;
+use crate::world::{Bounds, WORLD_LIMIT, within_world};
 
 /// How to fit the raster.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,14 +95,17 @@ pub enum FitError {
         margin: u32,
     },
     /// Explicit bounds that are not a box.
-    #[error("bounds {min} to {max}: expected finite corners with min < max on every axis")]
+    #[error(
+        "bounds {min} to {max}: expected corners within ±{WORLD_LIMIT:e} with min < max on every axis"
+    )]
     BadBounds {
         /// Lowest corner.
         min: DVec3,
         /// Highest corner.
         max: DVec3,
     },
-    /// The geometry has no extent (or is not finite).
+    /// The geometry has no extent, is not finite, or reaches beyond
+    /// [`WORLD_LIMIT`].
     #[error("{file}: {}", no_extent(*min, *max))]
     NoExtent {
         /// The scene file.
@@ -126,6 +129,16 @@ pub enum FitError {
     /// numbers; this guards scenes built in code).
     #[error("{loc}: {what} position is not finite")]
     NotFinite {
+        /// Where it is defined.
+        loc: SourceLoc,
+        /// What it is.
+        what: &'static str,
+    },
+    /// An object or a light reaches beyond [`WORLD_LIMIT`].
+    #[error(
+        "{loc}: {what} reaches beyond ±{WORLD_LIMIT:e} world units, where the exact arithmetic of intersections and shading would overflow; scale the scene down"
+    )]
+    BeyondWorld {
         /// Where it is defined.
         loc: SourceLoc,
         /// What it is.
@@ -202,6 +215,10 @@ pub struct Fitted {
 /// without extent, an estimate above `opts.max_memory`, or a light or
 /// object too far from the raster.
 pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
+    if opts.bounds.is_none() {
+        // Named by its place before the scene's bounds would refuse it.
+        beyond_world(scene)?;
+    }
     let frame = frame(scene, opts)?;
     let memory = estimate_memory(scene, &frame, opts.solid_spheres);
     if memory.total() > opts.max_memory {
@@ -235,6 +252,12 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
         .lights
         .iter()
         .map(|l| {
+            if l.position.is_finite() && !within_world(l.position) {
+                return Err(FitError::BeyondWorld {
+                    loc: l.loc.clone(),
+                    what: "light",
+                });
+            }
             Ok(FittedLight {
                 position: frame
                     .light_to_fixed(l.position)
@@ -256,6 +279,33 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
         memory,
         dropped,
     })
+}
+
+/// The first sphere, cone, polygon or torus (in that order) that reaches
+/// beyond [`WORLD_LIMIT`], as [`FitError::BeyondWorld`] at its place.
+fn beyond_world(scene: &Scene) -> Result<(), FitError> {
+    fn first<S: Surface>(list: &[Object<S>]) -> Result<(), FitError> {
+        match list.iter().find(|o| !o.shape.bounds().within_world()) {
+            Some(o) => Err(FitError::BeyondWorld {
+                loc: o.loc.clone(),
+                what: S::KIND,
+            }),
+            None => Ok(()),
+        }
+    }
+    first(&scene.spheres)?;
+    first(&scene.cones)?;
+    if let Some(p) = scene
+        .polygons
+        .iter()
+        .find(|p| !scene.polygon_bounds(p).within_world())
+    {
+        return Err(FitError::BeyondWorld {
+            loc: p.loc.clone(),
+            what: "polygon",
+        });
+    }
+    first(&scene.tori)
 }
 
 /// The object table as [`fit`] fills it.
@@ -282,6 +332,12 @@ impl Table<'_> {
         kind: &'static str,
         loc: &SourceLoc,
     ) -> Result<(), FitError> {
+        if !shape.bounds().within_world() {
+            return Err(FitError::BeyondWorld {
+                loc: loc.clone(),
+                what: kind,
+            });
+        }
         match shape.to_fixed(self.frame) {
             Ok(fixed) => self.objects.push(FittedObject {
                 shape: shape.into(),
@@ -360,6 +416,12 @@ fn no_extent(min: DVec3, max: DVec3) -> String {
     } else if !(max - min).is_finite() {
         format!(
             "the geometry's bounds {} to {} are too far apart to fit a raster to",
+            p(min),
+            p(max)
+        )
+    } else if !(within_world(min) && within_world(max)) {
+        format!(
+            "the geometry's bounds {} to {} reach beyond ±{WORLD_LIMIT:e} world units, where the exact arithmetic of intersections and shading would overflow; scale the scene down",
             p(min),
             p(max)
         )

@@ -24,7 +24,7 @@ pub fn frame(scene: &Scene, opts: &FitOptions) -> Result<RasterFrame, FitError> 
     }
     let (bounds, margin) = match opts.bounds {
         Some(b) => {
-            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmplt(b.max).all()) {
+            if !(b.within_world() && b.min.cmplt(b.max).all()) {
                 return Err(FitError::BadBounds {
                     min: b.min,
                     max: b.max,
@@ -40,7 +40,7 @@ pub fn frame(scene: &Scene, opts: &FitOptions) -> Result<RasterFrame, FitError> 
     }
     let size = bounds.size();
     let longest = size.max_element();
-    if !(longest > 0.0 && longest.is_finite() && bounds.min.is_finite()) {
+    if !(longest > 0.0 && longest.is_finite() && bounds.within_world()) {
         return Err(FitError::NoExtent {
             file: scene.file.to_string(),
             min: bounds.min,

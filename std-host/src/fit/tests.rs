@@ -69,7 +69,7 @@ fn explicit_bounds_are_used_exactly() {
     .unwrap_err();
     assert_eq!(
         e.to_string(),
-        "bounds [1, 1, 1] to [2, 1, 2]: expected finite corners with min < max on every axis"
+        "bounds [1, 1, 1] to [2, 1, 2]: expected corners within ±1e60 with min < max on every axis"
     );
 }
 
@@ -349,10 +349,38 @@ fn objects_keep_the_exact_world_geometry() {
 
 #[test]
 fn geometry_without_a_box_says_why() {
-    let e = |body: &str| fit(&scene(body), &opts(64)).unwrap_err().to_string();
+    // Scenes built in code: the readers refuse such numbers themselves.
+    let e = |radius: f64| {
+        let mut s = scene("s 1 1 1 1\n");
+        s.spheres[0].shape.radius = radius;
+        fit(&s, &opts(64)).unwrap_err().to_string()
+    };
+    for r in [1e61, 1e308] {
+        assert!(
+            e(r).starts_with("t.nff:8:1: sphere reaches beyond ±1e60 world units"),
+            "{}",
+            e(r)
+        );
+    }
+    // Geometry the object checks do not name (volumes, `.vox` models, CSG).
+    let bounds = |min: f64, max: f64| {
+        FitError::NoExtent {
+            file: "x.toml".into(),
+            min: DVec3::splat(min),
+            max: DVec3::splat(max),
+        }
+        .to_string()
+    };
     assert_eq!(
-        e("s 1 1 1 1e308\n"),
-        "t.nff: the geometry's bounds (-1e308, -1e308, -1e308) to (1e308, 1e308, 1e308) are too far apart to fit a raster to"
+        bounds(-1e308, 1e308),
+        "x.toml: the geometry's bounds (-1e308, -1e308, -1e308) to (1e308, 1e308, 1e308) are too far apart to fit a raster to"
+    );
+    assert!(
+        bounds(-1e61, 1.0).starts_with(
+            "x.toml: the geometry's bounds (-1e61, -1e61, -1e61) to (1e0, 1e0, 1e0) reach beyond ±1e60 world units"
+        ),
+        "{}",
+        bounds(-1e61, 1.0)
     );
     let empty = FitError::NoExtent {
         file: "x.toml".into(),
@@ -365,4 +393,59 @@ fn geometry_without_a_box_says_why() {
             .starts_with("x.toml: nothing to fit a raster to: every object is empty"),
         "{empty}"
     );
+}
+
+#[test]
+fn objects_and_lights_beyond_the_world_limit_are_refused() {
+    // Within explicit bounds the raster is small, but the exact intersection
+    // of a sphere of radius 1e100 would square it: refused by the object's
+    // place, as is a light as far.
+    let b = Some(Bounds {
+        min: DVec3::splat(-2.0),
+        max: DVec3::splat(2.0),
+    });
+    let mut s = scene("s 0 0 0 1\nl 1 1 1\n");
+    s.spheres[0].shape.radius = 1e100;
+    let e = fit(
+        &s,
+        &FitOptions {
+            bounds: b,
+            ..opts(16)
+        },
+    )
+    .unwrap_err();
+    assert!(
+        matches!(&e, FitError::BeyondWorld { what: "sphere", .. }),
+        "{e}"
+    );
+    assert!(
+        e.to_string()
+            .starts_with("t.nff:8:1: sphere reaches beyond ±1e60 world units"),
+        "{e}"
+    );
+    let mut s = scene("s 0 0 0 1\nl 1 1 1\n");
+    s.lights[0].position = DVec3::new(0.0, 0.0, -1e61);
+    let e = fit(&s, &opts(16)).unwrap_err();
+    assert!(
+        matches!(&e, FitError::BeyondWorld { what: "light", .. }),
+        "{e}"
+    );
+    // At the limit itself, everything is accepted.
+    let mut s = scene("s 0 0 0 1\nl 1 1 1\n");
+    s.lights[0].position = DVec3::new(0.0, 0.0, -1e60);
+    assert!(fit(&s, &opts(16)).is_ok());
+    let huge = Bounds {
+        min: DVec3::splat(-1e61),
+        max: DVec3::splat(2.0),
+    };
+    assert!(matches!(
+        fit(
+            &s,
+            &FitOptions {
+                bounds: Some(huge),
+                ..opts(16)
+            }
+        ),
+        Err(FitError::BadBounds { .. })
+    ));
 }

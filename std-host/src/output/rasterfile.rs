@@ -115,6 +115,7 @@ use crate::voxelize::{
     MAX_MATERIALS, VoxelScene, derive_plane, line_level, line_level_of_plane, plane_matches_records,
 };
 use crate::voxelize::{WorldLight, WorldObject};
+use crate::world::{WORLD_LIMIT, within_world};
 
 /// The file's first bytes.
 pub const MAGIC: [u8; 8] = *b"RRTRASTR";
@@ -1385,6 +1386,11 @@ fn read_meta(bytes: &[u8], path: &Path, h: &Header) -> Result<Meta, RasterFileEr
     if !(from.is_finite() && at.is_finite() && up.is_finite() && angle.is_finite()) {
         return Err(invalid("view is not finite".into()));
     }
+    if !(within_world(from) && within_world(at)) {
+        return Err(invalid(format!(
+            "view from or at beyond ±{WORLD_LIMIT:e} world units"
+        )));
+    }
     if let Some(defect) = ViewDefect::of(from, at, up) {
         let key = match defect {
             ViewDefect::NoDirection => "at",
@@ -2021,6 +2027,12 @@ fn objects_from(b: &[u8], materials: usize) -> Result<Vec<WorldObject>, String> 
         if let Err(e) = shape.validate() {
             return Err(format!("object {i}: {}: {e}", shape.kind()));
         }
+        if !shape.bounds().is_none_or(|b| b.within_world()) {
+            return Err(format!(
+                "object {i}: {} reaches beyond ±{WORLD_LIMIT:e} world units",
+                shape.kind()
+            ));
+        }
         objects.push(WorldObject { shape, material });
     }
     Ok(objects)
@@ -2039,9 +2051,11 @@ fn lights_from(b: &[u8]) -> Result<Vec<WorldLight>, String> {
         colour: c.vec(),
     });
     if lights.iter().any(|l| {
-        !(l.position.is_finite() && l.colour.is_finite() && l.colour.cmpge(DVec3::ZERO).all())
+        !(within_world(l.position) && l.colour.is_finite() && l.colour.cmpge(DVec3::ZERO).all())
     }) {
-        return Err("a light is not finite, or has a negative colour channel".into());
+        return Err(format!(
+            "a light is not finite or beyond ±{WORLD_LIMIT:e} world units, or has a negative colour channel"
+        ));
     }
     Ok(lights)
 }
@@ -2218,5 +2232,23 @@ mod tests {
             .to_string();
         assert!(e.starts_with("t.rrt: the raster needs"), "{e}");
         assert!(e.contains("more than the limit of 1000 B"), "{e}");
+    }
+
+    #[test]
+    fn objects_and_lights_beyond_the_world_limit_are_refused() {
+        let mut vs = built(BuildOptions::new(24));
+        let lights = |vs: &VoxelScene| lights_from(&lights_bytes(vs));
+        let objects = |vs: &VoxelScene| objects_from(&objects_bytes(vs), vs.materials.len());
+        assert!(lights(&vs).is_ok() && objects(&vs).is_ok());
+        vs.lights[0].position.z = WORLD_LIMIT;
+        assert!(lights(&vs).is_ok());
+        vs.lights[0].position.z = 2e60;
+        assert!(lights(&vs).unwrap_err().contains("beyond ±1e60"));
+        let Shape::Sphere(s) = &mut vs.objects[0].shape else {
+            panic!("{:?}", vs.objects[0].shape);
+        };
+        s.radius = 1e61;
+        let e = objects(&vs).unwrap_err();
+        assert_eq!(e, "object 0: sphere reaches beyond ±1e60 world units");
     }
 }

@@ -24,7 +24,7 @@
 use glam::DVec3;
 
 use crate::scene::View;
-use crate::world::Ray;
+use crate::world::{Ray, WORLD_LIMIT, within_world};
 
 /// Why a camera cannot be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -33,6 +33,9 @@ pub enum CameraError {
     /// `from` and `at` coincide (or are not finite).
     #[error("camera: `from` and `at` must be distinct finite points")]
     NoDirection,
+    /// `from` or `at` lies beyond [`WORLD_LIMIT`].
+    #[error("camera: `from` and `at` must lie within ±{WORLD_LIMIT:e} world units")]
+    BeyondWorld,
     /// `up` is zero or parallel to the view direction.
     #[error("camera: `up` must not be zero or parallel to the view direction (at − from)")]
     NoUp,
@@ -94,6 +97,9 @@ impl Camera {
         }
         if !from.is_finite() {
             return Err(CameraError::NoDirection);
+        }
+        if !(within_world(from) && (within_world(at) || !at.is_finite())) {
+            return Err(CameraError::BeyondWorld);
         }
         let forward = (at - from)
             .try_normalize()
@@ -294,6 +300,14 @@ mod tests {
         assert_eq!(
             Camera::look_at(DVec3::NAN, DVec3::ZERO, DVec3::Z, 45.0, 8, 8),
             Err(CameraError::NoDirection)
+        );
+        assert_eq!(
+            Camera::look_at(DVec3::ZERO, DVec3::X * 1e61, DVec3::Z, 45.0, 8, 8),
+            Err(CameraError::BeyondWorld)
+        );
+        assert_eq!(
+            Camera::look_at(DVec3::Y * -2e60, DVec3::ZERO, DVec3::Z, 45.0, 8, 8),
+            Err(CameraError::BeyondWorld)
         );
     }
 }

@@ -262,6 +262,10 @@ impl Polygon {
 /// ([`rrt_core::csg::CsgTree`]: children before parents, at most
 /// [`rrt_core::csg::MAX_NODES`] nodes, every leaf present); there is at
 /// least one object. `check_scene` (feature `check`) checks all of it.
+/// Geometry, lights and the eye beyond
+/// [`WORLD_LIMIT`](crate::world::WORLD_LIMIT) are refused by the NFF and
+/// TOML readers where they read the number, and otherwise (meshes,
+/// transforms, scenes built in code) by [`crate::fit`] and the camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     /// The file name the scene was read from, as given.

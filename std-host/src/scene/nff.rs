@@ -35,7 +35,7 @@
 //! Each field must be on the line the format puts it on; a line with too
 //! few or too many fields is an error at its end or at the extra token.
 //! Numbers must be finite (`NaN`, `inf` and overflowing literals are
-//! refused); counts and pixel sizes must be whole numbers. Ranges:
+//! refused) and within [`WORLD_LIMIT`] (±1e60) in magnitude; counts and pixel sizes must be whole numbers. Ranges:
 //! colours of `b` and `f` in `[0, 1]`; light colours ≥ 0; `Kd`, `Ks`,
 //! `Shine` and the index of refraction ≥ 0, `T` in `[0, 1]`, and an index
 //! of refraction > 0 when `T > 0`; sphere radii > 0 and cone radii ≥ 0
@@ -67,6 +67,7 @@ use super::loc::SourceLoc;
 use super::text::byte_loc;
 use super::{Light, Material, Object, Polygon, Scene, View, ViewDefect};
 use crate::shape::{Cone, Sphere};
+use crate::world::WORLD_LIMIT;
 
 /// Largest image width or height a `resolution` line may ask for: the
 /// renderer's largest side (`crate::render::MAX_SIDE` is this).
@@ -387,7 +388,8 @@ impl<'a> Parser<'a> {
             return Err(self.missing(field, "a number", Found::EndOfLine));
         };
         match tok.text.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok((v, tok)),
+            Ok(v) if v.abs() <= WORLD_LIMIT => Ok((v, tok)),
+            Ok(v) if v.is_finite() => Err(self.bad(tok, field, "a number within ±1e60")),
             Ok(_) => Err(self.bad(tok, field, "a finite number")),
             Err(_) => Err(self.bad(tok, field, "a number")),
         }

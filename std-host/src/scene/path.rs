@@ -25,6 +25,7 @@ use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
 use super::text::read_text;
 use super::{View, ViewDefect};
+use crate::world::WORLD_LIMIT;
 
 /// Largest camera path file read, in bytes.
 pub const MAX_FILE_BYTES: u64 = 64 << 20;
@@ -130,7 +131,8 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<PathView>, SceneError> {
                 found: Found::token(t),
             };
             *slot = match t.parse::<f64>() {
-                Ok(x) if x.is_finite() => x,
+                Ok(x) if x.abs() <= WORLD_LIMIT => x,
+                Ok(x) if x.is_finite() => return Err(bad("a number within ±1e60")),
                 Ok(_) => return Err(bad("a finite number")),
                 Err(_) => return Err(bad("a number")),
             };
@@ -233,6 +235,10 @@ mod tests {
             (
                 "0 -4 1 0 0 inf 0 0 1 45\n",
                 "p:1:12: path view at z: expected a finite number",
+            ),
+            (
+                "0 -4e70 1 0 0 0 0 0 1 45\n",
+                "p:1:3: path view from y: expected a number within ±1e60",
             ),
             ("# nothing\n\n", "p: no views"),
         ] {

@@ -32,9 +32,11 @@ pub(super) struct Builder<'t> {
     pub(super) volumes: BTreeMap<String, SceneVolume>,
 }
 
+/// The vector, if its numbers are finite and within
+/// [`WORLD_LIMIT`](crate::world::WORLD_LIMIT).
 pub(super) fn finite3(v: V3) -> Option<DVec3> {
     let d = DVec3::from(v.0);
-    d.is_finite().then_some(d)
+    crate::world::within_world(d).then_some(d)
 }
 
 impl Builder<'_> {
@@ -77,7 +79,8 @@ impl Builder<'_> {
         key: &str,
         v: V3,
     ) -> Result<DVec3, SceneError> {
-        finite3(v).ok_or_else(|| self.err(span.clone(), key, "expected finite numbers"))
+        finite3(v)
+            .ok_or_else(|| self.err(span.clone(), key, "expected finite numbers within ±1e60"))
     }
 
     pub(super) fn path(

@@ -11,6 +11,7 @@ use crate::scene::error::SceneError;
 use crate::scene::loc::SourceLoc;
 use crate::scene::objects::{Csg, CsgLeaf, Solid};
 use crate::shape::{Cone, Cuboid, Sphere, Torus};
+use crate::world::WORLD_LIMIT;
 
 impl Builder<'_> {
     pub(super) fn cone(
@@ -28,8 +29,12 @@ impl Builder<'_> {
             ("base_radius", c.base_radius),
             ("apex_radius", c.apex_radius),
         ] {
-            if !(r.is_finite() && r >= 0.0) {
-                return Err(self.err(s.clone(), &format!("{key}.{k}"), "expected a number ≥ 0"));
+            if !(0.0..=WORLD_LIMIT).contains(&r) {
+                return Err(self.err(
+                    s.clone(),
+                    &format!("{key}.{k}"),
+                    "expected a number ≥ 0, at most 1e60",
+                ));
             }
         }
         if c.base_radius + c.apex_radius <= 0.0 {
@@ -59,8 +64,12 @@ impl Builder<'_> {
             .try_normalize()
             .ok_or_else(|| self.err(s.clone(), &format!("{key}.axis"), "zero axis"))?;
         for (k, r) in [("major", t.major), ("minor", t.minor)] {
-            if !(r.is_finite() && r > 0.0) {
-                return Err(self.err(s.clone(), &format!("{key}.{k}"), "expected a number > 0"));
+            if !(r > 0.0 && r <= WORLD_LIMIT) {
+                return Err(self.err(
+                    s.clone(),
+                    &format!("{key}.{k}"),
+                    "expected a number > 0, at most 1e60",
+                ));
             }
         }
         Ok(Torus {
@@ -110,8 +119,12 @@ impl Builder<'_> {
         self.exactly_one(&given, &s, &key, "sphere, box, cone, torus, volume")?;
         let shape = if let Some(sp) = &d.sphere {
             let centre = self.vec3(&s, &format!("{key}.sphere.centre"), sp.centre)?;
-            if !(sp.radius.is_finite() && sp.radius > 0.0) {
-                return Err(self.err(s, &format!("{key}.sphere.radius"), "expected a number > 0"));
+            if !(sp.radius > 0.0 && sp.radius <= WORLD_LIMIT) {
+                return Err(self.err(
+                    s,
+                    &format!("{key}.sphere.radius"),
+                    "expected a number > 0, at most 1e60",
+                ));
             }
             Solid::Sphere(Sphere {
                 centre,

@@ -19,6 +19,7 @@ use crate::scene::loc::SourceLoc;
 use crate::scene::objects::{Solid, VolumeObject, VoxObject};
 use crate::scene::{Object, Scene, bezier, bpt, nff, obj};
 use crate::shape::Sphere;
+use crate::world::WORLD_LIMIT;
 
 /// What every shape of an object gets: where it is defined, its material
 /// and its transform.
@@ -118,8 +119,12 @@ impl Builder<'_> {
 
     fn sphere(&self, scene: &mut Scene, sp: &SphereDef, at: At) -> Result<(), SceneError> {
         let centre = self.vec3(&at.span, "object.sphere.centre", sp.centre)?;
-        if !(sp.radius.is_finite() && sp.radius > 0.0) {
-            return Err(self.err(at.span, "object.sphere.radius", "expected a number > 0"));
+        if !(sp.radius > 0.0 && sp.radius <= WORLD_LIMIT) {
+            return Err(self.err(
+                at.span,
+                "object.sphere.radius",
+                "expected a number > 0, at most 1e60",
+            ));
         }
         scene.spheres.push(Object {
             shape: Sphere {
