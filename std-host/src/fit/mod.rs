@@ -212,8 +212,9 @@ pub struct Fitted {
 ///
 /// # Errors
 /// [`FitError`]: an absurd raster size, bad explicit bounds, geometry
-/// without extent, an estimate above `opts.max_memory`, or a light or
-/// object too far from the raster.
+/// without extent, an estimate above `opts.max_memory`, a light or
+/// object too far from the raster, or geometry or a light beyond
+/// [`WORLD_LIMIT`].
 pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
     if opts.bounds.is_none() {
         // Named by its place before the scene's bounds would refuse it.
