@@ -35,10 +35,11 @@
 //! Each field must be on the line the format puts it on; a line with too
 //! few or too many fields is an error at its end or at the extra token.
 //! Numbers must be finite (`NaN`, `inf` and overflowing literals are
-//! refused) and within [`WORLD_LIMIT`] (±1e60) in magnitude; counts and pixel sizes must be whole numbers. Ranges:
-//! colours of `b` and `f` in `[0, 1]`; light colours ≥ 0; `Kd`, `Ks`,
-//! `Shine` and the index of refraction ≥ 0, `T` in `[0, 1]`, and an index
-//! of refraction > 0 when `T > 0`; sphere radii > 0 and cone radii ≥ 0
+//! refused) and within [`WORLD_LIMIT`] (±1e60) in magnitude; counts and
+//! pixel sizes must be whole numbers. Ranges: colours of `b` and `f` in
+//! `[0, 1]`; light colours ≥ 0; `Kd`, `Ks`, `Shine` and the index of
+//! refraction ≥ 0, `T` in `[0, 1]`, and an index of refraction > 0 when
+//! `T > 0`; sphere radii > 0 and cone radii ≥ 0
 //! (NFF's negative radii, "only the inside is visible", are refused: rrt
 //! shades both sides, as `embree_nff`); `0 < angle < 180`; resolutions
 //! from 1 to [`MAX_RESOLUTION`]. `v` and `b` may appear once. A view whose
