@@ -56,9 +56,14 @@ pub struct AtomicFile {
     file: Option<File>,
 }
 
+/// The longest file name the temporary name may have (bytes; the limit of
+/// common file systems).
+const NAME_MAX: usize = 255;
+
 impl AtomicFile {
     /// Creates the temporary file `NAME.PID-N.tmp` in `target`'s
-    /// directory (`N` counts the outputs of this process).
+    /// directory (`N` counts the outputs of this process; `.rrt.PID-N.tmp`
+    /// when that would be longer than 255 bytes).
     ///
     /// # Errors
     /// `target` is a directory or has no file name, or the temporary file
@@ -77,12 +82,19 @@ impl AtomicFile {
                 "not a file name",
             ));
         };
-        let mut tmp_name = name.to_owned();
-        tmp_name.push(format!(
+        let suffix = format!(
             ".{}-{}.tmp",
             std::process::id(),
             COUNT.fetch_add(1, Ordering::Relaxed)
-        ));
+        );
+        // A name that is legal but leaves no room for the suffix within
+        // the common 255-byte limit gets the short `.rrt.PID-N.tmp`.
+        let mut tmp_name = if name.len().saturating_add(suffix.len()) > NAME_MAX {
+            std::ffi::OsString::from(".rrt")
+        } else {
+            name.to_owned()
+        };
+        tmp_name.push(suffix);
         let tmp = target.with_file_name(tmp_name);
         // Registered before it exists, so an interruption between the two
         // cannot leave it behind.
@@ -210,6 +222,23 @@ mod tests {
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
         assert_eq!(names(&d), ["x.bin"]);
         assert!(pending().is_empty() || !pending().iter().any(|p| p.starts_with(&d)));
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    /// Names up to 255 bytes, legal on common file systems, are written
+    /// though the temporary name would be longer than that.
+    #[test]
+    fn the_longest_names_are_written() {
+        use std::io::Write;
+        let d = dir("long");
+        for len in [243, 244, 250, 255] {
+            let target = d.join(format!("{}.png", "a".repeat(len - 4)));
+            let mut f = AtomicFile::create(&target).unwrap();
+            f.file().write_all(b"x").unwrap();
+            f.commit().unwrap();
+            assert_eq!(std::fs::read(&target).unwrap(), b"x", "{len}");
+        }
+        assert_eq!(names(&d).len(), 4);
         let _ = std::fs::remove_dir_all(&d);
     }
 
