@@ -56,7 +56,6 @@
 //! [`ParseOptions::max_file_bytes`] before they are read.
 
 use std::fs;
-use std::io::Read;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -138,13 +137,9 @@ pub fn load_with(
     if meta.len() > opts.max_file_bytes {
         return Err(too_large(meta.len()));
     }
-    let mut bytes = Vec::new();
-    // `take` guards against a file that grows after the size check.
-    fs::File::open(path)
-        .map_err(io)?
-        .take(opts.max_file_bytes.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
+    let bytes =
+        super::text::read_until_binary(fs::File::open(path).map_err(io)?, opts.max_file_bytes)
+            .map_err(io)?;
     progress.set_length(bytes.len() as u64);
     parse_in(name, &bytes, opts, Some(progress))
 }

@@ -34,14 +34,28 @@ pub(crate) fn read_text(path: &Path, name: &Arc<str>, limit: u64) -> Result<Stri
             limit,
         });
     }
-    let mut bytes = Vec::new();
-    // `take` guards against a file that grows after the size check.
-    fs::File::open(path)
-        .map_err(io)?
-        .take(limit.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
+    let bytes = read_until_binary(fs::File::open(path).map_err(io)?, limit).map_err(io)?;
     text(name, bytes, limit)
+}
+
+/// Reads `reader` to its end, at most `limit + 1` bytes (a file that grows
+/// after its size was checked, or a device or pipe, which has no size),
+/// stopping early after a piece that holds a NUL byte: binary data is
+/// refused at its first megabyte, not after the limit's worth of memory.
+///
+/// # Errors
+/// The reader's.
+pub(crate) fn read_until_binary(reader: impl Read, limit: u64) -> std::io::Result<Vec<u8>> {
+    const PIECE: u64 = 1 << 20;
+    let mut reader = reader.take(limit.saturating_add(1));
+    let mut bytes = Vec::new();
+    loop {
+        let start = bytes.len();
+        let n = (&mut reader).take(PIECE).read_to_end(&mut bytes)?;
+        if n == 0 || bytes.get(start..).is_some_and(|piece| piece.contains(&0)) {
+            return Ok(bytes);
+        }
+    }
 }
 
 /// `bytes` as text (at most `limit` bytes).
@@ -87,4 +101,24 @@ pub(crate) fn byte_loc(file: &Arc<str>, bytes: &[u8], at: usize) -> SourceLoc {
         u32::try_from(lines + 1).unwrap_or(u32::MAX),
         u32::try_from(column + 1).unwrap_or(u32::MAX),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::read_until_binary;
+    use std::io::Read;
+
+    /// Binary data (an endless stream of NUL bytes, as `/dev/zero`) is
+    /// read only to the piece holding its first NUL; text is read whole,
+    /// up to the limit and one byte more.
+    #[test]
+    fn binary_streams_stop_at_their_first_piece() {
+        let zeros = read_until_binary(std::io::repeat(0), 1 << 30).unwrap();
+        assert_eq!(zeros.len(), 1 << 20);
+        let text = "s 0 0 0 1\n".repeat(300_000);
+        let read = read_until_binary(text.as_bytes(), 1 << 30).unwrap();
+        assert_eq!(read, text.as_bytes());
+        let capped = read_until_binary(std::io::repeat(b'x').take(5_000_000), 3_000_000).unwrap();
+        assert_eq!(capped.len(), 3_000_001);
+    }
 }
