@@ -331,3 +331,48 @@ fn saved_raster_options_are_checked() {
         .unwrap();
     });
 }
+
+/// A saved raster is refused when loading it would need more memory than
+/// `--max-memory`, as a scene's raster is, before it is made; and a raster
+/// saved for the verified mode renders the scene's verified image, byte
+/// for byte (it keeps the paper's light bits, which that mode reads).
+#[test]
+fn saved_rasters_keep_the_memory_limit_and_the_verified_image() {
+    in_temp_dir("saved-limit", |dir| {
+        let rrt = dir.join("t.rrt");
+        let r = rrt.to_str().unwrap();
+        let scene = data("balls1.nff");
+        let scene = scene.to_str().unwrap();
+        let small = ["--width", "24", "--height", "24", "-q"];
+        cli(&[
+            "voxelize", scene, "-o", r, "--raster", "96", "--mode", "verified", "-q",
+        ])
+        .unwrap();
+        let o = dir.join("o.png");
+        let o = o.to_str().unwrap();
+        fails_with(
+            &[&["render", r, "-o", o, "--max-memory", "64K"][..], &small].concat(),
+            "more than the limit of 64.0 KiB",
+        );
+        assert!(!Path::new(o).exists());
+        let image = |args: &[&str], out: &str| {
+            let out = dir.join(out);
+            let out = out.to_str().unwrap();
+            cli_with(
+                &[
+                    &["render"][..],
+                    args,
+                    &["-o", out, "--mode", "verified"],
+                    &small,
+                ]
+                .concat(),
+                &[],
+            )
+            .unwrap();
+            std::fs::read(out).unwrap()
+        };
+        let saved = image(&[r], "saved.ppm");
+        let direct = image(&[scene, "--raster", "96"], "scene.ppm");
+        assert_eq!(saved, direct);
+    });
+}

@@ -87,8 +87,9 @@ impl From<ModeArg> for Mode {
 /// What a build is for: its light pass computes what that needs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Purpose {
-    /// A raster to save: complete light visibility (the shadow
-    /// classification for records of exact objects), for every mode.
+    /// A raster to save: complete light visibility, for every mode (the
+    /// shadow classification for records of exact objects; the paper's
+    /// bits for the verified mode, which reads them).
     Save,
     /// A render now, in the mode asked for: the exact mode reads no light
     /// bits of exact objects, the verified mode the paper's.
@@ -113,6 +114,9 @@ impl RasterArgs {
             _ => BuildOptions::new(raster),
         };
         o.light.exact_records = match (purpose, self.mode) {
+            // The verified mode reads the paper's bits: saved so, the
+            // raster renders the scene's verified image.
+            (Purpose::Save, ModeArg::Verified) => ExactRecords::Paper,
             (Purpose::Save, _) => ExactRecords::Classify,
             (Purpose::Render, ModeArg::Exact) => ExactRecords::Skip,
             (Purpose::Render, _) => ExactRecords::Paper,
@@ -393,7 +397,8 @@ pub fn load_or_build(
         let t = Instant::now();
         let bar = progress(show_progress);
         crate::progress::phase(&bar, "loading", crate::progress::Unit::Bytes, 0);
-        let scene = rasterfile::load_with(p, &bar);
+        let limit = raster.max_memory.unwrap_or_else(default_max_memory);
+        let scene = rasterfile::load_within(p, &bar, limit);
         bar.finish_and_clear();
         let scene = scene?;
         check_view(&scene.view)?;

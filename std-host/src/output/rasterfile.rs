@@ -1672,8 +1672,21 @@ pub fn load(path: &Path) -> Result<VoxelScene, RasterFileError> {
 /// # Errors
 /// As [`load`].
 pub fn load_with(path: &Path, progress: &ProgressBar) -> Result<VoxelScene, RasterFileError> {
+    load_within(path, progress, default_max_memory())
+}
+
+/// [`load_with`], refusing a raster that needs more than `max_memory`
+/// bytes once loaded ([`RasterFileError::TooLarge`]) before allocating it.
+///
+/// # Errors
+/// As [`load`].
+pub fn load_within(
+    path: &Path,
+    progress: &ProgressBar,
+    max_memory: u64,
+) -> Result<VoxelScene, RasterFileError> {
     let bytes = map(path)?;
-    load_from(&bytes, path, progress, default_max_memory())
+    load_from(&bytes, path, progress, max_memory)
 }
 
 /// [`load`] from the bytes of a raster file in memory, named `path` in
