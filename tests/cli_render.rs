@@ -376,3 +376,31 @@ fn saved_rasters_keep_the_memory_limit_and_the_verified_image() {
         assert_eq!(saved, direct);
     });
 }
+
+/// The memory an image needs counts its format's encoding: OpenEXR is made
+/// whole in memory, so a limit a PNG of the same size fits is refused for
+/// it up front.
+#[test]
+fn the_image_memory_counts_the_format() {
+    in_temp_dir("exr-limit", |dir| {
+        let png = dir.join("o.png");
+        let exr = dir.join("o.exr");
+        let args = |out: &Path| {
+            let out = out.to_str().unwrap().to_owned();
+            let mut a: Vec<String> = ["render", &tetra(), "-o", &out, "--raster", "32", "-q"]
+                .iter()
+                .map(|s| (*s).to_owned())
+                .collect();
+            a.extend(["--width", "512", "--height", "512", "--max-memory", "8M"].map(String::from));
+            a
+        };
+        let run = |out: &Path| {
+            let a = args(out);
+            cli(&a.iter().map(String::as_str).collect::<Vec<_>>())
+        };
+        run(&png).unwrap();
+        let e = run(&exr).unwrap_err();
+        assert!(e.contains("more than the memory limit of 8.0 MiB"), "{e}");
+        assert!(!exr.exists());
+    });
+}

@@ -11,7 +11,7 @@ use super::common::{
 use super::frames::{Frames, Names, TileArg, parse_frame_count, parse_tile};
 use crate::fit::{Bytes, default_max_memory};
 use crate::output::band::BandTag;
-use crate::output::image::{Encoding, ImageOutput};
+use crate::output::image::{Encoding, Format, ImageOutput};
 use crate::render::camera::Camera;
 use crate::render::{RenderOptions, check_sizes, image_bytes, render_rows};
 use crate::scene::View;
@@ -136,6 +136,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     // path or an unknown format is reported at once), the others as their
     // turn comes.
     let mut first_output = Some(ImageOutput::create(&names.path(chosen.start), encoding)?);
+    let format = first_output.as_ref().map(ImageOutput::format);
     // Frame k's view, image size and camera, checked before voxelizing
     // (the first frame) and again for each render.
     let camera_of =
@@ -151,7 +152,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
                 }
                 None => h,
             };
-            check_image_memory(w, rows, args.bits, &args.raster)?;
+            check_image_memory(w, rows, args.bits, format, &args.raster)?;
             Ok((Camera::new(&view, w, h)?, view, w, h))
         };
     // The raster is fitted to the base view (the scene's with the
@@ -260,17 +261,27 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
 }
 
 /// Refuses an image of `width` × `rows` pixels whose memory (the
-/// rendered image and its `bits`-bit encoding, [`image_bytes`]) is more
-/// than `--max-memory` allows.
+/// rendered image, [`image_bytes`], and its encoding in `format`:
+/// `bits`-bit codes, or OpenEXR's, made whole in memory) is more than
+/// `--max-memory` allows.
 fn check_image_memory(
     width: u32,
     rows: u32,
     bits: u8,
+    format: Option<Format>,
     raster: &RasterArgs,
 ) -> Result<(), CliError> {
     let limit = raster.max_memory.unwrap_or_else(default_max_memory);
-    // The encoder's samples and their byte order: two copies of 3 codes.
-    let codes = u64::from(width) * u64::from(rows) * 6 * u64::from(bits.div_ceil(8));
+    let pixels = u64::from(width) * u64::from(rows);
+    let codes = match format {
+        // The float samples, the encoder's blocks, compressed and not,
+        // and the file's bytes, which it writes into memory first (it
+        // seeks): about 13 bytes a pixel measured, 24 counted.
+        Some(Format::Exr) => pixels * 24,
+        // The encoder's samples and their byte order: two copies of 3
+        // codes.
+        _ => pixels * 6 * u64::from(bits.div_ceil(8)),
+    };
     let needed = image_bytes(width, rows, false).saturating_add(codes);
     if needed > limit {
         return Err(CliError::Arg {
