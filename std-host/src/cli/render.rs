@@ -135,8 +135,9 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     // The first image's output is opened before any work (an unwritable
     // path or an unknown format is reported at once), the others as their
     // turn comes.
-    let mut first_output = Some(ImageOutput::create(&names.path(chosen.start), encoding)?);
-    let format = first_output.as_ref().map(ImageOutput::format);
+    let first = ImageOutput::create(&names.path(chosen.start), encoding)?;
+    let format = first.format();
+    let mut first_output = Some(first);
     // Frame k's view, image size and camera, checked before voxelizing
     // (the first frame) and again for each render.
     let camera_of =
@@ -268,7 +269,7 @@ fn check_image_memory(
     width: u32,
     rows: u32,
     bits: u8,
-    format: Option<Format>,
+    format: Format,
     raster: &RasterArgs,
 ) -> Result<(), CliError> {
     let limit = raster.max_memory.unwrap_or_else(default_max_memory);
@@ -277,7 +278,7 @@ fn check_image_memory(
         // The float samples, the encoder's blocks, compressed and not,
         // and the file's bytes, which it writes into memory first (it
         // seeks): about 13 bytes a pixel measured, 24 counted.
-        Some(Format::Exr) => pixels * 24,
+        Format::Exr => pixels * 24,
         // The encoder's samples and their byte order: two copies of 3
         // codes.
         _ => pixels * 6 * u64::from(bits.div_ceil(8)),
