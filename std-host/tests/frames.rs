@@ -407,6 +407,33 @@ fn stitch_refuses_what_is_not_one_image_in_order() {
     let turned = other(&["--from", "1,-4,1.5"], "1/3", "turned.png");
     let pfm = other(&[], "1/3", "b1.pfm");
     let exr = other(&[], "1/3", "b1.exr");
+    // The same view, sampling, mode and raster dimensions, but another
+    // scene: the sphere's colour, or the light, differs.
+    let recoloured = SCENE.replace("f 1 0.5 0.2", "f 1 0.5 0.3");
+    let relit = SCENE.replace("l 3 -3 4", "l 3 -3 4.5");
+    for (name, scene) in [("recoloured", &recoloured), ("relit", &relit)] {
+        std::fs::write(d.join(format!("{name}.nff")), scene).unwrap();
+        let (nff, rrt) = (format!("{name}.nff"), format!("{name}.rrt"));
+        ok(&d, &["voxelize", "-q", &nff, "--raster", "40", "-o", &rrt]);
+        let band = format!("{name}.png");
+        ok(&d, &["render", "-q", &rrt, "--tile", "1/3", "-o", &band]);
+    }
+    // A band of the scene file and bands of its saved raster are bands of
+    // one image.
+    ok(
+        &d,
+        &[
+            "render",
+            "-q",
+            "s.nff",
+            "--raster",
+            "40",
+            "--tile",
+            "1/3",
+            "-o",
+            "from-scene.png",
+        ],
+    );
     ok(&d, &["render", "-q", "s.rrt", "-o", "whole.png"]);
     std::fs::write(d.join("junk.png"), b"not a png").unwrap();
     for (files, want) in [
@@ -432,8 +459,13 @@ fn stitch_refuses_what_is_not_one_image_in_order() {
         ),
         (
             vec![b0, &turned, b2],
-            "turned.png: render \"view from 1,-4,1.5",
+            "turned.png: render \"view from 1,-4,1.5 at 0,0,0.4 up 0,0,1 angle 40\", but band-0.png has \"view from 0.5,-4,1.5 at 0,0,0.4 up 0,0,1 angle 40\": not bands of one image",
         ),
+        (
+            vec![b0, "recoloured.png", b2],
+            "recoloured.png: render \"scene ",
+        ),
+        (vec![b0, "relit.png", b2], "relit.png: render \"scene "),
         (
             vec![b0, b2, b1],
             "band-2.png: band 2 of 3 given before band 1 (band-1.png): list the bands in order",
@@ -480,5 +512,7 @@ fn stitch_refuses_what_is_not_one_image_in_order() {
     // The three in order make the whole image.
     ok(&d, &["stitch", "-o", "out.png", b0, b1, b2]);
     same(&d, "out.png", "whole.png");
+    ok(&d, &["stitch", "-o", "mixed.png", b0, "from-scene.png", b2]);
+    same(&d, "mixed.png", "whole.png");
     let _ = std::fs::remove_dir_all(&d);
 }

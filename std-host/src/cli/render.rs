@@ -298,12 +298,14 @@ fn check_image_memory(
 }
 
 /// What every band of one image shares, for its [`BandTag`]: the view,
-/// the sampling, the ray tree, the mode and the raster.
+/// the sampling, the ray tree, the mode, the raster's dimensions and the
+/// scene's [fingerprint](crate::voxelize::VoxelScene::fingerprint), so
+/// that bands of different scenes are not joined.
 fn render_key(args: &RenderArgs, view: &View, scene: &crate::voxelize::VoxelScene) -> String {
     let v = |p: glam::DVec3| format!("{},{},{}", p.x, p.y, p.z);
     let d = scene.extent().dims();
     format!(
-        "view from {} at {} up {} angle {}; supersample {}; depth {}; {} mode, {}; raster {}x{}x{}",
+        "view from {} at {} up {} angle {}; supersample {}; depth {}; {} mode, {}; raster {}x{}x{}; scene {}",
         v(view.from),
         v(view.at),
         v(view.up),
@@ -314,7 +316,8 @@ fn render_key(args: &RenderArgs, view: &View, scene: &crate::voxelize::VoxelScen
         rrt_core::Connectivity::from(args.raster.connectivity).name(),
         d[0],
         d[1],
-        d[2]
+        d[2],
+        scene.fingerprint()
     )
 }
 

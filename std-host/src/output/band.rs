@@ -10,7 +10,7 @@
 //! the band's index (from 0) and count, its rows (end excluded) and the
 //! whole image's width and height, the samples' kind, and a description
 //! of the render that every band of one image shares (the view, the
-//! sampling, the mode, the raster).
+//! sampling, the mode, the raster, the scene's fingerprint).
 
 use std::fmt;
 

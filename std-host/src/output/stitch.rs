@@ -189,11 +189,15 @@ fn check_bands(headers: &[Header]) -> Result<(), StitchError> {
             );
         }
         if t.render != ft.render {
-            return differs(
-                "render",
-                format!("\"{}\"", t.render),
-                format!("\"{}\"", ft.render),
-            );
+            // Name the first part of the render that differs (the view,
+            // the sampling, ..., the scene's fingerprint).
+            let (this, that) = t
+                .render
+                .split("; ")
+                .zip(ft.render.split("; "))
+                .find(|(a, b)| a != b)
+                .unwrap_or((&t.render, &ft.render));
+            return differs("render", format!("\"{this}\""), format!("\"{that}\""));
         }
     }
     let count = ft.band.count;

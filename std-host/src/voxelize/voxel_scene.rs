@@ -5,6 +5,8 @@
 //! table is, for intersection verification), the distinct materials and
 //! the lights in `f64` for shading.
 
+use std::fmt::Write as _;
+
 use glam::DVec3;
 use rayon::prelude::*;
 use rrt_core::light::ExactRecords;
@@ -105,6 +107,84 @@ impl VoxelScene {
         )
     }
 
+    /// A digest of everything a render of this scene reads besides the
+    /// view and the render's options: the raster's place and dimensions,
+    /// the separation, the records, object lists and brick directory, the
+    /// object table, the materials (not where the file defines them), the
+    /// lights, the background and the samples of volumes rendered
+    /// directly. Left out is what is made from these: the plane and line
+    /// level (from the records), and the records' light bits and
+    /// illumination (from the geometry and the lights), of which only
+    /// whether they are the paper's bits, which the image shows as they
+    /// are, counts. So a scene and its saved raster (`rrt voxelize`) have
+    /// the same digest, and two scenes that render differently from some
+    /// view almost surely differ in it (a CRC-32 of each of three parts:
+    /// 24 hex digits). Deterministic on every host.
+    #[must_use]
+    pub fn fingerprint(&self) -> String {
+        let crc = |parts: &[&[u8]]| {
+            let mut h = crc32fast::Hasher::new();
+            for p in parts {
+                h.update(&(p.len() as u64).to_le_bytes());
+                h.update(p);
+            }
+            h.finalize()
+        };
+        // The light bits and the illumination they give are made from
+        // the rest (the records' geometry, the objects and the lights);
+        // whether they are the paper's, which the image shows, or only
+        // the proofs of a renderer that finds the same shadows without
+        // them, is `paper_bits`.
+        let mut records = crc32fast::Hasher::new();
+        let mut buffer = Vec::with_capacity(4096);
+        for chunk in self.records.chunks(4096) {
+            buffer.clear();
+            buffer.extend(chunk.iter().map(|r| VoxelRecord {
+                lights: 0,
+                illum: [0; 3],
+                ..*r
+            }));
+            records.update(bytemuck::cast_slice(&buffer));
+        }
+        let raster = crc(&[
+            &records.finalize().to_le_bytes(),
+            bytemuck::cast_slice(&self.lists),
+            bytemuck::cast_slice(&self.directory),
+        ]);
+        let paper_bits = self.exact_records == ExactRecords::Paper;
+        // The world side as text (`Debug` writes every `f64` exactly),
+        // fed to the checksum piece by piece.
+        let mut world = CrcText(crc32fast::Hasher::new());
+        let _ = write!(
+            world,
+            "{:?}; {:?}; {}; {paper_bits}; {:?}; {:?}; ",
+            self.frame, self.separation, self.exact, self.lights, self.background
+        );
+        for m in &self.materials {
+            let _ = write!(
+                world,
+                "{:?} {:?} {:?} {:?} {:?} {:?}; ",
+                m.colour, m.kd, m.ks, m.shine, m.transmittance, m.ior
+            );
+        }
+        for o in &self.objects {
+            let _ = write!(world, "{o:?}; ");
+        }
+        let mut direct = crc32fast::Hasher::new();
+        for d in &self.direct {
+            let head = format!(
+                "{} {:?} {:?} {:?} {:?} {:?}",
+                d.object, d.first, d.dims, d.classifier, d.base, d.spacing
+            );
+            direct.update(&crc(&[head.as_bytes(), bytemuck::cast_slice(&d.values)]).to_le_bytes());
+        }
+        format!(
+            "{raster:08x}{:08x}{:08x}",
+            world.0.finalize(),
+            direct.finalize()
+        )
+    }
+
     /// The SPD intensity of each light and of the ambient term.
     #[must_use]
     pub fn intensity(&self) -> f64 {
@@ -134,6 +214,16 @@ impl VoxelScene {
                     .fold(0usize, usize::saturating_add),
             );
         u64::try_from(bytes).unwrap_or(u64::MAX)
+    }
+}
+
+/// Text written into a checksum ([`VoxelScene::fingerprint`]).
+struct CrcText(crc32fast::Hasher);
+
+impl std::fmt::Write for CrcText {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0.update(s.as_bytes());
+        Ok(())
     }
 }
 
