@@ -404,3 +404,71 @@ fn the_image_memory_counts_the_format() {
         assert!(!exr.exists());
     });
 }
+
+/// Reflected plus refracted rays, and the rays not traced, from a summary
+/// line.
+fn secondary_rays(summary: &str) -> (u64, u64) {
+    let count = |after: &str, word: &str| -> u64 {
+        let rest = &summary[summary.find(after).unwrap() + after.len()..];
+        let end = rest.find(word).unwrap_or_else(|| panic!("{summary}"));
+        rest[..end].trim().parse().unwrap()
+    };
+    let traced = count("primary, ", " reflected") + count("reflected, ", " refracted");
+    let pruned = if summary.contains("not traced") {
+        count("refracted (", " more not traced")
+    } else {
+        0
+    };
+    (traced, pruned)
+}
+
+#[test]
+fn rays_lighter_than_the_min_weight_are_counted_not_traced() {
+    // The eye inside a glass sphere with glass spheres around: the ray
+    // tree doubles at every level until the weights fall.
+    let scene = "\
+b 0.1 0.1 0.2
+l 0.5 -1 1
+f 0.9 0.9 1 0.1 0.5 50 0.9 1.5
+s 0 0 0 5
+s 0.5 0.5 0 1
+s -1 1 0.5 0.8
+s 1 -1 -0.5 0.7
+v
+from 0 -3 0
+at 0 0 0
+up 0 0 1
+angle 60
+hither 0.1
+resolution 4 4
+";
+    in_temp_dir("min-weight", |dir| {
+        let nff = dir.join("trap.nff");
+        std::fs::write(&nff, scene).unwrap();
+        let nff = nff.to_str().unwrap();
+        let render = |depth: &str, weight: &str, out: &str| {
+            let out = dir.join(out);
+            let args = ["render", nff, "-o", out.to_str().unwrap()];
+            let extra = ["--raster", "48", "--depth", depth, "--min-weight", weight];
+            let s = cli_with(&args, &extra).unwrap();
+            (secondary_rays(&s), std::fs::read(out).unwrap(), s)
+        };
+        // The whole tree, then rays lighter than 1/20 not traced.
+        let ((all, none), _, s) = render("12", "0", "all.png");
+        assert_eq!(none, 0, "{s}");
+        assert!(all > 1000, "{s}");
+        let ((heavy, light), _, s) = render("12", "0.05", "heavy.png");
+        assert!(light > 0 && heavy < all, "{s}");
+        assert!(s.contains("weight below 5e-2"), "{s}");
+        // At depth 3 no ray is as light as the default's 2^-16: the image
+        // is the whole tree's.
+        let ((_, light), with, _) = render("3", "1.52587890625e-5", "default.png");
+        let (_, whole, _) = render("3", "0", "whole.png");
+        assert_eq!(light, 0);
+        assert!(with == whole);
+        fails_with(
+            &["render", nff, "--min-weight", "2"],
+            "expected a number from 0 to 1, found 2",
+        );
+    });
+}

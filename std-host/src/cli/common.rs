@@ -221,6 +221,22 @@ pub fn parse_depth(s: &str) -> Result<u32, String> {
     u32::try_from(v).map_err(|e| e.to_string())
 }
 
+/// Parses `--min-weight`: a number from 0 to 1.
+///
+/// # Errors
+/// A message for anything else.
+pub fn parse_min_weight(s: &str) -> Result<f64, String> {
+    let w = s
+        .trim()
+        .parse::<f64>()
+        .map_err(|_| format!("expected a number from 0 to 1, found {s:?}"))?;
+    if (0.0..=1.0).contains(&w) {
+        Ok(w)
+    } else {
+        Err(format!("expected a number from 0 to 1, found {w}"))
+    }
+}
+
 /// Parses `--angle`: degrees strictly between 0 and 180.
 ///
 /// # Errors
@@ -532,6 +548,15 @@ mod tests {
         assert!(parse_threads("100000").is_err());
         assert!(parse_threads("two").unwrap_err().contains("whole number"));
         assert_eq!(parse_depth("64"), Ok(64));
+        assert_eq!(parse_min_weight("0"), Ok(0.0));
+        assert_eq!(parse_min_weight(" 1e-3"), Ok(1e-3));
+        assert_eq!(parse_min_weight("1"), Ok(1.0));
+        for bad in ["-0.5", "1.5", "nan", "inf", "", "x"] {
+            assert!(
+                parse_min_weight(bad).unwrap_err().contains("from 0 to 1"),
+                "{bad}"
+            );
+        }
         assert!(parse_depth("0").unwrap_err().contains("1 to 64, found 0"));
         assert!(parse_depth("-3").is_err());
         assert_eq!(parse_angle("40"), Ok(40.0));

@@ -29,7 +29,7 @@ pub enum Command {
     /// Render an NFF or TOML scene or a saved raster to an image: PNG,
     /// PPM, OpenEXR or PFM by the output's extension (no scene: the
     /// built-in 91-sphereflake to rrt.png).
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Join the bands written by `rrt render --tile I/N`, in order, into
     /// the whole image, byte for byte the file one render writes; refuses
     /// files that are not the bands of one image, each once, in order.
@@ -37,8 +37,9 @@ pub enum Command {
     /// Voxelize an NFF or TOML scene once and save the raster, with light
     /// visibility and precomputed illumination, for `rrt render`.
     Voxelize(voxelize::VoxelizeArgs),
-    /// Print what a saved raster holds, after checking every section's
-    /// checksum.
+    /// Print what a saved raster holds, from its header and meta section
+    /// (their checksums checked); `--check` checks every section and
+    /// loads the raster.
     Info(info::InfoArgs),
     /// Trace one discrete ray and list its voxels, one `x y z` per line,
     /// through an empty raster (`--dims`) or a saved one (`--raster`).

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use super::CliError;
 use super::common::{
-    ImageNeed, Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, parse_depth, parse_threads,
-    progress, secs,
+    ImageNeed, Loaded, Purpose, RasterArgs, ViewArgs, load_or_build, parse_depth, parse_min_weight,
+    parse_threads, progress, secs,
 };
 use super::frames::{Frames, Names, TileArg, parse_frame_count, parse_tile};
 use crate::fit::{Bytes, default_max_memory};
@@ -54,6 +54,15 @@ pub struct RenderArgs {
     /// Depth of the ray tree, 1 to 64 (the eye ray counts as 1).
     #[arg(long, value_name = "D", default_value_t = 3, value_parser = parse_depth, allow_hyphen_values = true)]
     pub depth: u32,
+    /// Reflected and refracted rays whose weight in the pixel (the
+    /// product of the `Ks` and `T` factors on their way to the eye) is
+    /// below W are not traced, 0 to 1 (0: the whole ray tree to
+    /// `--depth`); the summary line counts them. The default, 2^-16, is
+    /// below one step of a 16-bit linear image for a ray that sees at
+    /// most white, and keeps the ray tree of glass, which doubles at every
+    /// level, to what can be seen.
+    #[arg(long, value_name = "W", default_value_t = crate::trace::DEFAULT_MIN_WEIGHT, value_parser = parse_min_weight)]
+    pub min_weight: f64,
     /// K×K rays per pixel, box-filtered, K from 1 to 16 (and at most
     /// 2^32 rays in all).
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = parse_positive, allow_hyphen_values = true)]
@@ -181,6 +190,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             mode: args.raster.mode.into(),
             connectivity: args.raster.connectivity.into(),
             depth: args.depth,
+            min_weight: args.min_weight,
             packets: args.packets,
             ..TraceOptions::default()
         },
@@ -305,13 +315,14 @@ fn render_key(args: &RenderArgs, view: &View, scene: &crate::voxelize::VoxelScen
     let v = |p: glam::DVec3| format!("{},{},{}", p.x, p.y, p.z);
     let d = scene.extent().dims();
     format!(
-        "view from {} at {} up {} angle {}; supersample {}; depth {}; {} mode, {}; raster {}x{}x{}; scene {}",
+        "view from {} at {} up {} angle {}; supersample {}; depth {}, min weight {:e}; {} mode, {}; raster {}x{}x{}; scene {}",
         v(view.from),
         v(view.at),
         v(view.up),
         view.angle,
         args.supersample,
         args.depth,
+        args.min_weight,
         crate::trace::Mode::from(args.raster.mode).name(),
         rrt_core::Connectivity::from(args.raster.connectivity).name(),
         d[0],
@@ -337,7 +348,7 @@ fn summary(
     let rays = stats.rays().max(1);
     writeln!(
         out,
-        "{}: {size}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted, {} shadow ({} lights proven lit, {} blocked by the last blocker, {:.1} steps/shadow ray walked); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays){}",
+        "{}: {size}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted{}, {} shadow ({} lights proven lit, {} blocked by the last blocker, {:.1} steps/shadow ray walked); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays){}",
         path.display(),
         d[0],
         d[1],
@@ -349,6 +360,14 @@ fn summary(
         stats.primary,
         stats.reflected,
         stats.refracted,
+        if stats.pruned > 0 {
+            format!(
+                " ({} more not traced: weight below {:e})",
+                stats.pruned, args.min_weight
+            )
+        } else {
+            String::new()
+        },
         stats.shadow,
         stats.classified,
         stats.last_blocker,

@@ -34,7 +34,8 @@
 //! refracted ray (when `T > 0`: Snell's law with the material's index of
 //! refraction, total internal reflection falling back to the mirror
 //! direction) are traced recursively to [`TraceOptions::depth`] (the eye
-//! ray is depth 1). A ray that leaves the raster takes the background
+//! ray is depth 1), each while its weight in the pixel is at least
+//! [`TraceOptions::min_weight`]. A ray that leaves the raster takes the background
 //! colour.
 //!
 //! `illum` holds the lit side the stored normal faces. When the other
@@ -237,7 +238,7 @@ impl Mode {
 }
 
 /// How rays are traced.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TraceOptions {
     /// What a hit is and how it is lit.
     pub mode: Mode,
@@ -245,6 +246,16 @@ pub struct TraceOptions {
     pub connectivity: Connectivity,
     /// Maximum depth of the ray tree; the eye ray is depth 1.
     pub depth: u32,
+    /// The least weight of a traced reflected or refracted ray: its
+    /// weight is the product of the `Ks` and `T` factors that scale it on
+    /// its way to the eye (1 for the eye ray), so the colour it adds to a
+    /// pixel is that weight times what it sees. A ray lighter than this
+    /// is not traced (it adds nothing) and is counted in
+    /// [`RayStats::pruned`]. The default, 2⁻¹⁶, is below one step of a
+    /// 16-bit linear image for a ray that sees at most white; it bounds
+    /// the ray tree of glass, which otherwise doubles at every level, to
+    /// what can be seen. 0 traces the whole tree to `depth`.
+    pub min_weight: f64,
     /// The acne rule's slab and angle, and the connectivity of render-time
     /// shadow rays (those of the light pass by default).
     pub light: LightParams,
@@ -276,6 +287,7 @@ impl Default for TraceOptions {
             mode: Mode::Exact,
             connectivity: Connectivity::Adaptive,
             depth: 3,
+            min_weight: DEFAULT_MIN_WEIGHT,
             light: LightParams::default(),
             packets: false,
             last_blocker: true,
@@ -283,6 +295,9 @@ impl Default for TraceOptions {
         }
     }
 }
+
+/// [`TraceOptions::min_weight`]'s default: 2⁻¹⁶.
+pub const DEFAULT_MIN_WEIGHT: f64 = 1.0 / 65536.0;
 
 /// Counts of one render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -293,6 +308,9 @@ pub struct RayStats {
     pub reflected: u64,
     /// Refracted (or totally reflected) transmitted rays.
     pub refracted: u64,
+    /// Reflected and refracted rays not traced: lighter than
+    /// [`TraceOptions::min_weight`].
+    pub pruned: u64,
     /// Render-time shadow rays (lights seen through translucent material;
     /// in the exact mode, every light of a verified hit the shadow
     /// classification does not prove lit).
@@ -342,6 +360,7 @@ impl RayStats {
         self.primary += o.primary;
         self.reflected += o.reflected;
         self.refracted += o.refracted;
+        self.pruned += o.pruned;
         self.shadow += o.shadow;
         self.classified += o.classified;
         self.steps += o.steps;
@@ -627,13 +646,15 @@ impl<'s> Tracer<'s> {
         &self.opts
     }
 
-    /// Traces one ray (unit direction) at `depth` and returns its colour;
-    /// a ray leaving a surface has its acne rule `leave` and counts exact
-    /// intersections from `tmin` on ([`Tracer::leaving`]).
+    /// Traces one ray (unit direction) at `depth` of the ray tree, whose
+    /// colour adds to the pixel with `weight` ([`TraceOptions::min_weight`]),
+    /// and returns its colour; a ray leaving a surface has its acne rule
+    /// `leave` and counts exact intersections from `tmin` on
+    /// ([`Tracer::leaving`]).
     fn trace(
         &self,
         ray: &Ray,
-        depth: u32,
+        (depth, weight): (u32, f64),
         leave: Option<&LeavingSurface>,
         tmin: f64,
         stats: &mut RayStats,
@@ -646,7 +667,7 @@ impl<'s> Tracer<'s> {
         };
         let mut acc = Composite::default();
         let hit = self.resolve(ray, &mut walk, tmin, leave, &mut acc, stats);
-        self.behind(ray, hit, depth, &acc, stats).colour
+        self.behind(ray, hit, (depth, weight), &acc, stats).colour
     }
 
     /// What a ray whose walk composited `acc` and ended on `hit` (or left
@@ -657,7 +678,7 @@ impl<'s> Tracer<'s> {
         &self,
         ray: &Ray,
         hit: Option<SurfaceHit>,
-        depth: u32,
+        depth: (u32, f64),
         acc: &Composite,
         stats: &mut RayStats,
     ) -> Traced {
@@ -713,7 +734,7 @@ impl<'s> Tracer<'s> {
         stats.primary += 1;
         let mut acc = Composite::default();
         let hit = self.resolve(r, w, 0.0, None, &mut acc, stats);
-        self.behind(r, hit, 1, &acc, stats)
+        self.behind(r, hit, (1, 1.0), &acc, stats)
     }
 
     /// The surface a primary ray (unit direction) hits, resolved as the
@@ -739,6 +760,6 @@ impl<'s> Tracer<'s> {
     /// Traces one primary ray (unit direction) and returns its colour.
     pub fn trace_primary(&self, ray: &Ray, stats: &mut RayStats) -> DVec3 {
         stats.primary += 1;
-        self.trace(ray, 1, None, 0.0, stats)
+        self.trace(ray, (1, 1.0), None, 0.0, stats)
     }
 }

@@ -57,12 +57,13 @@ impl Tracer<'_> {
         LeavingSurface::new(&self.store, h.voxel, side, &h.rec, &self.opts.light)
     }
 
-    /// The colour of hit `h` of `ray` at `depth` (module docs).
+    /// The colour of hit `h` of `ray` at `depth` of the ray tree, with
+    /// `weight` in the pixel (module docs).
     pub(super) fn shade(
         &self,
         ray: &Ray,
         h: &SurfaceHit,
-        depth: u32,
+        (depth, weight): (u32, f64),
         stats: &mut RayStats,
     ) -> DVec3 {
         let m = self
@@ -128,19 +129,27 @@ impl Tracer<'_> {
         let mut reflected = DVec3::ZERO;
         let mut refracted = DVec3::ZERO;
         if depth < self.opts.depth {
-            if m.ks > 0.0 {
-                stats.reflected += 1;
+            // Whether a ray of weight `w` is traced, counted either way.
+            let traced = |w: f64, count: &mut u64, pruned: &mut u64| {
+                let heavy = w >= self.opts.min_weight;
+                *if heavy { count } else { pruned } += 1;
+                heavy
+            };
+            let w = weight * m.ks;
+            if m.ks > 0.0 && traced(w, &mut stats.reflected, &mut stats.pruned) {
                 let dir = shading::reflect(d, n).normalize_or(n);
                 let rule = self.leaving(h, n);
-                reflected = self.trace(&Ray::new(origin, dir), depth + 1, Some(&rule), tmin, stats);
+                let r = Ray::new(origin, dir);
+                reflected = self.trace(&r, (depth + 1, w), Some(&rule), tmin, stats);
             }
-            if m.transmittance > 0.0 {
-                stats.refracted += 1;
+            let w = weight * m.transmittance;
+            if m.transmittance > 0.0 && traced(w, &mut stats.refracted, &mut stats.pruned) {
                 let dir = shading::refract(d, h.normal, m.ior).dir();
                 let side = if dir.dot(n) > 0.0 { n } else { -n };
                 let rule = self.leaving(h, side);
                 let (from, tmin) = self.leaving_point(h, side);
-                refracted = self.trace(&Ray::new(from, dir), depth + 1, Some(&rule), tmin, stats);
+                let r = Ray::new(from, dir);
+                refracted = self.trace(&r, (depth + 1, w), Some(&rule), tmin, stats);
             }
         }
         shading::combine(m, local, reflected, refracted)
