@@ -301,13 +301,22 @@ fn saved_raster_options_are_checked() {
             cli_with(&["voxelize", &tetra(), "-o", out, "--raster", "32"], extra).unwrap();
         };
         voxelize(r, &["--mode", "paper", "-q"]);
+        // What the raster was voxelized for is the file's: it is named.
+        let thin = format!(
+            "{r}: the raster was voxelized for 6-connected or adaptive rays; 26-connected rays would pass through"
+        );
+        let paper = format!(
+            "{r}: the exact mode verifies hits against every object of a voxel, but this raster was voxelized for the paper's mode"
+        );
+        fails_with(&["render", r, "-o", o], &paper);
+        fails_with(
+            &["render", r, "-o", o, "--path", dir.to_str().unwrap()],
+            &format!("{}: is a directory, not a camera path", dir.display()),
+        );
         each_fails(
             &["render", r, "-o", o, "--mode", "paper"],
             &[
-                (
-                    &["--connectivity", "twenty-six"],
-                    "26-connected rays would pass through",
-                ),
+                (&["--connectivity", "twenty-six"], &thin),
                 (&["--raster", "64"], "--raster: "),
                 (&["--bounds", "0,0,0,1,1,1"], "--bounds: "),
             ],

@@ -720,7 +720,7 @@ fn missing_file_directory_empty_binary() {
     assert_eq!(
         nff::load(&big, &opts).unwrap_err().to_string(),
         format!(
-            "{}: 79 bytes, more than the limit of 16 bytes for a scene file",
+            "{}: 79 bytes, more than the limit of 16 bytes for an NFF file",
             big.display()
         )
     );

@@ -81,6 +81,15 @@ pub enum CliError {
     /// Setting up the tracer.
     #[error(transparent)]
     Trace(#[from] crate::trace::TraceError),
+    /// Setting up the tracer over a saved raster that cannot be rendered
+    /// so.
+    #[error("{}: {why}", path.display())]
+    SavedTrace {
+        /// The saved raster.
+        path: std::path::PathBuf,
+        /// Why.
+        why: crate::trace::TraceError,
+    },
     /// Rendering.
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),

@@ -194,7 +194,15 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             packets: args.packets,
             ..TraceOptions::default()
         },
-    )?;
+    )
+    .map_err(|why| match (&loaded, &args.scene) {
+        // What the raster was voxelized for is the saved file's.
+        (Loaded::Saved { .. }, Some(path)) => CliError::SavedTrace {
+            path: path.clone(),
+            why,
+        },
+        _ => why.into(),
+    })?;
     let mut prep = Some(match &loaded {
         Loaded::Built { report, parse, .. } => format!(
             "parse {}, voxelize {}, light visibility {}",

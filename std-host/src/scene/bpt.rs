@@ -50,7 +50,7 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// The file's I/O or text errors, and every error of [`parse`].
 pub fn load(path: &Path, name: &str) -> Result<Vec<Control>, SceneError> {
     let name: Arc<str> = Arc::from(name);
-    let text = read_text(path, &name, MAX_FILE_BYTES)?;
+    let text = read_text(path, &name, "a patch file", MAX_FILE_BYTES)?;
     parse(&name, &text)
 }
 

@@ -59,16 +59,20 @@ pub enum SceneError {
         source: io::Error,
     },
     /// The path names a directory.
-    #[error("{}: is a directory, not an NFF file", path.display())]
+    #[error("{}: is a directory, not {what}", path.display())]
     IsDirectory {
         /// The path.
         path: PathBuf,
+        /// What the file should have been ("an NFF file").
+        what: &'static str,
     },
     /// The file is larger than [`ParseOptions::max_file_bytes`](super::ParseOptions::max_file_bytes).
-    #[error("{file}: {size} bytes, more than the limit of {limit} bytes for a scene file")]
+    #[error("{file}: {size} bytes, more than the limit of {limit} bytes for {what}")]
     FileTooLarge {
         /// The file.
         file: Arc<str>,
+        /// What the file is ("an NFF file").
+        what: &'static str,
         /// Its size in bytes.
         size: u64,
         /// The limit.

@@ -127,10 +127,12 @@ pub fn load_with(
     if meta.is_dir() {
         return Err(SceneError::IsDirectory {
             path: path.to_owned(),
+            what: "an NFF file",
         });
     }
     let too_large = |size| SceneError::FileTooLarge {
         file: Arc::clone(&name),
+        what: "an NFF file",
         size,
         limit: opts.max_file_bytes,
     };
@@ -166,6 +168,7 @@ fn parse_in(
     if size > opts.max_file_bytes {
         return Err(SceneError::FileTooLarge {
             file,
+            what: "an NFF file",
             size,
             limit: opts.max_file_bytes,
         });

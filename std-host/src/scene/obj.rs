@@ -58,7 +58,7 @@ pub struct Mesh {
 /// [`MAX_TRIANGLES`] triangles.
 pub fn load(path: &Path, name: &str) -> Result<Mesh, SceneError> {
     let name: Arc<str> = Arc::from(name);
-    let text = read_text(path, &name, MAX_FILE_BYTES)?;
+    let text = read_text(path, &name, "an OBJ mesh", MAX_FILE_BYTES)?;
     parse(&name, &text)
 }
 

@@ -66,7 +66,7 @@ impl PathView {
 /// The file's I/O or text errors, and every error of [`parse`].
 pub fn load(path: &Path, name: &str) -> Result<Vec<PathView>, SceneError> {
     let name: Arc<str> = Arc::from(name);
-    let text = read_text(path, &name, MAX_FILE_BYTES)?;
+    let text = read_text(path, &name, "a camera path", MAX_FILE_BYTES)?;
     parse(&name, &text)
 }
 

@@ -10,13 +10,18 @@ use super::error::SceneError;
 use super::loc::SourceLoc;
 
 /// Reads the file at `path` (at most `limit` bytes) as UTF-8 text; `name`
-/// is what messages call it.
+/// is what messages call it, `what` what the file is ("a camera path").
 ///
 /// # Errors
 /// [`SceneError::Io`], [`SceneError::IsDirectory`],
 /// [`SceneError::FileTooLarge`], [`SceneError::NotText`] (a NUL byte or
 /// invalid UTF-8, located).
-pub(crate) fn read_text(path: &Path, name: &Arc<str>, limit: u64) -> Result<String, SceneError> {
+pub(crate) fn read_text(
+    path: &Path,
+    name: &Arc<str>,
+    what: &'static str,
+    limit: u64,
+) -> Result<String, SceneError> {
     let io = |source| SceneError::Io {
         path: path.to_owned(),
         source,
@@ -25,17 +30,19 @@ pub(crate) fn read_text(path: &Path, name: &Arc<str>, limit: u64) -> Result<Stri
     if meta.is_dir() {
         return Err(SceneError::IsDirectory {
             path: path.to_owned(),
+            what,
         });
     }
     if meta.len() > limit {
         return Err(SceneError::FileTooLarge {
             file: Arc::clone(name),
+            what,
             size: meta.len(),
             limit,
         });
     }
     let bytes = read_until_binary(fs::File::open(path).map_err(io)?, limit).map_err(io)?;
-    text(name, bytes, limit)
+    text(name, what, bytes, limit)
 }
 
 /// Reads `reader` to its end, at most `limit + 1` bytes (a file that grows
@@ -58,15 +65,21 @@ pub(crate) fn read_until_binary(reader: impl Read, limit: u64) -> std::io::Resul
     }
 }
 
-/// `bytes` as text (at most `limit` bytes).
+/// `bytes` as text (at most `limit` bytes) of `what` ("a camera path").
 ///
 /// # Errors
 /// [`SceneError::FileTooLarge`], [`SceneError::NotText`].
-pub(crate) fn text(name: &Arc<str>, bytes: Vec<u8>, limit: u64) -> Result<String, SceneError> {
+pub(crate) fn text(
+    name: &Arc<str>,
+    what: &'static str,
+    bytes: Vec<u8>,
+    limit: u64,
+) -> Result<String, SceneError> {
     let size = u64::try_from(bytes.len()).unwrap_or(u64::MAX);
     if size > limit {
         return Err(SceneError::FileTooLarge {
             file: Arc::clone(name),
+            what,
             size,
             limit,
         });

@@ -109,7 +109,7 @@ impl Default for Options {
 /// everything wrong inside it (module docs).
 pub fn load(path: &Path, opts: &Options) -> Result<Scene, SceneError> {
     let name: Arc<str> = Arc::from(path.to_string_lossy().as_ref());
-    let text = read_text(path, &name, MAX_FILE_BYTES)?;
+    let text = read_text(path, &name, "a TOML scene", MAX_FILE_BYTES)?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     parse(&name, &text, &dir, opts)
 }
