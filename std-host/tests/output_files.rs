@@ -315,3 +315,70 @@ fn an_interrupted_render_keeps_the_old_image() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn an_interrupted_animation_keeps_its_complete_frames_and_says_so() {
+    let d = folder("int-orbit");
+    let mut child = rrt()
+        .current_dir(&d)
+        .args([
+            "render",
+            "-q",
+            "--orbit",
+            "50",
+            "--width",
+            "300",
+            "--height",
+            "300",
+            "-o",
+            "f-%02d.png",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Frame 2's temporary file: frames 0 and 1 are complete.
+    let t = Instant::now();
+    while !names(&d)
+        .iter()
+        .any(|n| n.starts_with("f-02.png") && n.ends_with(".tmp"))
+    {
+        assert!(
+            t.elapsed() < Duration::from_secs(120),
+            "frame 2 never started"
+        );
+        assert!(child.try_wait().unwrap().is_none(), "finished too soon");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let out = child.wait_with_output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("complete outputs written before stay"),
+        "{err}"
+    );
+    let left = names(&d);
+    assert!(!left.iter().any(|n| n.ends_with(".tmp")), "{left:?}");
+    // The complete frames are those a render of each frame alone writes.
+    for k in ["0", "1"] {
+        let name = format!("f-0{k}.png");
+        let alone = format!("alone-{k}.png");
+        let one = rrt()
+            .current_dir(&d)
+            .args([
+                "render", "-q", "--orbit", "50", "--frame", k, "--width", "300", "--height", "300",
+                "-o", &alone,
+            ])
+            .status()
+            .unwrap();
+        assert!(one.success());
+        let read = |n: &str| std::fs::read(d.join(n)).unwrap();
+        assert!(read(&name) == read(&alone), "{name}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -19,6 +19,10 @@ use std::sync::{Mutex, MutexGuard};
 /// Temporary files not yet renamed over their targets.
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// Outputs renamed over their targets, complete, by this process (under
+/// the [`PENDING`] lock).
+static COMMITTED: AtomicU64 = AtomicU64::new(0);
+
 fn pending() -> MutexGuard<'static, Vec<PathBuf>> {
     PENDING
         .lock()
@@ -30,7 +34,8 @@ pub const INTERRUPTED_EXIT: i32 = 130;
 
 /// Installs the SIGINT/SIGTERM handler (once per process; later calls do
 /// nothing): it removes the pending temporary files, says so on stderr
-/// and exits with [`INTERRUPTED_EXIT`].
+/// (and how many outputs were complete before, which stay) and exits
+/// with [`INTERRUPTED_EXIT`].
 ///
 /// # Errors
 /// The handler could not be installed.
@@ -40,7 +45,15 @@ pub fn remove_on_interrupt() -> Result<(), ctrlc::Error> {
         for f in files.iter() {
             let _ = std::fs::remove_file(f);
         }
-        eprintln!("rrt: interrupted; no output written");
+        let (removed, kept) = (files.len(), COMMITTED.load(Ordering::SeqCst));
+        let outputs = if kept == 1 { "output" } else { "outputs" };
+        match (removed, kept) {
+            (_, 0) => eprintln!("rrt: interrupted; no output written"),
+            (0, k) => eprintln!("rrt: interrupted; the {k} complete {outputs} written before stay"),
+            (_, k) => eprintln!(
+                "rrt: interrupted; the output being written was removed, the {k} complete {outputs} written before stay"
+            ),
+        }
         std::process::exit(INTERRUPTED_EXIT);
     }) {
         Err(ctrlc::Error::MultipleHandlers) => Ok(()),
@@ -151,6 +164,9 @@ impl AtomicFile {
             let _ = std::fs::remove_file(&self.tmp);
         }
         list.retain(|p| *p != self.tmp);
+        if renamed.is_ok() {
+            COMMITTED.fetch_add(1, Ordering::SeqCst);
+        }
         drop(list);
         renamed?;
         #[cfg(unix)]
