@@ -339,18 +339,24 @@ fn encode(
     };
     let (width, height, band) = (image.width, image.height, image.band);
     match (format, image.samples) {
-        (Format::Png, Samples::Codes(c)) => {
-            super::png::write_codes(width, height, c, enc, band, w).map_err(|e| failed(e.into()))
-        }
+        // The encoders' I/O errors are the file's (their own messages
+        // would repeat the system's).
+        (Format::Png, Samples::Codes(c)) => super::png::write_codes(width, height, c, enc, band, w)
+            .map_err(|e| match e {
+                png::EncodingError::IoError(e) => io(e),
+                e => failed(e.into()),
+            }),
         (Format::Ppm, Samples::Codes(c)) => {
             super::ppm::write_ppm_codes(width, height, c, band, w).map_err(io)
         }
         (Format::Pfm, Samples::Float(v)) => {
             super::ppm::write_pfm_floats(width, height, v, w).map_err(io)
         }
-        (Format::Exr, Samples::Float(v)) => {
-            super::exr::write_floats(width, height, v, band, w).map_err(|e| failed(e.into()))
-        }
+        (Format::Exr, Samples::Float(v)) => super::exr::write_floats(width, height, v, band, w)
+            .map_err(|e| match e {
+                exr::error::Error::Io(e) => io(e),
+                e => failed(e.into()),
+            }),
         // `write_samples` checked the kind.
         _ => Err(failed("samples of another kind than the format's".into())),
     }
@@ -375,6 +381,60 @@ mod tests {
         for p in ["a.jpg", "b", "c.png.bak", "d.tiff"] {
             let e = Format::from_path(Path::new(p)).unwrap_err().to_string();
             assert!(e.contains("the image formats are .png"), "{e}");
+        }
+    }
+
+    /// A disk that is full.
+    struct Full;
+
+    impl Write for Full {
+        fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+            Err(std::io::Error::from(std::io::ErrorKind::StorageFull))
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_full_disk_is_the_files_error_said_once() {
+        let (w, h) = (64, 64);
+        for (format, samples) in [
+            (
+                Format::Png,
+                Samples::Codes(Codes::Eight(vec![7; w * h * 3])),
+            ),
+            (
+                Format::Ppm,
+                Samples::Codes(Codes::Sixteen(vec![7; w * h * 3])),
+            ),
+            (Format::Exr, Samples::Float(vec![0.5; w * h * 3].into())),
+            (Format::Pfm, Samples::Float(vec![0.5; w * h * 3].into())),
+        ] {
+            let image = Encoded {
+                width: w as u32,
+                height: h as u32,
+                samples: &samples,
+                band: None,
+            };
+            let e = encode(
+                format,
+                Encoding::default(),
+                &image,
+                &mut Full,
+                Path::new("o"),
+            )
+            .unwrap_err();
+            assert!(matches!(e, OutputError::Io { .. }), "{format:?}: {e:?}");
+            // The message and its sources, as `rrt` prints them.
+            let mut text = e.to_string();
+            let mut source = std::error::Error::source(&e);
+            while let Some(s) = source {
+                text = format!("{text}: {s}");
+                source = s.source();
+            }
+            let full = std::io::Error::from(std::io::ErrorKind::StorageFull).to_string();
+            assert_eq!(text, format!("cannot write o: {full}"), "{format:?}");
         }
     }
 }
