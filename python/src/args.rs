@@ -59,6 +59,9 @@ pub struct RenderArgs {
     pub supersample: u32,
     /// Depth of the ray tree.
     pub depth: u32,
+    /// The least weight of a traced reflected or refracted ray
+    /// (`--min-weight`).
+    pub min_weight: f64,
     /// Threads, 0 for one per core.
     pub threads: usize,
     /// Frame `k` of an `n`-frame orbit of the view (`k` taken modulo `n`).
@@ -104,10 +107,18 @@ impl RenderArgs {
                 i64::from(rrt_host::render::MAX_SUPERSAMPLE),
             )?,
             depth: whole("depth", depth, 1, 64)?,
+            min_weight: rrt_host::trace::DEFAULT_MIN_WEIGHT,
             threads: whole("threads", threads, 0, max_threads)? as usize,
             frame,
             float,
             alpha,
         })
+    }
+
+    /// With `min_weight`, checked as `--min-weight` is: 0 to 1.
+    pub fn with_min_weight(self, min_weight: f64) -> Result<Self, Error> {
+        let min_weight = rrt_host::cli::common::parse_min_weight(&min_weight.to_string())
+            .map_err(|m| Error::arg("min_weight", m))?;
+        Ok(Self { min_weight, ..self })
     }
 }

@@ -34,6 +34,7 @@ pub fn render_view(
             mode: raster.mode.into(),
             connectivity: raster.connectivity.into(),
             depth: a.depth,
+            min_weight: a.min_weight,
             ..TraceOptions::default()
         },
     )?;

@@ -55,7 +55,7 @@ impl Raster {
     /// sRGB codes, or with `float=True` the linear `float32` values; with
     /// `alpha=True` an `(H, W, 4)` array, the coverage in the fourth
     /// channel and the colour in straight alpha (as `rrt.render`).
-    #[pyo3(signature = (view = None, *, frame = None, width = None, height = None, supersample = 1, depth = 3, threads = 0, mode = "exact", connectivity = "adaptive", float = false, alpha = false))]
+    #[pyo3(signature = (view = None, *, frame = None, width = None, height = None, supersample = 1, depth = 3, min_weight = rrt_host::trace::DEFAULT_MIN_WEIGHT, threads = 0, mode = "exact", connectivity = "adaptive", float = false, alpha = false))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -66,6 +66,7 @@ impl Raster {
         height: Option<i64>,
         supersample: i64,
         depth: i64,
+        min_weight: f64,
         threads: i64,
         mode: &str,
         connectivity: &str,
@@ -81,7 +82,8 @@ impl Raster {
             frame,
             float,
             alpha,
-        )?;
+        )?
+        .with_min_weight(min_weight)?;
         let raster = raster_args(None, mode, connectivity)?;
         let view = view.map_or_else(|| self.scene.view.clone(), |v| v.inner.clone());
         let scene = Arc::clone(&self.scene);
@@ -149,10 +151,11 @@ fn view_args(view: Option<&View>) -> ViewArgs {
 ///
 /// `view` replaces the scene's camera (its resolution is the default
 /// size), `frame=(k, n)` renders frame `k` of the `n`-frame orbit of the
-/// view, `raster` is `--raster`, `mode` is `"exact"`, `"verified"` or
-/// `"paper"`, `connectivity` `"adaptive"`, `"six"` or `"twenty-six"`.
+/// view, `raster` is `--raster`, `min_weight` `--min-weight`, `mode` is
+/// `"exact"`, `"verified"` or `"paper"`, `connectivity` `"adaptive"`,
+/// `"six"` or `"twenty-six"`.
 #[pyfunction]
-#[pyo3(signature = (scene = None, *, view = None, frame = None, width = None, height = None, supersample = 1, depth = 3, threads = 0, mode = "exact", connectivity = "adaptive", raster = None, float = false, alpha = false))]
+#[pyo3(signature = (scene = None, *, view = None, frame = None, width = None, height = None, supersample = 1, depth = 3, min_weight = rrt_host::trace::DEFAULT_MIN_WEIGHT, threads = 0, mode = "exact", connectivity = "adaptive", raster = None, float = false, alpha = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -163,6 +166,7 @@ pub fn render<'py>(
     height: Option<i64>,
     supersample: i64,
     depth: i64,
+    min_weight: f64,
     threads: i64,
     mode: &str,
     connectivity: &str,
@@ -179,7 +183,8 @@ pub fn render<'py>(
         frame,
         float,
         alpha,
-    )?;
+    )?
+    .with_min_weight(min_weight)?;
     let raster = raster_args(raster, mode, connectivity)?;
     let given = view.as_deref().map(|v| v.inner.clone());
     if let Some(v) = &given {

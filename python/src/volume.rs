@@ -384,7 +384,7 @@ pub fn volume(
 /// * `camera`: an `rrt.View`; default: the whole volume from the front,
 ///   right and above, z up. `frame=(k, n)`: frame `k` of its orbit.
 #[pyfunction]
-#[pyo3(signature = (array, *, width = None, height = None, spacing = [1.0, 1.0, 1.0], transfer = None, camera = None, frame = None, background = DEFAULT_BACKGROUND, supersample = 1, depth = 3, threads = 0, raster = None, float = false, alpha = false))]
+#[pyo3(signature = (array, *, width = None, height = None, spacing = [1.0, 1.0, 1.0], transfer = None, camera = None, frame = None, background = DEFAULT_BACKGROUND, supersample = 1, depth = 3, min_weight = rrt_host::trace::DEFAULT_MIN_WEIGHT, threads = 0, raster = None, float = false, alpha = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render_volume<'py>(
     py: Python<'py>,
@@ -398,6 +398,7 @@ pub fn render_volume<'py>(
     background: [f64; 3],
     supersample: i64,
     depth: i64,
+    min_weight: f64,
     threads: i64,
     raster: Option<i64>,
     float: bool,
@@ -412,7 +413,8 @@ pub fn render_volume<'py>(
         frame,
         float,
         alpha,
-    )?;
+    )?
+    .with_min_weight(min_weight)?;
     let r = build(
         py,
         array,

@@ -27,6 +27,18 @@ def test_render_matches_the_cli_png(tmp_path):
     np.testing.assert_array_equal(rrt.render(sphere, width=40, height=30, supersample=2), read_png(png))
 
 
+def test_min_weight_is_the_clis(tmp_path):
+    png = tmp_path / "deep.png"
+    for weight in (0, 0.05):
+        status, err = run_cli("render", BALL, "-o", png, "--depth", 12, "--min-weight", weight,
+                              "--quiet")
+        assert status == 0, err
+        np.testing.assert_array_equal(rrt.render(BALL, depth=12, min_weight=weight), read_png(png))
+    # The default is the command line's default.
+    np.testing.assert_array_equal(rrt.render(BALL, depth=12),
+                                  rrt.render(BALL, depth=12, min_weight=2.0 ** -16))
+
+
 def test_float_output_is_the_linear_image():
     codes = rrt.render(BALL)
     linear = rrt.render(BALL, float=True)
@@ -112,6 +124,9 @@ def test_scene_errors_carry_the_cli_message(tmp_path):
         ({"width": 40000}, "width"),
         ({"supersample": 0}, "supersample"),
         ({"depth": 65}, "depth"),
+        ({"min_weight": 2.0}, "min_weight"),
+        ({"min_weight": -0.5}, "min_weight"),
+        ({"min_weight": float("nan")}, "min_weight"),
         ({"threads": -1}, "threads"),
         ({"frame": (-1, 2)}, "frame"),
         ({"frame": (0, 0)}, "frame"),
