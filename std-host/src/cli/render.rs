@@ -212,6 +212,8 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
         ),
         Loaded::Saved { load, .. } => format!("load {}", secs(*load)),
     });
+    // Bands name their scene (read once: it reads every record).
+    let fingerprint = args.tile.map(|_| scene.fingerprint()).unwrap_or_default();
     for k in chosen {
         let (camera, view, w, h) = camera_of(&scene.view, k)?;
         let output = match first_output.take() {
@@ -240,7 +242,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
                 width: w,
                 height: h,
                 kind: output.kind(),
-                render: render_key(args, &view, scene),
+                render: render_key(args, &view, scene, &fingerprint),
             }
             .to_string()
         });
@@ -319,7 +321,12 @@ fn check_image_memory(
 /// the sampling, the ray tree, the mode, the raster's dimensions and the
 /// scene's [fingerprint](crate::voxelize::VoxelScene::fingerprint), so
 /// that bands of different scenes are not joined.
-fn render_key(args: &RenderArgs, view: &View, scene: &crate::voxelize::VoxelScene) -> String {
+fn render_key(
+    args: &RenderArgs,
+    view: &View,
+    scene: &crate::voxelize::VoxelScene,
+    fingerprint: &str,
+) -> String {
     let v = |p: glam::DVec3| format!("{},{},{}", p.x, p.y, p.z);
     let d = scene.extent().dims();
     format!(
@@ -336,7 +343,7 @@ fn render_key(args: &RenderArgs, view: &View, scene: &crate::voxelize::VoxelScen
         d[0],
         d[1],
         d[2],
-        scene.fingerprint()
+        fingerprint
     )
 }
 
