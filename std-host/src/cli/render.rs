@@ -59,8 +59,8 @@ pub struct RenderArgs {
     /// below W are not traced, 0 to 1 (0: the whole ray tree to
     /// `--depth`); the summary line counts them. The default, 2^-16, is
     /// below one step of a 16-bit linear image for a ray that sees at
-    /// most white, and keeps the ray tree of glass, which doubles at every
-    /// level, to what can be seen.
+    /// most white. A material with both `Ks` and `T` doubles the ray tree
+    /// at every level until the weights fall below W.
     #[arg(long, value_name = "W", default_value_t = crate::trace::DEFAULT_MIN_WEIGHT, value_parser = parse_min_weight)]
     pub min_weight: f64,
     /// K×K rays per pixel, box-filtered, K from 1 to 16 (and at most

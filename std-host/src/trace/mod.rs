@@ -252,9 +252,10 @@ pub struct TraceOptions {
     /// pixel is that weight times what it sees. A ray lighter than this
     /// is not traced (it adds nothing) and is counted in
     /// [`RayStats::pruned`]. The default, 2⁻¹⁶, is below one step of a
-    /// 16-bit linear image for a ray that sees at most white; it bounds
-    /// the ray tree of glass, which otherwise doubles at every level, to
-    /// what can be seen. 0 traces the whole tree to `depth`.
+    /// 16-bit linear image for a ray that sees at most white. A material
+    /// with both `Ks` and `T` doubles the ray tree at every level until
+    /// the weights fall below this (with factors near 1, until `depth`).
+    /// 0 traces the whole tree to `depth`.
     pub min_weight: f64,
     /// The acne rule's slab and angle, and the connectivity of render-time
     /// shadow rays (those of the light pass by default).
