@@ -235,6 +235,12 @@ fn absurd_sizes_are_refused_up_front() {
                 ),
                 (&["--depth", "0"], "--depth"),
                 (&["--bounds", "1,2,3"], "six comma-separated"),
+                // A box so small that the objects reaching out of it are
+                // beyond its raster's fixed point: the box is named.
+                (
+                    &["--bounds", "0,0,0,1e-9,1e-9,1e-9"],
+                    "is too small for the objects that reach outside it; give a larger box or a smaller --raster",
+                ),
                 (&["--max-memory", "lots"], "expected a size"),
                 // A raster that does not fit the memory limit: refused before
                 // allocating, with the estimate.

@@ -484,7 +484,25 @@ pub fn build_scene(
     };
     let mut opts = raster.build_options(purpose, default_raster(scene, &need));
     opts.threads = threads;
-    Ok(build(scene, &opts, bar)?)
+    build(scene, &opts, bar).map_err(|e| {
+        use crate::voxelize::BuildError;
+        let beyond_fixed_point = matches!(
+            e,
+            BuildError::Fit(crate::fit::FitError::OutOfRange { .. }) | BuildError::Voxelize { .. }
+        );
+        match raster.bounds {
+            // Objects that reach far outside a small box are out of its
+            // raster's reach: the box is the cause.
+            Some(b) if beyond_fixed_point => CliError::Arg {
+                arg: "--bounds",
+                message: format!(
+                    "{e}: the box [{:?}, {:?}, {:?}] to [{:?}, {:?}, {:?}] is too small for the objects that reach outside it; give a larger box or a smaller --raster",
+                    b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
+                ),
+            },
+            _ => e.into(),
+        }
+    })
 }
 
 /// Refuses `--bounds` that do not meet the box around the scene's

@@ -200,15 +200,14 @@ pub enum BuildError {
         count: usize,
     },
     /// A voxelizer refused an object.
-    #[error("{loc}: {what}: cannot voxelize: {source}")]
+    #[error("{loc}: {what}: cannot voxelize: {why}")]
     Voxelize {
         /// Where the object is defined.
         loc: SourceLoc,
         /// What it is.
         what: &'static str,
         /// Why.
-        #[source]
-        source: VoxelizeError,
+        why: VoxelizeError,
     },
     /// The exact record count exceeds the memory limit.
     #[error("raster {dims}: the scene has {records} surface voxels; plane, directory and records need {}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), Bytes(*limit))]

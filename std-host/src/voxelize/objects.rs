@@ -188,10 +188,10 @@ fn primitive(
             }
         }
     };
-    voxelized.map_err(|source| BuildError::Voxelize {
+    voxelized.map_err(|why| BuildError::Voxelize {
         loc: o.loc.clone(),
         what: o.kind,
-        source,
+        why,
     })?;
     Ok(())
 }
