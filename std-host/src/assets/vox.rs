@@ -52,8 +52,10 @@
 //!
 //! # Bad input
 //! The chunk structure is checked before decoding: a file that is not a
-//! `.vox`, a chunk whose sizes run past its parent, a `SIZE` that is not
-//! 1 to 256 per axis, an `XYZI` whose count does not match its bytes or
+//! `.vox`, a chunk whose sizes run past its parent, a chunk inside `MAIN`
+//! with child chunks of its own (only `MAIN` has children; nested chunks
+//! would be decoded recursively, as deep as the file nests them), a
+//! `SIZE` that is not 1 to 256 per axis, an `XYZI` whose count does not match its bytes or
 //! whose voxel lies outside its model, a bad palette size, or a scene
 //! graph with missing nodes, cycles, bad `_t`/`_r` values or unknown
 //! models: a [`VoxError`] naming the file and the byte offset (or scene
@@ -290,6 +292,16 @@ fn check_chunks(path: &Path, b: &[u8]) -> Result<usize, VoxError> {
         let end = chunk_end(b, at, main_end).map_err(|m| err(at, m))?;
         let id = &b[at..at + 4];
         let clen = le32(b, at + 4).unwrap_or(0) as usize;
+        let children = le32(b, at + 8).unwrap_or(0);
+        if children != 0 {
+            return Err(err(
+                at,
+                format!(
+                    "chunk `{}` holds {children} bytes of child chunks; only `MAIN` has children",
+                    String::from_utf8_lossy(id).escape_debug()
+                ),
+            ));
+        }
         let body = &b[at + 12..at + 12 + clen];
         let name = String::from_utf8_lossy(id);
         match id {
