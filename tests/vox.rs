@@ -389,6 +389,37 @@ fn bad_files() {
     assert!(matches!(e, VoxError::Io { .. }));
 }
 
+/// A scene node the decoder cannot read, or whose id is not its place in
+/// the file, is refused at its offset: the decoder would drop it (or
+/// number it by its place) and silently place the wrong nodes, or none.
+#[test]
+fn damaged_or_misnumbered_scene_nodes_are_refused() {
+    let good = bytes(true);
+    let transforms: Vec<usize> = (0..good.len() - 4)
+        .filter(|&i| &good[i..i + 4] == b"nTRN")
+        .collect();
+    // The first transform (node 0, the root) and the second (node 2).
+    let (root, second) = (transforms[0], transforms[1]);
+    // A frame count far beyond the chunk's bytes: the root does not decode.
+    let mut bad = good.clone();
+    bad[root + 32..root + 36].copy_from_slice(&0x7fff_ffffu32.to_le_bytes());
+    assert_eq!(
+        err(&bad),
+        format!(
+            "bad.vox: byte {root}: `nTRN` scene node 0 cannot be decoded (damaged or truncated)"
+        )
+    );
+    // Node 2 claiming to be node 7.
+    let mut bad = good.clone();
+    bad[second + 12..second + 16].copy_from_slice(&7u32.to_le_bytes());
+    assert_eq!(
+        err(&bad),
+        format!(
+            "bad.vox: byte {second}: `nTRN` scene node 2 holds the id 7: ids must number the scene nodes in file order"
+        )
+    );
+}
+
 /// A chunk inside `MAIN` with children of its own is refused at its
 /// offset: nested chunks, decoded recursively, would overflow the stack
 /// (a `MAIN` nested 100,000 deep is a 1.2 MB file).
