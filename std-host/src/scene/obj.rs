@@ -1,7 +1,9 @@
 //! Triangle meshes from Wavefront OBJ files, read with the `tobj` crate.
 //!
 //! Faces are triangulated (fans), points and lines are ignored, and
-//! per-vertex normals (`vn`) are kept when every face gives them. Groups,
+//! per-vertex normals (`vn`) are kept when every face gives them. A UTF-8
+//! byte-order mark at the start of the file is skipped (columns on the
+//! first line count from after it, as editors show them). Groups,
 //! objects and materials (`.mtl`) do not matter here: the scene gives the
 //! mesh one material.
 //!
@@ -258,6 +260,9 @@ impl BufRead for Counting<'_> {
 /// As [`load`], less the file-system errors.
 pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
     let file: Arc<str> = Arc::from(file);
+    // tobj takes `\u{feff}v` for an unknown statement and drops that
+    // vertex, renumbering every one after it.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     prescan(&file, text)?;
     // tobj reads `l` like `f`, as a face when it has three vertices or
     // more; lines are ignored, so `l` becomes `#` (same byte, same lines).
@@ -518,6 +523,24 @@ mod tests {
         let m = parse("t.obj", "v 0 0 0\nv 3e38 0 0\nv 0 0 2 2\nf 1 2 3\n").unwrap();
         assert_eq!(m.positions.len(), 3);
         assert!(m.positions.iter().any(|p| *p == DVec3::new(0.0, 0.0, 1.0)));
+    }
+
+    /// A byte-order mark does not hide the first vertex: the triangle is
+    /// the file's, not one of the vertices after it.
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n";
+        let plain = parse("t.obj", text).unwrap();
+        let marked = parse("t.obj", &format!("\u{feff}{text}")).unwrap();
+        assert_eq!(marked, plain);
+        assert_eq!(marked.positions[0], DVec3::ZERO);
+        let e = parse("t.obj", "\u{feff}v 0 0 nan\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj:1:7: vertex: coordinate is not finite"),
+            "{e}"
+        );
     }
 
     #[test]
