@@ -887,6 +887,26 @@ fn every_bad_value_is_located_at_itself() {
             "2 or more operands",
         ),
         (
+            "csg operand type",
+            second_object(
+                "csg = { difference = [\"a\", { union = [\"b\", 7] }] }",
+                solids,
+            ),
+            "7",
+            "object[1].csg.difference[1].union[1]",
+            "invalid type: integer `7`, expected a solid's name or an operation",
+        ),
+        (
+            "csg nested key",
+            second_object(
+                "csg = { difference = [\"a\", { unon = [\"b\", \"a\"] }] }",
+                solids,
+            ),
+            "unon",
+            "object[1].csg.difference[1].unon",
+            "unknown field `unon`, expected one of `union`, `intersection`, `difference`",
+        ),
+        (
             "solid",
             second_object(
                 "csg = { union = [\"a\", \"b\"] }",
