@@ -1053,6 +1053,19 @@ fn every_bad_value_is_located_at_itself() {
     }
 }
 
+/// A scene without objects says so in TOML's terms, not NFF's.
+#[test]
+fn a_scene_without_objects_names_the_object_table() {
+    let msg = error_of(
+        "no-objects",
+        &format!("{CAMERA}[[light]]\nposition = [1, 1, 1]\n[material.m]\n"),
+    );
+    assert!(
+        msg.ends_with("bad.toml: no objects: the scene has no [[object]] table"),
+        "{msg}"
+    );
+}
+
 /// toml's own errors name the table a key is missing from, and nothing
 /// for a document without its `[camera]`.
 #[test]

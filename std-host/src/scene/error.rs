@@ -205,4 +205,10 @@ pub enum SceneError {
         /// The file.
         file: Arc<str>,
     },
+    /// A TOML scene without objects.
+    #[error("{file}: no objects: the scene has no [[object]] table")]
+    NoTomlObjects {
+        /// The file.
+        file: Arc<str>,
+    },
 }
