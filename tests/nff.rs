@@ -671,7 +671,7 @@ fn missing_file_directory_empty_binary() {
     let e = Scene::load(&dir).unwrap_err();
     assert_eq!(
         e.to_string(),
-        format!("{}: is a directory, not an NFF file", dir.display())
+        format!("{}: is a directory, not a file", dir.display())
     );
 
     let empty = dir.join("empty.nff");

@@ -1053,6 +1053,17 @@ fn every_bad_value_is_located_at_itself() {
     }
 }
 
+/// A directory named like a TOML scene is refused as a directory, not
+/// as an NFF file.
+#[test]
+fn a_directory_is_not_called_an_nff_file() {
+    let scratch = temp_dir("dir-scene");
+    let d = scratch.join("scene.toml");
+    std::fs::create_dir_all(&d).unwrap();
+    let msg = Scene::load(&d).unwrap_err().to_string();
+    assert_eq!(msg, format!("{}: is a directory, not a file", d.display()));
+}
+
 /// A scene without objects says so in TOML's terms, not NFF's.
 #[test]
 fn a_scene_without_objects_names_the_object_table() {

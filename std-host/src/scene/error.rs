@@ -58,8 +58,9 @@ pub enum SceneError {
         #[source]
         source: io::Error,
     },
-    /// The path names a directory.
-    #[error("{}: is a directory, not an NFF file", path.display())]
+    /// The path names a directory (for any text file: an NFF or TOML
+    /// scene, a camera path, a mesh or patch file).
+    #[error("{}: is a directory, not a file", path.display())]
     IsDirectory {
         /// The path.
         path: PathBuf,
