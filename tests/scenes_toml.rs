@@ -1064,6 +1064,55 @@ fn a_directory_is_not_called_an_nff_file() {
     assert_eq!(msg, format!("{}: is a directory, not a file", d.display()));
 }
 
+/// The files a TOML scene refers to are not scenes: given as one, each is
+/// refused with the TOML that draws it, not read as NFF (an OBJ mesh's
+/// `v x y z` lines read as a broken NFF view).
+#[test]
+fn meshes_models_and_volumes_are_not_read_as_nff() {
+    let d = temp_dir("not-a-scene");
+    let cases = [
+        (
+            "teapot.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            "an OBJ mesh, not a scene: a TOML scene draws it with [[object]] mesh = { file = \"teapot.obj\" }",
+        ),
+        (
+            "teapot.BPT",
+            "1\n3 3\n",
+            "a Bézier patch file, not a scene: a TOML scene draws it with [[object]] bezier = { file = \"teapot.BPT\" }",
+        ),
+        (
+            "m.vox",
+            "VOX ",
+            "a MagicaVoxel model, not a scene: a TOML scene draws it with [[object]] vox = { file = \"m.vox\" }",
+        ),
+        (
+            "h.nrrd",
+            "NRRD0004\n",
+            "a NRRD volume, not a scene: a TOML scene draws it with [volume.NAME] file = \"h.nrrd\", iso or opacity, and [[object]] volume = \"NAME\"",
+        ),
+        (
+            "e.raw",
+            "",
+            "raw volume samples, not a scene: a TOML scene draws it with [volume.NAME] raw = { file = \"e.raw\", dims, type }, iso or opacity, and [[object]] volume = \"NAME\"",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        let msg = Scene::load(&p).unwrap_err().to_string();
+        assert_eq!(msg, format!("{}: {want}", p.display()));
+    }
+    // Other names are still NFF.
+    let p = d.join("scene.txt");
+    std::fs::write(&p, "v 0 0 0\n").unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    assert!(
+        msg.contains("scene.txt:1:3: view: expected end of line"),
+        "{msg}"
+    );
+}
+
 /// A scene without objects says so in TOML's terms, not NFF's.
 #[test]
 fn a_scene_without_objects_names_the_object_table() {

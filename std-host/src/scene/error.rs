@@ -206,6 +206,17 @@ pub enum SceneError {
         /// The file.
         file: Arc<str>,
     },
+    /// A file a TOML scene refers to (a mesh, a model, a volume), given
+    /// where a scene is expected.
+    #[error("{file}: {what}, not a scene: a TOML scene draws it with {how}")]
+    NotAScene {
+        /// The file.
+        file: Arc<str>,
+        /// What it is.
+        what: &'static str,
+        /// The TOML that draws it.
+        how: String,
+    },
     /// A TOML scene without objects.
     #[error("{file}: no objects: the scene has no [[object]] table")]
     NoTomlObjects {
