@@ -32,7 +32,7 @@ use glam::DVec3;
 
 use super::error::SceneError;
 use super::loc::SourceLoc;
-use super::text::read_text;
+use super::text::{read_text, without_bom};
 
 /// Largest OBJ file read, in bytes.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
@@ -268,7 +268,7 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
     let file: Arc<str> = Arc::from(file);
     // tobj takes `\u{feff}v` for an unknown statement and drops that
     // vertex, renumbering every one after it.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let text = without_bom(text);
     prescan(&file, text)?;
     // tobj reads `l` like `f`, as a face when it has three vertices or
     // more; lines are ignored, so `l` becomes `#` (same byte, same lines).
