@@ -1113,6 +1113,52 @@ fn meshes_models_and_volumes_are_not_read_as_nff() {
     );
 }
 
+/// A capped cone or CSG solid too thin for the raster's fixed point is
+/// refused at its own definition as a degenerate solid, not as a broken
+/// raster's "CSG leaf 0".
+#[test]
+fn degenerate_solids_are_named_at_their_definition() {
+    let d = temp_dir("degenerate-solid");
+    let cone = "cone = { base = [0,0,0], base_radius = 1, apex = [0,0,1e-300], apex_radius = 1, capped = true }";
+    let p = d.join("cone.toml");
+    let text = second_object(cone, "");
+    std::fs::write(&p, &text).unwrap();
+    let line = text
+        .lines()
+        .collect::<Vec<_>>()
+        .iter()
+        .rposition(|l| *l == "[[object]]")
+        .unwrap()
+        + 1;
+    let scene = Scene::load(&p).unwrap();
+    let e = build(&scene, &BuildOptions::new(64), &ProgressBar::hidden())
+        .err()
+        .unwrap()
+        .to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{}:{line}:1: capped cone: too thin or too small to have an inside at the raster's precision (a degenerate solid)",
+            p.display()
+        )
+    );
+    // A leaf of a tree: at its [solid.NAME].
+    let solids = "[solid.a]\nsphere = { centre = [0,0,0], radius = 1 }\n[solid.b]\ncone = { base = [0,0,0], base_radius = 1, apex = [0,0,1e-300], apex_radius = 1 }\n";
+    let p = d.join("tree.toml");
+    let text = second_object("csg = { union = [\"a\", \"b\"] }", solids);
+    std::fs::write(&p, &text).unwrap();
+    let line = text.lines().position(|l| l == "[solid.b]").unwrap() + 1;
+    let scene = Scene::load(&p).unwrap();
+    let e = build(&scene, &BuildOptions::new(64), &ProgressBar::hidden())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.starts_with(&format!("{}:{line}:", p.display())) && e.contains(": capped cone: too thin"),
+        "{e}"
+    );
+}
+
 /// A scene without objects says so in TOML's terms, not NFF's.
 #[test]
 fn a_scene_without_objects_names_the_object_table() {
