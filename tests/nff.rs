@@ -50,6 +50,18 @@ fn test_data(name: &str) -> PathBuf {
 
 // ------------------------------------------------------------ good scenes
 
+/// A UTF-8 byte-order mark (which editors write and do not show) is
+/// skipped, not an unknown directive; columns count from after it.
+#[test]
+fn a_byte_order_mark_is_skipped() {
+    let src = format!("{HEAD}l 1 1 1\ns 0 0 0 1\n");
+    assert_eq!(ok(&format!("\u{feff}{src}")), ok(&src));
+    assert_eq!(
+        err("\u{feff}b 0 2 0\n"),
+        r#"scene.nff:1:5: background colour: expected a number from 0 to 1, found "2""#
+    );
+}
+
 #[test]
 fn balls1_copy_parses_with_counts_and_values() {
     let s = Scene::load(test_data("balls1.nff")).unwrap();

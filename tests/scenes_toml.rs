@@ -887,6 +887,26 @@ fn every_bad_value_is_located_at_itself() {
             "2 or more operands",
         ),
         (
+            "csg operand type",
+            second_object(
+                "csg = { difference = [\"a\", { union = [\"b\", 7] }] }",
+                solids,
+            ),
+            "7",
+            "object[1].csg.difference[1].union[1]",
+            "invalid type: integer `7`, expected a solid's name or an operation",
+        ),
+        (
+            "csg nested key",
+            second_object(
+                "csg = { difference = [\"a\", { unon = [\"b\", \"a\"] }] }",
+                solids,
+            ),
+            "unon",
+            "object[1].csg.difference[1].unon",
+            "unknown field `unon`, expected one of `union`, `intersection`, `difference`",
+        ),
+        (
             "solid",
             second_object(
                 "csg = { union = [\"a\", \"b\"] }",
@@ -1031,6 +1051,128 @@ fn every_bad_value_is_located_at_itself() {
         );
         assert!(err.contains(msg), "{name}: want {msg:?}: {err}");
     }
+}
+
+/// A directory named like a TOML scene is refused as a directory, not
+/// as an NFF file.
+#[test]
+fn a_directory_is_not_called_an_nff_file() {
+    let scratch = temp_dir("dir-scene");
+    let d = scratch.join("scene.toml");
+    std::fs::create_dir_all(&d).unwrap();
+    let msg = Scene::load(&d).unwrap_err().to_string();
+    assert_eq!(
+        msg,
+        format!("{}: is a directory, not a TOML scene", d.display())
+    );
+}
+
+/// The files a TOML scene refers to are not scenes: given as one, each is
+/// refused with the TOML that draws it, not read as NFF (an OBJ mesh's
+/// `v x y z` lines read as a broken NFF view).
+#[test]
+fn meshes_models_and_volumes_are_not_read_as_nff() {
+    let d = temp_dir("not-a-scene");
+    let cases = [
+        (
+            "teapot.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            "an OBJ mesh, not a scene: a TOML scene draws it with [[object]] mesh = { file = \"teapot.obj\" }",
+        ),
+        (
+            "teapot.BPT",
+            "1\n3 3\n",
+            "a Bézier patch file, not a scene: a TOML scene draws it with [[object]] bezier = { file = \"teapot.BPT\" }",
+        ),
+        (
+            "m.vox",
+            "VOX ",
+            "a MagicaVoxel model, not a scene: a TOML scene draws it with [[object]] vox = { file = \"m.vox\" }",
+        ),
+        (
+            "h.nrrd",
+            "NRRD0004\n",
+            "a NRRD volume, not a scene: a TOML scene draws it with [volume.NAME] file = \"h.nrrd\", iso or opacity, and [[object]] volume = \"NAME\"",
+        ),
+        (
+            "e.raw",
+            "",
+            "raw volume samples, not a scene: a TOML scene draws it with [volume.NAME] raw = { file = \"e.raw\", dims, type }, iso or opacity, and [[object]] volume = \"NAME\"",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let p = d.join(name);
+        std::fs::write(&p, text).unwrap();
+        let msg = Scene::load(&p).unwrap_err().to_string();
+        assert_eq!(msg, format!("{}: {want}", p.display()));
+    }
+    // Other names are still NFF.
+    let p = d.join("scene.txt");
+    std::fs::write(&p, "v 0 0 0\n").unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    assert!(
+        msg.contains("scene.txt:1:3: view: expected end of line"),
+        "{msg}"
+    );
+}
+
+/// A capped cone or CSG solid too thin for the raster's fixed point is
+/// refused at its own definition as a degenerate solid, not as a broken
+/// raster's "CSG leaf 0".
+#[test]
+fn degenerate_solids_are_named_at_their_definition() {
+    let d = temp_dir("degenerate-solid");
+    let cone = "cone = { base = [0,0,0], base_radius = 1, apex = [0,0,1e-300], apex_radius = 1, capped = true }";
+    let p = d.join("cone.toml");
+    let text = second_object(cone, "");
+    std::fs::write(&p, &text).unwrap();
+    let line = text
+        .lines()
+        .collect::<Vec<_>>()
+        .iter()
+        .rposition(|l| *l == "[[object]]")
+        .unwrap()
+        + 1;
+    let scene = Scene::load(&p).unwrap();
+    let e = build(&scene, &BuildOptions::new(64), &ProgressBar::hidden())
+        .err()
+        .unwrap()
+        .to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{}:{line}:1: capped cone: too thin or too small to have an inside at the raster's precision (a degenerate solid)",
+            p.display()
+        )
+    );
+    // A leaf of a tree: at its [solid.NAME].
+    let solids = "[solid.a]\nsphere = { centre = [0,0,0], radius = 1 }\n[solid.b]\ncone = { base = [0,0,0], base_radius = 1, apex = [0,0,1e-300], apex_radius = 1 }\n";
+    let p = d.join("tree.toml");
+    let text = second_object("csg = { union = [\"a\", \"b\"] }", solids);
+    std::fs::write(&p, &text).unwrap();
+    let line = text.lines().position(|l| l == "[solid.b]").unwrap() + 1;
+    let scene = Scene::load(&p).unwrap();
+    let e = build(&scene, &BuildOptions::new(64), &ProgressBar::hidden())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.starts_with(&format!("{}:{line}:", p.display())) && e.contains(": capped cone: too thin"),
+        "{e}"
+    );
+}
+
+/// A scene without objects says so in TOML's terms, not NFF's.
+#[test]
+fn a_scene_without_objects_names_the_object_table() {
+    let msg = error_of(
+        "no-objects",
+        &format!("{CAMERA}[[light]]\nposition = [1, 1, 1]\n[material.m]\n"),
+    );
+    assert!(
+        msg.ends_with("bad.toml: no objects: the scene has no [[object]] table"),
+        "{msg}"
+    );
 }
 
 /// toml's own errors name the table a key is missing from, and nothing

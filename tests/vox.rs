@@ -389,6 +389,78 @@ fn bad_files() {
     assert!(matches!(e, VoxError::Io { .. }));
 }
 
+/// A scene node the decoder cannot read, or whose id is not its place in
+/// the file, is refused at its offset: the decoder would drop it (or
+/// number it by its place) and silently place the wrong nodes, or none.
+#[test]
+fn damaged_or_misnumbered_scene_nodes_are_refused() {
+    let good = bytes(true);
+    let transforms: Vec<usize> = (0..good.len() - 4)
+        .filter(|&i| &good[i..i + 4] == b"nTRN")
+        .collect();
+    // The first transform (node 0, the root) and the second (node 2).
+    let (root, second) = (transforms[0], transforms[1]);
+    // A frame count far beyond the chunk's bytes: the root does not decode.
+    let mut bad = good.clone();
+    bad[root + 32..root + 36].copy_from_slice(&0x7fff_ffffu32.to_le_bytes());
+    assert_eq!(
+        err(&bad),
+        format!(
+            "bad.vox: byte {root}: `nTRN` scene node 0 cannot be decoded (damaged or truncated)"
+        )
+    );
+    // Node 2 claiming to be node 7.
+    let mut bad = good.clone();
+    bad[second + 12..second + 16].copy_from_slice(&7u32.to_le_bytes());
+    assert_eq!(
+        err(&bad),
+        format!(
+            "bad.vox: byte {second}: `nTRN` scene node 2 holds the id 7: ids must number the scene nodes in file order"
+        )
+    );
+}
+
+/// A chunk inside `MAIN` with children of its own is refused at its
+/// offset: nested chunks, decoded recursively, would overflow the stack
+/// (a `MAIN` nested 100,000 deep is a 1.2 MB file).
+#[test]
+fn nested_chunks_are_refused_not_recursed() {
+    // The models' chunks inside 100,000 nested MAINs.
+    let models = &bytes(false)[20..];
+    let depth = 100_000;
+    let mut file = b"VOX \x96\0\0\0".to_vec();
+    for level in 0..depth {
+        let children = models.len() + 12 * (depth - 1 - level);
+        file.extend_from_slice(b"MAIN");
+        file.extend_from_slice(&0u32.to_le_bytes());
+        file.extend_from_slice(&u32::try_from(children).unwrap().to_le_bytes());
+    }
+    file.extend_from_slice(models);
+    assert_eq!(
+        err(&file),
+        format!(
+            "bad.vox: byte 20: chunk `MAIN` holds {} bytes of child chunks; only `MAIN` has children",
+            file.len() - 32
+        )
+    );
+    // Any other chunk with children, too.
+    let good = bytes(false);
+    let at = find(&good, b"RGBA");
+    let mut bad = good[..at].to_vec();
+    let rgba = &good[at..];
+    bad.extend_from_slice(b"RGBA");
+    bad.extend_from_slice(&0u32.to_le_bytes());
+    bad.extend_from_slice(&u32::try_from(rgba.len()).unwrap().to_le_bytes());
+    bad.extend_from_slice(rgba);
+    let main = u32::try_from(bad.len() - 20).unwrap();
+    bad[16..20].copy_from_slice(&main.to_le_bytes());
+    assert!(
+        err(&bad).starts_with(&format!("bad.vox: byte {at}: chunk `RGBA` holds ")),
+        "{}",
+        err(&bad)
+    );
+}
+
 /// A file of `levels` groups, each holding its next level twice (a node
 /// shared by two parents), ending in the shape of a `side`³ model (or, with
 /// `side` 0, in an empty group and no model): 2^levels paths through a

@@ -52,9 +52,14 @@
 //!
 //! # Bad input
 //! The chunk structure is checked before decoding: a file that is not a
-//! `.vox`, a chunk whose sizes run past its parent, a `SIZE` that is not
-//! 1 to 256 per axis, an `XYZI` whose count does not match its bytes or
-//! whose voxel lies outside its model, a bad palette size, or a scene
+//! `.vox`, a chunk whose sizes run past its parent, a chunk inside `MAIN`
+//! with child chunks of its own (only `MAIN` has children; nested chunks
+//! would be decoded recursively, as deep as the file nests them), a
+//! `SIZE` that is not 1 to 256 per axis, an `XYZI` whose count does not match its bytes or
+//! whose voxel lies outside its model, a bad palette size, a scene node
+//! (`nTRN`, `nGRP`, `nSHP`) or layer (`LAYR`) chunk that does not decode
+//! or whose id is not its place among its kind (the decoder would drop it
+//! and renumber the rest, placing the wrong nodes), or a scene
 //! graph with missing nodes, cycles, bad `_t`/`_r` values or unknown
 //! models: a [`VoxError`] naming the file and the byte offset (or scene
 //! node). So is a scene graph that places more than [`MAX_INSTANCES`]
@@ -286,10 +291,22 @@ fn check_chunks(path: &Path, b: &[u8]) -> Result<usize, VoxError> {
     let mut at = 20 + content;
     let mut pending_size: Option<([u32; 3], usize)> = None;
     let mut models = 0usize;
+    // Scene nodes and layers are numbered by their order in the file.
+    let (mut nodes, mut layers) = (0u32, 0u32);
     while at < main_end {
         let end = chunk_end(b, at, main_end).map_err(|m| err(at, m))?;
         let id = &b[at..at + 4];
         let clen = le32(b, at + 4).unwrap_or(0) as usize;
+        let children = le32(b, at + 8).unwrap_or(0);
+        if children != 0 {
+            return Err(err(
+                at,
+                format!(
+                    "chunk `{}` holds {children} bytes of child chunks; only `MAIN` has children",
+                    String::from_utf8_lossy(id).escape_debug()
+                ),
+            ));
+        }
         let body = &b[at + 12..at + 12 + clen];
         let name = String::from_utf8_lossy(id);
         match id {
@@ -345,6 +362,22 @@ fn check_chunks(path: &Path, b: &[u8]) -> Result<usize, VoxError> {
                     return Err(err(at, format!("`RGBA` holds {clen} bytes, expected 1024")));
                 }
             }
+            b"nTRN" | b"nGRP" | b"nSHP" => {
+                let id = match id {
+                    b"nTRN" => dot_vox::parse_scene_transform(body).map(|(_, n)| n.header.id),
+                    b"nGRP" => dot_vox::parse_scene_group(body).map(|(_, n)| n.header.id),
+                    _ => dot_vox::parse_scene_shape(body).map(|(_, n)| n.header.id),
+                };
+                check_numbered(id, nodes, "scene node")
+                    .map_err(|m| err(at, format!("`{name}` {m}")))?;
+                nodes += 1;
+            }
+            b"LAYR" => {
+                let id = dot_vox::parse_layer(body).map(|(_, l)| l.id);
+                check_numbered(id, layers, "layer")
+                    .map_err(|m| err(at, format!("`{name}` {m}")))?;
+                layers += 1;
+            }
             _ if id.iter().all(|c| c.is_ascii_graphic() || *c == b' ') => {}
             _ => {
                 return Err(err(
@@ -359,6 +392,23 @@ fn check_chunks(path: &Path, b: &[u8]) -> Result<usize, VoxError> {
         return Err(err(o, "`SIZE` without its `XYZI` chunk".into()));
     }
     Ok(models)
+}
+
+/// Checks that a scene node or layer chunk decodes (`id` is its decoded
+/// id) and that its id is `index`, its place among the chunks of its
+/// kind: the decoder drops a chunk it cannot read and numbers the rest by
+/// their order, so either would silently renumber the nodes (or layers)
+/// after it.
+fn check_numbered<E>(id: Result<u32, E>, index: u32, what: &str) -> Result<(), String> {
+    match id {
+        Err(_) => Err(format!(
+            "{what} {index} cannot be decoded (damaged or truncated)"
+        )),
+        Ok(id) if id != index => Err(format!(
+            "{what} {index} holds the id {id}: ids must number the {what}s in file order"
+        )),
+        Ok(_) => Ok(()),
+    }
 }
 
 /// End of the chunk at `at` (header, content and children) if it fits in

@@ -12,7 +12,8 @@
 //! ```
 //!
 //! Numbers are separated by any white space (one point per line is
-//! customary, not required); `#` starts a comment to the end of the line.
+//! customary, not required); `#` starts a comment to the end of the line;
+//! a UTF-8 byte-order mark at the start is skipped.
 //! Every number must be finite; the file must hold exactly the announced
 //! patches. Errors name the file, line and column of the offending token.
 //!
@@ -35,7 +36,7 @@ use glam::DVec3;
 
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
-use super::text::read_text;
+use super::text::{read_text, without_bom};
 
 /// Control points of one bicubic patch, `control[i][j]` for `u = i/3`,
 /// `v = j/3`.
@@ -107,6 +108,7 @@ impl<'a> Tokens<'a> {
 /// a patch that is not bicubic, or a patch count the file cannot hold
 /// (checked before allocating); [`SceneError::Invalid`] for trailing data.
 pub fn parse(file: &str, text: &str) -> Result<Vec<Control>, SceneError> {
+    let text = without_bom(text);
     let lines: Vec<&str> = text.lines().collect();
     let mut t = Tokens {
         file: Arc::from(file),
@@ -203,6 +205,20 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<Control>, SceneError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A byte-order mark before the patch count is skipped, not a
+    /// malformed count.
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let one = "1\n3 3\n".to_string()
+            + &(0..16)
+                .map(|k| format!("{} {} 0\n", k / 4, k % 4))
+                .collect::<String>();
+        let plain = parse("t.bpt", &one).unwrap();
+        assert_eq!(parse("t.bpt", &format!("\u{feff}{one}")).unwrap(), plain);
+        let e = parse("t.bpt", "\u{feff}x").unwrap_err().to_string();
+        assert!(e.starts_with("t.bpt:1:1: patch count:"), "{e}");
+    }
 
     #[test]
     fn errors_are_located() {

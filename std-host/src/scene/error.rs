@@ -58,7 +58,8 @@ pub enum SceneError {
         #[source]
         source: io::Error,
     },
-    /// The path names a directory.
+    /// The path names a directory (for any text file: an NFF or TOML
+    /// scene, a camera path, a mesh or patch file).
     #[error("{}: is a directory, not {what}", path.display())]
     IsDirectory {
         /// The path.
@@ -206,6 +207,23 @@ pub enum SceneError {
     /// No object.
     #[error("{file}: no objects: the scene has no s, c, p or pp")]
     NoObjects {
+        /// The file.
+        file: Arc<str>,
+    },
+    /// A file a TOML scene refers to (a mesh, a model, a volume), given
+    /// where a scene is expected.
+    #[error("{file}: {what}, not a scene: a TOML scene draws it with {how}")]
+    NotAScene {
+        /// The file.
+        file: Arc<str>,
+        /// What it is.
+        what: &'static str,
+        /// The TOML that draws it.
+        how: String,
+    },
+    /// A TOML scene without objects.
+    #[error("{file}: no objects: the scene has no [[object]] table")]
+    NoTomlObjects {
         /// The file.
         file: Arc<str>,
     },

@@ -334,13 +334,17 @@ impl Scene {
 
     /// Reads and parses the scene file at `path` with default limits: a
     /// TOML scene ([`toml`]) when its name ends in `.toml`, NFF ([`nff`])
-    /// otherwise.
+    /// otherwise, except the files a TOML scene refers to (`.obj`, `.bpt`,
+    /// `.vox`, `.nrrd`, `.nhdr`, `.raw`), which are not scenes: they are
+    /// refused with the TOML that draws them
+    /// ([`SceneError::NotAScene`]), not parsed as NFF.
     ///
     /// # Errors
     /// [`SceneError`] naming the file (and line, column and field or key
     /// where there is one): a missing or unreadable file, a directory, an
-    /// empty file, binary data, and every syntax or range error of the
-    /// format (and of the files a TOML scene refers to).
+    /// empty file, binary data, a mesh, model or volume file, and every
+    /// syntax or range error of the format (and of the files a TOML scene
+    /// refers to).
     pub fn load(path: impl AsRef<std::path::Path>) -> Result<Self, SceneError> {
         Self::load_with(path, &indicatif::ProgressBar::hidden())
     }
@@ -355,6 +359,13 @@ impl Scene {
         progress: &indicatif::ProgressBar,
     ) -> Result<Self, SceneError> {
         let path = path.as_ref();
+        if let Some((what, how)) = not_a_scene(path) {
+            return Err(SceneError::NotAScene {
+                file: Arc::from(path.display().to_string()),
+                what,
+                how,
+            });
+        }
         if path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
@@ -502,4 +513,28 @@ fn newell_normal(v: &[DVec3]) -> DVec3 {
             )
         })
         .sum()
+}
+
+/// What the file at `path` is, and how a TOML scene draws it, when its
+/// extension names a file a TOML scene refers to rather than a scene.
+fn not_a_scene(path: &std::path::Path) -> Option<(&'static str, String)> {
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    let name = path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let object = |key: &str| format!("[[object]] {key} = {{ file = {name:?} }}");
+    let volume = |data: String| {
+        format!("[volume.NAME] {data}, iso or opacity, and [[object]] volume = \"NAME\"")
+    };
+    Some(match ext.as_str() {
+        "obj" => ("an OBJ mesh", object("mesh")),
+        "bpt" => ("a Bézier patch file", object("bezier")),
+        "vox" => ("a MagicaVoxel model", object("vox")),
+        "nrrd" | "nhdr" => ("a NRRD volume", volume(format!("file = {name:?}"))),
+        "raw" => (
+            "raw volume samples",
+            volume(format!("raw = {{ file = {name:?}, dims, type }}")),
+        ),
+        _ => return None,
+    })
 }

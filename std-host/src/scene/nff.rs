@@ -32,7 +32,9 @@
 //! `peers/common/nff.h` (and so `embree_nff`) does, so images compare.
 //!
 //! # Strictness
-//! Each field must be on the line the format puts it on; a line with too
+//! A UTF-8 byte-order mark at the start of the file is skipped (columns
+//! on the first line count from after it). Each field must be on the line
+//! the format puts it on; a line with too
 //! few or too many fields is an error at its end or at the extra token.
 //! Numbers must be finite (`NaN`, `inf` and overflowing literals are
 //! refused) and within [`WORLD_LIMIT`] (±1e60) in magnitude; counts and
@@ -64,7 +66,7 @@ use indicatif::ProgressBar;
 
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
-use super::text::byte_loc;
+use super::text::{byte_loc, without_bom};
 use super::{Light, Material, Object, Polygon, Scene, View, ViewDefect};
 use crate::shape::{Cone, Sphere};
 use crate::world::WORLD_LIMIT;
@@ -188,7 +190,7 @@ fn parse_in(
             });
         }
     };
-    let mut parser = Parser::new(file, text, opts);
+    let mut parser = Parser::new(file, without_bom(text), opts);
     parser.progress = progress.filter(|p| !p.is_hidden());
     parser.parse()
 }

@@ -11,7 +11,7 @@
 //! the point looked at `at`, the `up` direction and the vertical angle in
 //! degrees (as a scene's view: between the centres of the top and bottom
 //! pixel rows, strictly between 0 and 180). `#` starts a comment; blank
-//! lines are skipped. Line `k` of views (from 0) is frame `k`. Every
+//! lines and a UTF-8 byte-order mark at the start are skipped. Line `k` of views (from 0) is frame `k`. Every
 //! error names the file, line and column and the field, as the scene
 //! parsers' do; a view whose `at` equals its `from` or whose `up` is
 //! parallel to the view direction is refused at its line.
@@ -23,7 +23,7 @@ use glam::DVec3;
 
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
-use super::text::read_text;
+use super::text::{read_text, without_bom};
 use super::{View, ViewDefect};
 use crate::world::WORLD_LIMIT;
 
@@ -96,7 +96,7 @@ const ANGLE: &str = "path view angle";
 pub fn parse(file: &str, text: &str) -> Result<Vec<PathView>, SceneError> {
     let file: Arc<str> = Arc::from(file);
     let mut views = Vec::new();
-    for (n, raw) in text.lines().enumerate() {
+    for (n, raw) in without_bom(text).lines().enumerate() {
         let line_no = u32::try_from(n + 1).unwrap_or(u32::MAX);
         let content = raw.find('#').map_or(raw, |h| &raw[..h]);
         let loc = |byte: usize| {
@@ -194,6 +194,16 @@ fn tokens_at(line: &str, i: usize) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A byte-order mark before the first view is skipped.
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let text = "0 -4 1  0 0 0  0 0 1  45\n";
+        let marked = parse("p.txt", &format!("\u{feff}{text}")).unwrap();
+        assert_eq!(marked, parse("p.txt", text).unwrap());
+        let e = parse("p.txt", "\u{feff}0 -4 x").unwrap_err().to_string();
+        assert!(e.starts_with("p.txt:1:6: path view from z"), "{e}");
+    }
 
     #[test]
     fn views_with_comments_and_blank_lines() {

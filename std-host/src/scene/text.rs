@@ -99,6 +99,12 @@ pub(crate) fn text(
     })
 }
 
+/// `text` without a UTF-8 byte-order mark at its start: editors write one
+/// and do not show it, so columns on the first line count from after it.
+pub(crate) fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
+
 /// The line and column (from 1; columns count characters) of byte `at`.
 pub(crate) fn byte_loc(file: &Arc<str>, bytes: &[u8], at: usize) -> SourceLoc {
     let before = bytes.get(..at).unwrap_or(bytes);

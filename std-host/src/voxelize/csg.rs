@@ -148,7 +148,24 @@ pub(super) fn voxelize_object(
 ) -> Result<(), BuildError> {
     let p = prepare(c, frame)?;
     let leaves: Vec<&dyn csg::Solid> = p.solids.iter().map(AsRef::as_ref).collect();
-    let tree = CsgTree::new(&p.nodes, &leaves).map_err(|e| BuildError::csg(&c.loc, &e))?;
+    let tree = CsgTree::new(&p.nodes, &leaves).map_err(|e| match e {
+        csg::CsgError::Degenerate { leaf } => {
+            // A volume cut by the tree is not among the core's leaves.
+            let skipped = c.leaves.len().saturating_sub(p.solids.len());
+            let leaf = c.leaves.get(usize::from(leaf) + skipped);
+            BuildError::DegenerateSolid {
+                loc: leaf.map_or_else(|| c.loc.clone(), |l| l.loc.clone()),
+                what: match leaf.map(|l| &l.shape) {
+                    Some(Solid::Sphere(_)) => "sphere",
+                    Some(Solid::Cuboid(_)) => "box",
+                    Some(Solid::Cone(_)) => "capped cone",
+                    Some(Solid::Torus(_)) => "torus",
+                    Some(Solid::Volume(_)) | None => "solid",
+                },
+            }
+        }
+        e => BuildError::csg(&c.loc, &e),
+    })?;
     let extent = frame.extent;
     let volume_leaf = match c.leaves.first() {
         Some(l) => match &l.shape {

@@ -209,6 +209,17 @@ pub enum BuildError {
         /// Why.
         why: VoxelizeError,
     },
+    /// A CSG leaf or capped cone with no inside at the raster's fixed-point
+    /// precision (thinner or smaller than the core can represent).
+    #[error(
+        "{loc}: {what}: too thin or too small to have an inside at the raster's precision (a degenerate solid)"
+    )]
+    DegenerateSolid {
+        /// Where the solid is defined.
+        loc: SourceLoc,
+        /// What it is.
+        what: &'static str,
+    },
     /// The exact record count exceeds the memory limit.
     #[error("raster {dims}: the scene has {records} surface voxels; plane, directory and records need {}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), Bytes(*limit))]
     TooMuchMemory {

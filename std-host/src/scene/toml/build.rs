@@ -172,7 +172,7 @@ impl Builder<'_> {
         }
         self.entry.set(None);
         if scene.has_no_objects() {
-            return Err(SceneError::NoObjects {
+            return Err(SceneError::NoTomlObjects {
                 file: Arc::clone(&self.file),
             });
         }

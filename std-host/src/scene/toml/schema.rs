@@ -7,7 +7,7 @@ use std::marker::PhantomData;
 
 use ::toml::Spanned;
 use serde::Deserialize;
-use serde::de::{self, Deserializer, IgnoredAny, SeqAccess, Visitor};
+use serde::de::{self, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 
 /// An array of exactly `N` elements: every fixed-length array of the
 /// schema is one. serde's `[T; N]` reads the first `N` elements of a TOML
@@ -327,11 +327,36 @@ pub(super) struct SolidDef {
     pub(super) volume: Option<Spanned<String>>,
 }
 
-#[derive(Deserialize)]
-#[serde(untagged)]
+/// An operand of a CSG operation: a solid's name or a nested operation.
+/// Read by hand rather than as an untagged enum, whose only error is
+/// "data did not match any variant", at the whole operand list: a wrong
+/// type is named at the operand itself, and a nested operation's own
+/// errors (an unknown key, a wrong type inside it) at theirs.
 pub(super) enum CsgExpr {
     Leaf(String),
     Op(CsgOp),
+}
+
+impl<'de> Deserialize<'de> for CsgExpr {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Operand;
+        impl<'de> Visitor<'de> for Operand {
+            type Value = CsgExpr;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(
+                    "a solid's name or an operation ({ union = [...] }, { intersection = [...] } \
+                     or { difference = [...] })",
+                )
+            }
+            fn visit_str<E: de::Error>(self, name: &str) -> Result<CsgExpr, E> {
+                Ok(CsgExpr::Leaf(name.to_owned()))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<CsgExpr, A::Error> {
+                CsgOp::deserialize(de::value::MapAccessDeserializer::new(map)).map(CsgExpr::Op)
+            }
+        }
+        d.deserialize_any(Operand)
+    }
 }
 
 #[derive(Deserialize)]
