@@ -1159,6 +1159,51 @@ fn degenerate_solids_are_named_at_their_definition() {
     );
 }
 
+/// An error of a file a scene refers to keeps its cause: the reason a
+/// data file cannot be read, the decoder's reason an image is refused.
+#[test]
+fn file_errors_keep_their_cause() {
+    let d = temp_dir("causes");
+    std::fs::write(
+        d.join("v.nhdr"),
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: gone.raw\n\n",
+    )
+    .unwrap();
+    let p = d.join("vol.toml");
+    std::fs::write(
+        &p,
+        second_object("volume = \"v\"", "[volume.v]\nfile = \"v.nhdr\"\niso = 1\n"),
+    )
+    .unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    assert!(
+        msg.contains(&format!(
+            "volume.v.file: cannot read {}: ",
+            d.join("gone.raw").display()
+        )) && msg.contains("No such file"),
+        "{msg}"
+    );
+    // A PNG cut in half.
+    let mut png = Vec::new();
+    image::RgbImage::from_pixel(16, 16, image::Rgb([9, 9, 9]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    std::fs::write(d.join("half.png"), &png[..png.len() / 2]).unwrap();
+    let p = d.join("tex.toml");
+    let texture = "[material.t]\n[material.t.texture.image]\nfile = \"half.png\"\nplanar = { origin = [0,0,0], u = [1,0,0], v = [0,1,0] }\n";
+    std::fs::write(
+        &p,
+        second_object("sphere = { centre = [0,0,0], radius = 1 }", texture),
+    )
+    .unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    let shown = format!(
+        "{}: cannot decode the image: ",
+        d.join("half.png").display()
+    );
+    assert!(msg.contains(&shown) && !msg.ends_with(&shown), "{msg}");
+}
+
 /// A scene without objects says so in TOML's terms, not NFF's.
 #[test]
 fn a_scene_without_objects_names_the_object_table() {

@@ -14,7 +14,7 @@ use super::schema::{
     BezierDef, BoxDef, ConeDef, Doc, MeshDef, ObjectDef, SHAPE_KEYS, ShapeDef, SphereDef, TorusDef,
     TransformDef, V3, VoxDef,
 };
-use crate::scene::error::SceneError;
+use crate::scene::error::{SceneError, with_causes};
 use crate::scene::loc::SourceLoc;
 use crate::scene::objects::{Solid, VolumeObject, VoxObject};
 use crate::scene::{Object, Scene, bezier, bpt, nff, obj};
@@ -210,7 +210,7 @@ impl Builder<'_> {
         }
         let (path, shown) = self.path(&b.file, "object.bezier.file")?;
         let patches = bpt::load(&path, &shown)
-            .map_err(|e| self.err(b.file.span(), "object.bezier.file", e.to_string()))?;
+            .map_err(|e| self.err(b.file.span(), "object.bezier.file", with_causes(&e)))?;
         let per = (b.steps as usize + 1).pow(2);
         if patches
             .len()
@@ -236,7 +236,7 @@ impl Builder<'_> {
         let transform = at.transform;
         let (path, shown) = self.path(&m.file, "object.mesh.file")?;
         let mesh = obj::load(&path, &shown)
-            .map_err(|e| self.err(m.file.span(), "object.mesh.file", e.to_string()))?;
+            .map_err(|e| self.err(m.file.span(), "object.mesh.file", with_causes(&e)))?;
         if mesh
             .triangles
             .len()
@@ -327,7 +327,7 @@ impl Builder<'_> {
             ));
         }
         let vox = crate::assets::vox::read(&path)
-            .map_err(|e| self.err(v.file.span(), "object.vox.file", e.to_string()))?;
+            .map_err(|e| self.err(v.file.span(), "object.vox.file", with_causes(&e)))?;
         let position = self.vec3(&at.span, "object.vox.position", v.position)?;
         if !(v.cell.is_finite() && v.cell > 0.0) {
             return Err(self.err(at.span, "object.vox.cell", "expected a number > 0"));
@@ -352,7 +352,7 @@ impl Builder<'_> {
     ) -> Result<(), SceneError> {
         let (path, _) = self.path(n, "object.nff")?;
         let inc = nff::load(&path, &nff::ParseOptions::default())
-            .map_err(|e| self.err(n.span(), "object.nff", e.to_string()))?;
+            .map_err(|e| self.err(n.span(), "object.nff", with_causes(&e)))?;
         self.include(scene, inc, s)
     }
 
