@@ -1103,6 +1103,17 @@ fn meshes_models_and_volumes_are_not_read_as_nff() {
         let msg = Scene::load(&p).unwrap_err().to_string();
         assert_eq!(msg, format!("{}: {want}", p.display()));
     }
+    // Included as an NFF file, too.
+    let p = d.join("inc.toml");
+    std::fs::write(&p, format!("{CAMERA}[[object]]\nnff = \"teapot.obj\"\n")).unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    assert!(
+        msg.ends_with(&format!(
+            "object[0].nff: {}: an OBJ mesh, not an NFF scene: draw it with [[object]] mesh = {{ file = \"teapot.obj\" }}",
+            d.join("teapot.obj").display()
+        )),
+        "{msg}"
+    );
     // Other names are still NFF.
     let p = d.join("scene.txt");
     std::fs::write(&p, "v 0 0 0\n").unwrap();

@@ -343,14 +343,22 @@ impl Builder<'_> {
     }
 
     /// Every object, light and material of an NFF file (its view is
-    /// ignored).
+    /// ignored). A mesh, patch, model or volume file named here is refused
+    /// with the key that draws it, not parsed as NFF.
     fn nff(
         &self,
         scene: &mut Scene,
         n: &Spanned<String>,
         s: &Range<usize>,
     ) -> Result<(), SceneError> {
-        let (path, _) = self.path(n, "object.nff")?;
+        let (path, shown) = self.path(n, "object.nff")?;
+        if let Some((what, how)) = crate::scene::not_a_scene(&path, n.get_ref()) {
+            return Err(self.err(
+                n.span(),
+                "object.nff",
+                format!("{shown}: {what}, not an NFF scene: draw it with {how}"),
+            ));
+        }
         let inc = nff::load(&path, &nff::ParseOptions::default())
             .map_err(|e| self.err(n.span(), "object.nff", with_causes(&e)))?;
         self.include(scene, inc, s)
