@@ -323,10 +323,15 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
                 tobj::LoadError::ColorParseError => ("vertex", "malformed colour"),
                 tobj::LoadError::ScalingByZeroError => ("vertex", "weight w = 0"),
                 tobj::LoadError::InvalidPolygon => ("face", "fewer than three vertices"),
+                // `prescan` checks the indices, not the colours, which
+                // tobj requires on every vertex or none.
+                tobj::LoadError::FaceColorOutOfBounds => (
+                    "face",
+                    "a vertex without a colour, where others have one (`v x y z r g b`): give colours on every v line or on none",
+                ),
                 tobj::LoadError::FaceVertexOutOfBounds
                 | tobj::LoadError::FaceTexCoordOutOfBounds
-                | tobj::LoadError::FaceNormalOutOfBounds
-                | tobj::LoadError::FaceColorOutOfBounds => ("face", "index out of range"),
+                | tobj::LoadError::FaceNormalOutOfBounds => ("face", "index out of range"),
                 _ => ("OBJ", "not a readable OBJ file"),
             };
             return Err(invalid(&file, line, 1, field, problem));
@@ -529,6 +534,26 @@ mod tests {
         let m = parse("t.obj", "v 0 0 0\nv 3e38 0 0\nv 0 0 2 2\nf 1 2 3\n").unwrap();
         assert_eq!(m.positions.len(), 3);
         assert!(m.positions.iter().any(|p| *p == DVec3::new(0.0, 0.0, 1.0)));
+    }
+
+    /// Vertex colours on some vertices but not all are named as such, not
+    /// as a face index out of range (the indices are all valid).
+    #[test]
+    fn colours_on_some_vertices_only() {
+        let e = parse("t.obj", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj:4:1: face: a vertex without a colour, where others have one"),
+            "{e}"
+        );
+        // On every vertex they are fine (and ignored).
+        let m = parse(
+            "t.obj",
+            "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n",
+        )
+        .unwrap();
+        assert_eq!(m.triangles.len(), 1);
     }
 
     /// Columns count characters, however many words precede them.
