@@ -1106,6 +1106,17 @@ fn meshes_models_and_volumes_are_not_read_as_nff() {
         let msg = Scene::load(&p).unwrap_err().to_string();
         assert_eq!(msg, format!("{}: {want}", p.display()));
     }
+    // Included as an NFF file, too.
+    let p = d.join("inc.toml");
+    std::fs::write(&p, format!("{CAMERA}[[object]]\nnff = \"teapot.obj\"\n")).unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    assert!(
+        msg.ends_with(&format!(
+            "object[0].nff: {}: an OBJ mesh, not an NFF scene: draw it with [[object]] mesh = {{ file = \"teapot.obj\" }}",
+            d.join("teapot.obj").display()
+        )),
+        "{msg}"
+    );
     // Other names are still NFF.
     let p = d.join("scene.txt");
     std::fs::write(&p, "v 0 0 0\n").unwrap();
@@ -1160,6 +1171,51 @@ fn degenerate_solids_are_named_at_their_definition() {
         e.starts_with(&format!("{}:{line}:", p.display())) && e.contains(": capped cone: too thin"),
         "{e}"
     );
+}
+
+/// An error of a file a scene refers to keeps its cause: the reason a
+/// data file cannot be read, the decoder's reason an image is refused.
+#[test]
+fn file_errors_keep_their_cause() {
+    let d = temp_dir("causes");
+    std::fs::write(
+        d.join("v.nhdr"),
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: gone.raw\n\n",
+    )
+    .unwrap();
+    let p = d.join("vol.toml");
+    std::fs::write(
+        &p,
+        second_object("volume = \"v\"", "[volume.v]\nfile = \"v.nhdr\"\niso = 1\n"),
+    )
+    .unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    assert!(
+        msg.contains(&format!(
+            "volume.v.file: cannot read {}: ",
+            d.join("gone.raw").display()
+        )) && msg.contains("No such file"),
+        "{msg}"
+    );
+    // A PNG cut in half.
+    let mut png = Vec::new();
+    image::RgbImage::from_pixel(16, 16, image::Rgb([9, 9, 9]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    std::fs::write(d.join("half.png"), &png[..png.len() / 2]).unwrap();
+    let p = d.join("tex.toml");
+    let texture = "[material.t]\n[material.t.texture.image]\nfile = \"half.png\"\nplanar = { origin = [0,0,0], u = [1,0,0], v = [0,1,0] }\n";
+    std::fs::write(
+        &p,
+        second_object("sphere = { centre = [0,0,0], radius = 1 }", texture),
+    )
+    .unwrap();
+    let msg = Scene::load(&p).unwrap_err().to_string();
+    let shown = format!(
+        "{}: cannot decode the image: ",
+        d.join("half.png").display()
+    );
+    assert!(msg.contains(&shown) && !msg.ends_with(&shown), "{msg}");
 }
 
 /// A scene without objects says so in TOML's terms, not NFF's.

@@ -7,6 +7,20 @@ use std::sync::Arc;
 
 use super::loc::SourceLoc;
 
+/// `e`'s message followed by those of its causes, each after `: ` (an
+/// I/O error's reason, a decoder's), for errors a TOML scene reports as
+/// text at the key that names the file.
+pub(crate) fn with_causes(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut msg = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        msg.push_str(": ");
+        msg.push_str(&c.to_string());
+        cause = c.source();
+    }
+    msg
+}
+
 /// What stood where the parser expected a value.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Found {

@@ -359,7 +359,10 @@ impl Scene {
         progress: &indicatif::ProgressBar,
     ) -> Result<Self, SceneError> {
         let path = path.as_ref();
-        if let Some((what, how)) = not_a_scene(path) {
+        let name = path
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        if let Some((what, how)) = not_a_scene(path, &name) {
             return Err(SceneError::NotAScene {
                 file: Arc::from(path.display().to_string()),
                 what,
@@ -515,13 +518,11 @@ fn newell_normal(v: &[DVec3]) -> DVec3 {
         .sum()
 }
 
-/// What the file at `path` is, and how a TOML scene draws it, when its
-/// extension names a file a TOML scene refers to rather than a scene.
-fn not_a_scene(path: &std::path::Path) -> Option<(&'static str, String)> {
+/// What the file at `path` is, and how a TOML scene draws it (naming it
+/// `name`), when its extension names a file a TOML scene refers to rather
+/// than a scene.
+pub(crate) fn not_a_scene(path: &std::path::Path, name: &str) -> Option<(&'static str, String)> {
     let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-    let name = path
-        .file_name()
-        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let object = |key: &str| format!("[[object]] {key} = {{ file = {name:?} }}");
     let volume = |data: String| {
         format!("[volume.NAME] {data}, iso or opacity, and [[object]] volume = \"NAME\"")

@@ -11,8 +11,10 @@
 //! Before `tobj` parses the file, a scan of its lines checks, reporting
 //! the line and column: every face's indices against the vertex,
 //! texture-coordinate and normal counts (1-based, negative indices
-//! counting back from the latest element, 0 is never valid), which tobj
-//! reports without a location; that every face (`f`) has at least three
+//! counting back from the latest element, 0 is never valid; positive ones
+//! may name elements defined later, but before the face's object ends at
+//! the next `o` or `g` line, where tobj resolves its faces), which tobj
+//! reports without a location, or at the line that ends the object; that every face (`f`) has at least three
 //! vertices (tobj takes shorter ones for points and lines and drops them);
 //! and that every vertex (`v`, including `x y z` divided by a weight `w`)
 //! and normal (`vn`) coordinate is finite in single precision, in which
@@ -169,6 +171,24 @@ fn prescan(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
         }
     }
     let mut seen = [0i64; 3];
+    // Positive indices past the elements read so far, with their line and
+    // column: legal if the elements come before the object ends (an `o`
+    // or `g` line after faces, or the end of the file), where tobj
+    // resolves the object's faces.
+    let mut ahead: Vec<(usize, i64, usize, usize)> = Vec::new();
+    let mut faces = false;
+    let resolve = |ahead: &mut Vec<(usize, i64, usize, usize)>, seen: &[i64; 3]| {
+        let late = ahead.iter().find(|&&(k, i, _, _)| i > seen[k]).copied();
+        ahead.clear();
+        late.map_or(Ok(()), |(k, _, line, column)| {
+            Err(invalid(file, line, column, "face", LATE[k]))
+        })
+    };
+    const LATE: [&str; 3] = [
+        "vertex index of a vertex defined after the face's object ends (faces are resolved at the next `o` or `g`)",
+        "texture coordinate index of one defined after the face's object ends (faces are resolved at the next `o` or `g`)",
+        "normal index of one defined after the face's object ends (faces are resolved at the next `o` or `g`)",
+    ];
     const WHAT: [&str; 3] = [
         "vertex index out of range (indices count from 1; negative ones back from the latest vertex)",
         "texture coordinate index out of range",
@@ -183,6 +203,10 @@ fn prescan(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
             invalid(file, n + 1, column, field, problem)
         };
         match first {
+            "o" | "g" if faces => {
+                resolve(&mut ahead, &seen)?;
+                faces = false;
+            }
             "v" => {
                 seen[0] += 1;
                 check_coordinates(words, true).map_err(|(c, why)| at(c, "vertex", why))?;
@@ -204,6 +228,7 @@ fn prescan(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
                 if let Some(problem) = few {
                     return Err(at(first_col, "face", problem));
                 }
+                faces = true;
                 for (col, word) in words {
                     for (k, part) in word.split('/').enumerate().take(3) {
                         if part.is_empty() {
@@ -220,6 +245,9 @@ fn prescan(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
                         };
                         if !ok {
                             return Err(at(col, "face", WHAT[k]));
+                        }
+                        if i > seen[k] {
+                            ahead.push((k, i, n + 1, col));
                         }
                     }
                 }
@@ -323,10 +351,15 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
                 tobj::LoadError::ColorParseError => ("vertex", "malformed colour"),
                 tobj::LoadError::ScalingByZeroError => ("vertex", "weight w = 0"),
                 tobj::LoadError::InvalidPolygon => ("face", "fewer than three vertices"),
+                // `prescan` checks the indices, not the colours, which
+                // tobj requires on every vertex or none.
+                tobj::LoadError::FaceColorOutOfBounds => (
+                    "face",
+                    "a vertex without a colour, where others have one (`v x y z r g b`): give colours on every v line or on none",
+                ),
                 tobj::LoadError::FaceVertexOutOfBounds
                 | tobj::LoadError::FaceTexCoordOutOfBounds
-                | tobj::LoadError::FaceNormalOutOfBounds
-                | tobj::LoadError::FaceColorOutOfBounds => ("face", "index out of range"),
+                | tobj::LoadError::FaceNormalOutOfBounds => ("face", "index out of range"),
                 _ => ("OBJ", "not a readable OBJ file"),
             };
             return Err(invalid(&file, line, 1, field, problem));
@@ -529,6 +562,54 @@ mod tests {
         let m = parse("t.obj", "v 0 0 0\nv 3e38 0 0\nv 0 0 2 2\nf 1 2 3\n").unwrap();
         assert_eq!(m.positions.len(), 3);
         assert!(m.positions.iter().any(|p| *p == DVec3::new(0.0, 0.0, 1.0)));
+    }
+
+    /// A face naming a vertex defined in a later object is refused at the
+    /// index, not at the `o` line where tobj finds it; within its own
+    /// object a forward reference is fine.
+    #[test]
+    fn forward_references_past_the_object_are_located() {
+        let e = parse(
+            "t.obj",
+            "o a\nf 1 2 3\no b\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with(
+                "t.obj:2:3: face: vertex index of a vertex defined after the face's object ends"
+            ),
+            "{e}"
+        );
+        let e = parse("t.obj", "v 0 0 0\nv 1 0 0\ng a\nf 1 2 3\ng b\nv 0 1 0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj:4:7: face: vertex index of a vertex defined after"),
+            "{e}"
+        );
+        let m = parse("t.obj", "o a\nf 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\no b\n").unwrap();
+        assert_eq!(m.triangles.len(), 1);
+    }
+
+    /// Vertex colours on some vertices but not all are named as such, not
+    /// as a face index out of range (the indices are all valid).
+    #[test]
+    fn colours_on_some_vertices_only() {
+        let e = parse("t.obj", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj:4:1: face: a vertex without a colour, where others have one"),
+            "{e}"
+        );
+        // On every vertex they are fine (and ignored).
+        let m = parse(
+            "t.obj",
+            "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n",
+        )
+        .unwrap();
+        assert_eq!(m.triangles.len(), 1);
     }
 
     /// Columns count characters, however many words precede them.

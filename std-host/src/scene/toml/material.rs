@@ -8,7 +8,7 @@ use super::schema::{MaterialDef, NoiseDef, TextureDef};
 use crate::assets::texture::{
     AnyTexture, Blend, Checker, ImageTexture, Mapping, Marble, Wood, Wrap,
 };
-use crate::scene::error::SceneError;
+use crate::scene::error::{SceneError, with_causes};
 use crate::scene::objects::{SceneTexture, TextureKind};
 use crate::scene::{Material, Scene};
 
@@ -202,7 +202,7 @@ impl Builder<'_> {
             };
             let (path, _) = self.path(&i.file, &k("image.file"))?;
             let img = ImageTexture::open(&path, mapping)
-                .map_err(|e| self.err(i.file.span(), &k("image.file"), e.to_string()))?;
+                .map_err(|e| self.err(i.file.span(), &k("image.file"), with_causes(&e)))?;
             AnyTexture::Image(img.with_wrap(wrap))
         } else {
             return Err(self.err(s, key, "no texture"));

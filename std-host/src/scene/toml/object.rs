@@ -14,7 +14,7 @@ use super::schema::{
     BezierDef, BoxDef, ConeDef, Doc, MeshDef, ObjectDef, SHAPE_KEYS, ShapeDef, SphereDef, TorusDef,
     TransformDef, V3, VoxDef,
 };
-use crate::scene::error::SceneError;
+use crate::scene::error::{SceneError, with_causes};
 use crate::scene::loc::SourceLoc;
 use crate::scene::objects::{Solid, VolumeObject, VoxObject};
 use crate::scene::{Object, Scene, bezier, bpt, nff, obj};
@@ -210,7 +210,7 @@ impl Builder<'_> {
         }
         let (path, shown) = self.path(&b.file, "object.bezier.file")?;
         let patches = bpt::load(&path, &shown)
-            .map_err(|e| self.err(b.file.span(), "object.bezier.file", e.to_string()))?;
+            .map_err(|e| self.err(b.file.span(), "object.bezier.file", with_causes(&e)))?;
         let per = (b.steps as usize + 1).pow(2);
         if patches
             .len()
@@ -236,7 +236,7 @@ impl Builder<'_> {
         let transform = at.transform;
         let (path, shown) = self.path(&m.file, "object.mesh.file")?;
         let mesh = obj::load(&path, &shown)
-            .map_err(|e| self.err(m.file.span(), "object.mesh.file", e.to_string()))?;
+            .map_err(|e| self.err(m.file.span(), "object.mesh.file", with_causes(&e)))?;
         if mesh
             .triangles
             .len()
@@ -327,7 +327,7 @@ impl Builder<'_> {
             ));
         }
         let vox = crate::assets::vox::read(&path)
-            .map_err(|e| self.err(v.file.span(), "object.vox.file", e.to_string()))?;
+            .map_err(|e| self.err(v.file.span(), "object.vox.file", with_causes(&e)))?;
         let position = self.vec3(&at.span, "object.vox.position", v.position)?;
         if !(v.cell.is_finite() && v.cell > 0.0) {
             return Err(self.err(at.span, "object.vox.cell", "expected a number > 0"));
@@ -343,16 +343,24 @@ impl Builder<'_> {
     }
 
     /// Every object, light and material of an NFF file (its view is
-    /// ignored).
+    /// ignored). A mesh, patch, model or volume file named here is refused
+    /// with the key that draws it, not parsed as NFF.
     fn nff(
         &self,
         scene: &mut Scene,
         n: &Spanned<String>,
         s: &Range<usize>,
     ) -> Result<(), SceneError> {
-        let (path, _) = self.path(n, "object.nff")?;
+        let (path, shown) = self.path(n, "object.nff")?;
+        if let Some((what, how)) = crate::scene::not_a_scene(&path, n.get_ref()) {
+            return Err(self.err(
+                n.span(),
+                "object.nff",
+                format!("{shown}: {what}, not an NFF scene: draw it with {how}"),
+            ));
+        }
         let inc = nff::load(&path, &nff::ParseOptions::default())
-            .map_err(|e| self.err(n.span(), "object.nff", e.to_string()))?;
+            .map_err(|e| self.err(n.span(), "object.nff", with_causes(&e)))?;
         self.include(scene, inc, s)
     }
 

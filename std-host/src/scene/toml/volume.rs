@@ -13,7 +13,7 @@ use super::schema::{Exact, VolumeDef};
 use crate::assets::volume::computed::{self, Metaball, Metaballs};
 use crate::assets::volume::raw::{self, RawSpec};
 use crate::assets::volume::{self, Classifier, Endian, Grid, Placement, SampleType, Volume};
-use crate::scene::error::SceneError;
+use crate::scene::error::{SceneError, with_causes};
 use crate::scene::objects::SceneVolume;
 
 impl Builder<'_> {
@@ -48,7 +48,7 @@ impl Builder<'_> {
         if let Some(f) = &d.file {
             let (path, _) = self.path(f, &key("file"))?;
             volume::nrrd::read(&path, &self.opts.volume)
-                .map_err(|e| self.err(f.span(), &key("file"), e.to_string()))
+                .map_err(|e| self.err(f.span(), &key("file"), with_causes(&e)))
         } else if let Some(r) = &d.raw {
             let sample_type = match r.sample_type.as_str() {
                 "uint8" | "u8" => SampleType::U8,
@@ -89,7 +89,7 @@ impl Builder<'_> {
                 skip: r.skip,
             };
             raw::read(&path, &spec, &self.opts.volume)
-                .map_err(|e| self.err(r.file.span(), &key("raw.file"), e.to_string()))
+                .map_err(|e| self.err(r.file.span(), &key("raw.file"), with_causes(&e)))
         } else if let Some(m) = &d.metaballs {
             let lo = self.vec3(&s, &key("metaballs.min"), m.min)?;
             let hi = self.vec3(&s, &key("metaballs.max"), m.max)?;
