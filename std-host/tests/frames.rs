@@ -516,3 +516,70 @@ fn stitch_refuses_what_is_not_one_image_in_order() {
     same(&d, "mixed.png", "whole.png");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A band description for a `width`×`height` image of one band of
+/// `kind`.
+fn whole_band_tag(width: u32, height: u32, kind: &str) -> String {
+    format!("band 0/1 rows 0..{height} of {width}x{height}, {kind}; view x")
+}
+
+#[test]
+fn stitch_refuses_an_image_too_large_before_reading_pixels() {
+    let d = std::env::temp_dir().join(format!("rrt-frames-{}-huge", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    // A PNG saying it is the one band of a 32768×32768 16-bit image, with
+    // no pixels: stitching it would allocate gigabytes before finding out.
+    let side = 32_768;
+    {
+        let file = std::fs::File::create(d.join("huge.png")).unwrap();
+        let mut e = png::Encoder::new(std::io::BufWriter::new(file), side, side);
+        e.set_color(png::ColorType::Rgb);
+        e.set_depth(png::BitDepth::Sixteen);
+        e.add_text_chunk(
+            "rrt-band".to_string(),
+            whole_band_tag(side, side, "16-bit linear"),
+        )
+        .unwrap();
+        let mut w = e.write_header().unwrap();
+        // An empty zlib stream: the decoder reads the header, the
+        // pixels are missing.
+        w.write_chunk(png::chunk::IDAT, &[0x78, 0x9c, 3, 0, 0, 0, 0, 1])
+            .unwrap();
+        drop(w);
+    }
+    // A PPM saying the same, with 100 bytes of samples.
+    let mut ppm = format!(
+        "P6\n# rrt {}\n{side} {side}\n65535\n",
+        whole_band_tag(side, side, "16-bit sRGB")
+    )
+    .into_bytes();
+    ppm.extend([0u8; 100]);
+    std::fs::write(d.join("huge.ppm"), &ppm).unwrap();
+    for (band, out) in [("huge.png", "out.png"), ("huge.ppm", "out.ppm")] {
+        fails(
+            &d,
+            &["stitch", "--max-memory", "1G", "-o", out, band],
+            &format!("{band}: a 32768x32768 image of 16-bit"),
+        );
+        fails(
+            &d,
+            &["stitch", "--max-memory", "1G", "-o", out, band],
+            "more than the memory limit of 1.0 GiB (--max-memory)",
+        );
+        assert!(!d.join(out).exists());
+    }
+    // Within the limit, the PPM's length says it lacks its samples before
+    // they are allocated.
+    fails(
+        &d,
+        &["stitch", "--max-memory", "1T", "-o", "out.ppm", "huge.ppm"],
+        "huge.ppm: 100 bytes of samples, expected 6442450944",
+    );
+    let names: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert!(names.iter().all(|n| n.starts_with("huge.")), "{names:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
