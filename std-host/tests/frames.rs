@@ -583,3 +583,53 @@ fn stitch_refuses_an_image_too_large_before_reading_pixels() {
     assert!(names.iter().all(|n| n.starts_with("huge.")), "{names:?}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn stitch_refuses_a_band_whose_description_lies_about_its_samples() {
+    let d = folder("lying");
+    let names = bands(&d, "s.rrt", "exr", 2, &[]);
+    // OpenEXR bands saying they hold 8-bit codes (the same length, so the
+    // files stay readable): refused naming the band, not the output.
+    let mut lying = Vec::new();
+    for (i, n) in names.iter().enumerate() {
+        let bytes = read(&d, n);
+        let text = b"32-bit float; ";
+        let at = bytes
+            .windows(text.len())
+            .position(|w| w == text)
+            .expect("the band description");
+        let mut bytes = bytes;
+        bytes[at..at + text.len()].copy_from_slice(b"8-bit linear; ");
+        let name = format!("lying-{i}.exr");
+        std::fs::write(d.join(&name), bytes).unwrap();
+        lying.push(name);
+    }
+    fails(
+        &d,
+        &["stitch", "-o", "out.png", &lying[0], &lying[1]],
+        "lying-0.exr: says it holds 8-bit linear samples, but OpenEXR bands hold 32-bit floats",
+    );
+    assert!(!d.join("out.png").exists());
+    // A PNG band with two descriptions.
+    {
+        let file = std::fs::File::create(d.join("twice.png")).unwrap();
+        let mut e = png::Encoder::new(std::io::BufWriter::new(file), 2, 2);
+        e.set_color(png::ColorType::Rgb);
+        for view in ["x", "y"] {
+            e.add_text_chunk(
+                "rrt-band".to_string(),
+                format!("band 0/1 rows 0..2 of 2x2, 8-bit linear; view {view}"),
+            )
+            .unwrap();
+        }
+        let mut w = e.write_header().unwrap();
+        w.write_image_data(&[0; 12]).unwrap();
+    }
+    fails(
+        &d,
+        &["stitch", "-o", "out.png", "twice.png"],
+        "twice.png: two `rrt-band` descriptions",
+    );
+    assert!(!d.join("out.png").exists());
+    let _ = std::fs::remove_dir_all(&d);
+}

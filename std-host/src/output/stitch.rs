@@ -303,12 +303,22 @@ fn header(path: &Path) -> Result<Header, StitchError> {
     let text = match format {
         Format::Png => {
             let reader = png_reader(path)?;
-            reader
+            let mut tags = reader
                 .info()
                 .uncompressed_latin1_text
                 .iter()
-                .find(|t| t.keyword == super::png::BAND_KEYWORD)
-                .map(|t| t.text.clone())
+                .filter(|t| t.keyword == super::png::BAND_KEYWORD);
+            let text = tags.next().map(|t| t.text.clone());
+            if tags.next().is_some() {
+                return Err(band_error(
+                    path,
+                    format!(
+                        "two `{}` descriptions: a band says once which band it is",
+                        super::png::BAND_KEYWORD
+                    ),
+                ));
+            }
+            text
         }
         Format::Ppm => ppm_header(path)?.band,
         Format::Exr => {
@@ -341,6 +351,22 @@ fn header(path: &Path) -> Result<Header, StitchError> {
     };
     let tag = BandTag::parse(&text)
         .ok_or_else(|| band_error(path, format!("unreadable band description {text:?}")))?;
+    // OpenEXR bands hold floats, PNG and PPM bands integer codes.
+    if (tag.kind == SampleKind::Float) != format.is_float() {
+        return Err(band_error(
+            path,
+            format!(
+                "says it holds {} samples, but {} bands hold {}",
+                tag.kind,
+                format.name(),
+                if format.is_float() {
+                    "32-bit floats"
+                } else {
+                    "integer codes"
+                }
+            ),
+        ));
+    }
     Ok(Header {
         path: path.to_path_buf(),
         format,
