@@ -509,6 +509,14 @@ fn stitch_refuses_what_is_not_one_image_in_order() {
         "out.exr: cannot hold the bands' samples (8-bit sRGB in band-0.png); stitch them into .png or .ppm",
     );
     fails(&d, &["stitch", "-o", "out.png"], "required");
+    // The output one of the bands: refused, the band kept.
+    let band1 = read(&d, b1);
+    fails(
+        &d,
+        &["stitch", "-o", &format!("./{b1}"), b0, b1, b2],
+        &format!("./{b1}: is the band {b1} too: the whole image would replace it"),
+    );
+    assert!(read(&d, b1) == band1);
     // The three in order make the whole image.
     ok(&d, &["stitch", "-o", "out.png", b0, b1, b2]);
     same(&d, "out.png", "whole.png");

@@ -93,9 +93,10 @@ pub struct Stitched {
 /// pixels are read or the output is created.
 ///
 /// # Errors
-/// [`StitchError`]: no inputs, an unreadable file, a file that is not a
-/// band of the same image as the first or not in its place (naming the
-/// file and what is wrong), an image needing more memory than
+/// [`StitchError`]: no inputs, an output that is one of the bands, an
+/// unreadable file, a file that is not a band of the same image as the
+/// first or not in its place (naming the file and what is wrong), an
+/// image needing more memory than
 /// `max_memory`, an output format that cannot hold the bands' samples,
 /// or the output's error.
 pub fn stitch(
@@ -108,6 +109,20 @@ pub fn stitch(
         return Err(StitchError::NoBands);
     };
     let out_format = Format::from_path(output)?;
+    // The whole image written over one of its bands would lose the band.
+    if let Ok(out) = std::fs::canonicalize(output)
+        && let Some(band) = inputs
+            .iter()
+            .find(|p| std::fs::canonicalize(p).is_ok_and(|p| p == out))
+    {
+        return Err(band_error(
+            output,
+            format!(
+                "is the band {} too: the whole image would replace it; write it to another file",
+                band.display()
+            ),
+        ));
+    }
     let headers = inputs
         .iter()
         .map(|p| header(p))
