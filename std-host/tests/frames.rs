@@ -509,10 +509,135 @@ fn stitch_refuses_what_is_not_one_image_in_order() {
         "out.exr: cannot hold the bands' samples (8-bit sRGB in band-0.png); stitch them into .png or .ppm",
     );
     fails(&d, &["stitch", "-o", "out.png"], "required");
+    // The output one of the bands: refused, the band kept.
+    let band1 = read(&d, b1);
+    fails(
+        &d,
+        &["stitch", "-o", &format!("./{b1}"), b0, b1, b2],
+        &format!("./{b1}: is the band {b1} too: the whole image would replace it"),
+    );
+    assert!(read(&d, b1) == band1);
     // The three in order make the whole image.
     ok(&d, &["stitch", "-o", "out.png", b0, b1, b2]);
     same(&d, "out.png", "whole.png");
     ok(&d, &["stitch", "-o", "mixed.png", b0, "from-scene.png", b2]);
     same(&d, "mixed.png", "whole.png");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// A band description for a `width`×`height` image of one band of
+/// `kind`.
+fn whole_band_tag(width: u32, height: u32, kind: &str) -> String {
+    format!("band 0/1 rows 0..{height} of {width}x{height}, {kind}; view x")
+}
+
+#[test]
+fn stitch_refuses_an_image_too_large_before_reading_pixels() {
+    let d = std::env::temp_dir().join(format!("rrt-frames-{}-huge", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    // A PNG saying it is the one band of a 32768×32768 16-bit image, with
+    // no pixels: stitching it would allocate gigabytes before finding out.
+    let side = 32_768;
+    {
+        let file = std::fs::File::create(d.join("huge.png")).unwrap();
+        let mut e = png::Encoder::new(std::io::BufWriter::new(file), side, side);
+        e.set_color(png::ColorType::Rgb);
+        e.set_depth(png::BitDepth::Sixteen);
+        e.add_text_chunk(
+            "rrt-band".to_string(),
+            whole_band_tag(side, side, "16-bit linear"),
+        )
+        .unwrap();
+        let mut w = e.write_header().unwrap();
+        // An empty zlib stream: the decoder reads the header, the
+        // pixels are missing.
+        w.write_chunk(png::chunk::IDAT, &[0x78, 0x9c, 3, 0, 0, 0, 0, 1])
+            .unwrap();
+        drop(w);
+    }
+    // A PPM saying the same, with 100 bytes of samples.
+    let mut ppm = format!(
+        "P6\n# rrt {}\n{side} {side}\n65535\n",
+        whole_band_tag(side, side, "16-bit sRGB")
+    )
+    .into_bytes();
+    ppm.extend([0u8; 100]);
+    std::fs::write(d.join("huge.ppm"), &ppm).unwrap();
+    for (band, out) in [("huge.png", "out.png"), ("huge.ppm", "out.ppm")] {
+        fails(
+            &d,
+            &["stitch", "--max-memory", "1G", "-o", out, band],
+            &format!("{band}: a 32768x32768 image of 16-bit"),
+        );
+        fails(
+            &d,
+            &["stitch", "--max-memory", "1G", "-o", out, band],
+            "more than the memory limit of 1.0 GiB (--max-memory)",
+        );
+        assert!(!d.join(out).exists());
+    }
+    // Within the limit, the PPM's length says it lacks its samples before
+    // they are allocated.
+    fails(
+        &d,
+        &["stitch", "--max-memory", "1T", "-o", "out.ppm", "huge.ppm"],
+        "huge.ppm: 100 bytes of samples, expected 6442450944",
+    );
+    let names: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert!(names.iter().all(|n| n.starts_with("huge.")), "{names:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn stitch_refuses_a_band_whose_description_lies_about_its_samples() {
+    let d = folder("lying");
+    let names = bands(&d, "s.rrt", "exr", 2, &[]);
+    // OpenEXR bands saying they hold 8-bit codes (the same length, so the
+    // files stay readable): refused naming the band, not the output.
+    let mut lying = Vec::new();
+    for (i, n) in names.iter().enumerate() {
+        let bytes = read(&d, n);
+        let text = b"32-bit float; ";
+        let at = bytes
+            .windows(text.len())
+            .position(|w| w == text)
+            .expect("the band description");
+        let mut bytes = bytes;
+        bytes[at..at + text.len()].copy_from_slice(b"8-bit linear; ");
+        let name = format!("lying-{i}.exr");
+        std::fs::write(d.join(&name), bytes).unwrap();
+        lying.push(name);
+    }
+    fails(
+        &d,
+        &["stitch", "-o", "out.png", &lying[0], &lying[1]],
+        "lying-0.exr: says it holds 8-bit linear samples, but OpenEXR bands hold 32-bit floats",
+    );
+    assert!(!d.join("out.png").exists());
+    // A PNG band with two descriptions.
+    {
+        let file = std::fs::File::create(d.join("twice.png")).unwrap();
+        let mut e = png::Encoder::new(std::io::BufWriter::new(file), 2, 2);
+        e.set_color(png::ColorType::Rgb);
+        for view in ["x", "y"] {
+            e.add_text_chunk(
+                "rrt-band".to_string(),
+                format!("band 0/1 rows 0..2 of 2x2, 8-bit linear; view {view}"),
+            )
+            .unwrap();
+        }
+        let mut w = e.write_header().unwrap();
+        w.write_image_data(&[0; 12]).unwrap();
+    }
+    fails(
+        &d,
+        &["stitch", "-o", "out.png", "twice.png"],
+        "twice.png: two `rrt-band` descriptions",
+    );
+    assert!(!d.join("out.png").exists());
     let _ = std::fs::remove_dir_all(&d);
 }

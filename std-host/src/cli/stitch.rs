@@ -5,6 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::CliError;
+use crate::fit::default_max_memory;
 use crate::output::stitch::stitch;
 
 /// Arguments of `rrt stitch`.
@@ -20,6 +21,12 @@ pub struct StitchArgs {
     /// --tile` for one image (PFM bands cannot say which band they are).
     #[arg(value_name = "BAND", required = true)]
     pub bands: Vec<PathBuf>,
+    /// Refuse an image needing more memory than this to stitch (bytes, or
+    /// with K, M, G, T suffixes; binary units), checked from the bands'
+    /// headers before any pixels are read [default: half of the
+    /// machine's RAM].
+    #[arg(long, value_name = "SIZE", value_parser = super::common::parse_memory)]
+    pub max_memory: Option<u64>,
     /// No summary line.
     #[arg(long, short)]
     pub quiet: bool,
@@ -33,7 +40,8 @@ pub struct StitchArgs {
 /// place (naming it and what is wrong), an output that cannot hold the
 /// bands' samples, or the output's error.
 pub fn run(args: &StitchArgs, out: &mut impl Write) -> Result<(), CliError> {
-    let done = stitch(&args.bands, &args.output, out)?;
+    let limit = args.max_memory.unwrap_or_else(default_max_memory);
+    let done = stitch(&args.bands, &args.output, limit, out)?;
     if !args.quiet {
         let mut stderr = std::io::stderr();
         let out: &mut dyn Write = if args.output.as_os_str() == "-" {

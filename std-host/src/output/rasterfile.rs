@@ -68,7 +68,9 @@
 //! # Loading
 //! The file is mapped (`memmap2`), not read in full: loading reads the
 //! sections it decodes and checks each one's checksum first. [`load`]
-//! refuses, with the file's name and what is wrong: a file that is
+//! refuses, with the file's name and what is wrong (naming the section
+//! and its bytes in the file where a section's contents are wrong): a
+//! file that is
 //! not a raster, another version, a header or section whose checksum does
 //! not match (corrupt, with the section's bytes), a section that ends past the end of the file or a
 //! file shorter than its last section's padding (truncated), bytes after
@@ -101,7 +103,9 @@ use super::atomic::AtomicFile;
 use rrt_core::light::ExactRecords;
 use rrt_core::object_table::MAX_LIGHTS;
 use rrt_core::raster::{Extent, LINE_CELLS};
-use rrt_core::store::{BRICK, BRICK_VOXELS, RecordStore, brick_count, brick_dims, directory_len};
+use rrt_core::store::{
+    BRICK, BRICK_VOXELS, RecordStore, StoreError, brick_count, brick_dims, directory_len,
+};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
@@ -1120,6 +1124,20 @@ struct Header {
 }
 
 impl Header {
+    /// `what` is wrong in section `k`: [`RasterFileError::Invalid`] naming
+    /// the section and its bytes in the file.
+    fn invalid_in(&self, path: &Path, k: usize, what: &str) -> RasterFileError {
+        let (_, _, off, len) = self.sections[k];
+        RasterFileError::Invalid {
+            path: path.to_path_buf(),
+            what: format!(
+                "{} section (bytes {off} to {}): {what}",
+                self.name(k),
+                off.saturating_add(len)
+            ),
+        }
+    }
+
     fn name(&self, k: usize) -> &'static str {
         if self.version == 3 && k == 1 {
             "plane bricks"
@@ -1299,6 +1317,7 @@ fn read_meta(bytes: &[u8], path: &Path, h: &Header) -> Result<Meta, RasterFileEr
         )));
     }
     let b = section(bytes, path, h, 0, &ProgressBar::hidden(), |_, _| {})?;
+    let invalid = |what: String| h.invalid_in(path, 0, &what);
     let mut c = Cursor::new(b);
     let dims = [c.u32(), c.u32(), c.u32()];
     let separation = match c.u8() {
@@ -1807,21 +1826,25 @@ fn load_from(
             derived: false,
         }
     };
-    let materials = materials_from(raw(5)?).map_err(invalid)?;
-    let objects = objects_from(raw(4)?, materials.len()).map_err(invalid)?;
-    let lights = lights_from(raw(6)?).map_err(invalid)?;
+    let materials = materials_from(raw(5)?).map_err(|e| h.invalid_in(path, 5, &e))?;
+    let objects = objects_from(raw(4)?, materials.len()).map_err(|e| h.invalid_in(path, 4, &e))?;
+    let lights = lights_from(raw(6)?).map_err(|e| h.invalid_in(path, 6, &e))?;
     let store = RecordStore::with_lists(extent, &directory, &records, &lists)
-        .map_err(|e| invalid(e.to_string()))?;
+        .map_err(|e| h.invalid_in(path, store_section(e), &e.to_string()))?;
     for (i, r) in records.iter().enumerate() {
         let ids = store.objects(r);
         if ids.iter().any(|&o| o as usize >= objects.len())
             || usize::from(r.material) >= materials.len()
         {
-            return Err(invalid(format!(
-                "record {i} names object {} and material {}, beyond the tables",
-                ids.iter().max().copied().unwrap_or(u32::MAX),
-                r.material
-            )));
+            return Err(h.invalid_in(
+                path,
+                3,
+                &format!(
+                    "record {i} names object {} and material {}, beyond the tables",
+                    ids.iter().max().copied().unwrap_or(u32::MAX),
+                    r.material
+                ),
+            ));
         }
     }
     Ok(VoxelScene {
@@ -1851,6 +1874,20 @@ fn load_from(
         view: m.view,
         direct: Vec::new(),
     })
+}
+
+/// The section (its index in the table) holding what `e` finds wrong:
+/// the brick directory, the records or the object lists.
+fn store_section(e: StoreError) -> usize {
+    match e {
+        StoreError::TooManyBricks
+        | StoreError::DirectoryLength { .. }
+        | StoreError::DirectoryStart
+        | StoreError::DirectoryOrder { .. }
+        | StoreError::DirectoryEnd { .. } => 2,
+        StoreError::ListsEnd { .. } | StoreError::ListsTooLong { .. } => 7,
+        _ => 3,
+    }
 }
 
 /// The raster of a version 3 file: its entries decoded, the plane made
@@ -1945,7 +1982,7 @@ fn load_sparse(
     )
     .map_err(|e| invalid(1, e))?;
     RecordStore::with_lists(extent, &directory, &records, &lists)
-        .map_err(|e| invalid(3, e.to_string()))?;
+        .map_err(|e| invalid(store_section(e), e.to_string()))?;
     let nz = extent.dims()[2];
     let (mut plane, _) =
         derive_plane(extent, &directory, &records, &lists, [0, nz]).map_err(|source| {
@@ -2152,6 +2189,62 @@ mod tests {
             sparse.len(),
             dense.len()
         );
+    }
+
+    /// A file whose contents break an invariant is refused naming the
+    /// section and its bytes: an object naming a material beyond the
+    /// table, a light that is not finite, a record naming an object beyond
+    /// the table, a brick directory not starting at 0 (every version).
+    #[test]
+    fn corrupt_contents_name_their_section_and_bytes() {
+        let s = built(BuildOptions::new(37));
+        let path = Path::new("t.rrt");
+        for format in [Format::Sparse { compress: false }, Format::Dense] {
+            let good = save_bytes_as(&s, path, format).unwrap();
+            let version = u32::from_le_bytes(good[8..12].try_into().unwrap());
+            // The sections' places in the table: the same in every version.
+            let (dir, recs, objs, lights) = (2, 3, 4, 6);
+            let range = |k: usize| {
+                let (_, _, off, len) = table_entry(&good, version, k);
+                (usize::try_from(off).unwrap(), off + len)
+            };
+            let name = |k: usize| {
+                if version == 3 && k == 1 {
+                    "plane bricks"
+                } else {
+                    NAMES[k]
+                }
+            };
+            let cases: [(usize, usize, &[u8], &str); 4] = [
+                (objs, 4, &99u32.to_le_bytes(), "object 0 names material 99"),
+                (lights, 0, &f64::NAN.to_le_bytes(), "a light is not finite"),
+                (
+                    recs,
+                    0,
+                    &0x7fff_fff0u32.to_le_bytes(),
+                    "record 0 names object",
+                ),
+                (
+                    dir,
+                    0,
+                    &1u32.to_le_bytes(),
+                    "brick directory does not start at 0",
+                ),
+            ];
+            for (k, at, value, want) in cases {
+                let mut b = good.clone();
+                let (off, end) = range(k);
+                b[off + at..off + at + value.len()].copy_from_slice(value);
+                reseal(&mut b);
+                let e = load_bytes(path, &b).unwrap_err().to_string();
+                let section = format!(
+                    "t.rrt: corrupt: {} section (bytes {off} to {end}): ",
+                    name(k)
+                );
+                assert!(e.starts_with(&section), "version {version}: {e}");
+                assert!(e.contains(want), "version {version}: {e}");
+            }
+        }
     }
 
     /// A plane that is not the one made from the records (cells changed

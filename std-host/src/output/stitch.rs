@@ -15,12 +15,13 @@
 //! codes of the same bit depth and encoding, OpenEXR or PFM for floats.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
 use super::band::BandTag;
 use super::encoding::{Codes, Encoding, SampleKind, Samples};
 use super::image::{Format, ImageOutput, OutputError};
+use crate::fit::Bytes;
 
 /// Why bands cannot be stitched.
 #[derive(Debug, thiserror::Error)]
@@ -87,27 +88,61 @@ pub struct Stitched {
 
 /// Joins the band files `inputs`, in order, into `output` (its extension
 /// chooses the format; `-` is PNG on `stdout`), through
-/// [`ImageOutput`].
+/// [`ImageOutput`]. The memory the image needs ([`stitch_memory`]) is
+/// checked against `max_memory` from the bands' headers, before any
+/// pixels are read or the output is created.
 ///
 /// # Errors
-/// [`StitchError`]: no inputs, an unreadable file, a file that is not a
-/// band of the same image as the first or not in its place (naming the
-/// file and what is wrong), an output format that cannot hold the bands'
-/// samples, or the output's error.
+/// [`StitchError`]: no inputs, an output that is one of the bands, an
+/// unreadable file, a file that is not a band of the same image as the
+/// first or not in its place (naming the file and what is wrong), an
+/// image needing more memory than
+/// `max_memory`, an output format that cannot hold the bands' samples,
+/// or the output's error.
 pub fn stitch(
     inputs: &[PathBuf],
     output: &Path,
+    max_memory: u64,
     stdout: &mut impl Write,
 ) -> Result<Stitched, StitchError> {
     let Some(first_path) = inputs.first() else {
         return Err(StitchError::NoBands);
     };
     let out_format = Format::from_path(output)?;
+    // The whole image written over one of its bands would lose the band.
+    if let Ok(out) = std::fs::canonicalize(output)
+        && let Some(band) = inputs
+            .iter()
+            .find(|p| std::fs::canonicalize(p).is_ok_and(|p| p == out))
+    {
+        return Err(band_error(
+            output,
+            format!(
+                "is the band {} too: the whole image would replace it; write it to another file",
+                band.display()
+            ),
+        ));
+    }
     let headers = inputs
         .iter()
         .map(|p| header(p))
         .collect::<Result<Vec<_>, _>>()?;
     check_bands(&headers)?;
+    let needed = stitch_memory(&headers, out_format);
+    if needed > max_memory {
+        let t = &headers[0].tag;
+        return Err(band_error(
+            first_path,
+            format!(
+                "a {}x{} image of {} needs about {} to stitch, more than the memory limit of {} (--max-memory)",
+                t.width,
+                t.height,
+                t.kind,
+                Bytes(needed),
+                Bytes(max_memory)
+            ),
+        ));
+    }
     let first = &headers[0].tag;
     let encoding = match first.kind {
         SampleKind::Codes(e) => e,
@@ -148,6 +183,39 @@ pub fn stitch(
         bands: first.band.count,
         kind: first.kind,
     })
+}
+
+/// Bytes of memory stitching the bands `headers` (checked to be bands of
+/// one image) into `out` needs at most: the whole image's samples, the
+/// largest band's as read (twice: the file's bytes and the samples made
+/// of them), and the encoder's copies, counted as `rrt render` counts
+/// them (two copies of the codes; 24 bytes a pixel for OpenEXR).
+fn stitch_memory(headers: &[Header], out: Format) -> u64 {
+    let Some(first) = headers.first() else {
+        return 0;
+    };
+    let t = &first.tag;
+    let per_pixel = match t.kind {
+        SampleKind::Codes(e) => 3 * u64::from(e.bits.div_ceil(8)),
+        SampleKind::Float => 12,
+    };
+    let pixels = u64::from(t.width) * u64::from(t.height);
+    let rows = headers
+        .iter()
+        .map(|h| {
+            let r = h.tag.rows();
+            u64::from(r.end - r.start)
+        })
+        .max()
+        .unwrap_or(0);
+    let band = u64::from(t.width) * rows * per_pixel;
+    let encoding = match out {
+        Format::Exr => pixels * 24,
+        _ => pixels * 2 * per_pixel,
+    };
+    (pixels * per_pixel)
+        .saturating_add(band.saturating_mul(2))
+        .saturating_add(encoding)
 }
 
 /// Checks that the headers are the bands of one image, each once, in
@@ -250,12 +318,22 @@ fn header(path: &Path) -> Result<Header, StitchError> {
     let text = match format {
         Format::Png => {
             let reader = png_reader(path)?;
-            reader
+            let mut tags = reader
                 .info()
                 .uncompressed_latin1_text
                 .iter()
-                .find(|t| t.keyword == super::png::BAND_KEYWORD)
-                .map(|t| t.text.clone())
+                .filter(|t| t.keyword == super::png::BAND_KEYWORD);
+            let text = tags.next().map(|t| t.text.clone());
+            if tags.next().is_some() {
+                return Err(band_error(
+                    path,
+                    format!(
+                        "two `{}` descriptions: a band says once which band it is",
+                        super::png::BAND_KEYWORD
+                    ),
+                ));
+            }
+            text
         }
         Format::Ppm => ppm_header(path)?.band,
         Format::Exr => {
@@ -288,6 +366,22 @@ fn header(path: &Path) -> Result<Header, StitchError> {
     };
     let tag = BandTag::parse(&text)
         .ok_or_else(|| band_error(path, format!("unreadable band description {text:?}")))?;
+    // OpenEXR bands hold floats, PNG and PPM bands integer codes.
+    if (tag.kind == SampleKind::Float) != format.is_float() {
+        return Err(band_error(
+            path,
+            format!(
+                "says it holds {} samples, but {} bands hold {}",
+                tag.kind,
+                format.name(),
+                if format.is_float() {
+                    "32-bit floats"
+                } else {
+                    "integer codes"
+                }
+            ),
+        ));
+    }
     Ok(Header {
         path: path.to_path_buf(),
         format,
@@ -409,10 +503,23 @@ fn pixels(h: &Header) -> Result<Samples<'static>, StitchError> {
                 SampleKind::Codes(e) if e.bits == bits => {}
                 _ => return Err(kind_error(format!("{bits}-bit"))),
             }
-            let mut buf = Vec::with_capacity(count * usize::from(bits / 8));
+            // The file's length says how many samples follow the header:
+            // a file short of them (or longer) is refused before they are
+            // allocated.
+            let bytes = count * usize::from(bits / 8);
+            let at = p.reader.stream_position().map_err(io_error(path))?;
+            let len = p.reader.get_ref().metadata().map_err(io_error(path))?.len();
+            let held = len.saturating_sub(at);
+            if held != bytes as u64 {
+                return Err(band_error(
+                    path,
+                    format!("{held} bytes of samples, expected {bytes}"),
+                ));
+            }
+            let mut buf = Vec::with_capacity(bytes);
             p.reader
                 .by_ref()
-                .take(u64::try_from(count * usize::from(bits / 8) + 1).unwrap_or(u64::MAX))
+                .take(u64::try_from(bytes + 1).unwrap_or(u64::MAX))
                 .read_to_end(&mut buf)
                 .map_err(io_error(path))?;
             codes(path, buf, bits, count)
