@@ -88,7 +88,7 @@ pub struct Stitched {
 
 /// Joins the band files `inputs`, in order, into `output` (its extension
 /// chooses the format; `-` is PNG on `stdout`), through
-/// [`ImageOutput`]. The memory the image needs ([`stitch_memory`]) is
+/// [`ImageOutput`]. The memory the image needs (`stitch_memory`) is
 /// checked against `max_memory` from the bands' headers, before any
 /// pixels are read or the output is created.
 ///
