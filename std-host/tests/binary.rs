@@ -302,3 +302,56 @@ fn info_checks_every_checksum() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A scene read from a pipe (`/dev/stdin`) is read whole: the check for a
+/// saved raster's magic does not take its first bytes (here a light,
+/// eight bytes) from the parser.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_scene_from_a_pipe_is_read_whole() {
+    use std::io::Write;
+    use std::process::Stdio;
+    let dir = std::env::temp_dir().join(format!("rrt-bin-{}-pipe", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = "l 4 4 4\nv\nfrom 0 -5 2\nat 0 0 0.5\nup 0 0 1\nangle 40\nhither 0.1\nresolution 16 16\n\
+        f 0.9 0.4 0.2 0.8 0.2 20 0 1\ns 0 0 0.7 0.7\np 3\n-2 -2 0\n2 -2 0\n2 2 0\n";
+    std::fs::write(dir.join("s.nff"), scene).unwrap();
+    let render = |input: &str, out: &str, stdin: Stdio| {
+        Command::new(env!("CARGO_BIN_EXE_rrt"))
+            .args(["render", "-q", input, "--raster", "32", "-o", out])
+            .current_dir(&dir)
+            .stdin(stdin)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run rrt")
+    };
+    let file = render("s.nff", "file.png", Stdio::null())
+        .wait_with_output()
+        .unwrap();
+    assert!(
+        file.status.success(),
+        "{}",
+        String::from_utf8_lossy(&file.stderr)
+    );
+    let mut child = render("/dev/stdin", "pipe.png", Stdio::piped());
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(scene.as_bytes())
+        .unwrap();
+    let pipe = child.wait_with_output().unwrap();
+    assert!(
+        pipe.status.success(),
+        "{}",
+        String::from_utf8_lossy(&pipe.stderr)
+    );
+    assert!(
+        std::fs::read(dir.join("file.png")).unwrap()
+            == std::fs::read(dir.join("pipe.png")).unwrap(),
+        "the piped scene renders another image"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1066,13 +1066,23 @@ pub fn reseal(bytes: &mut [u8]) {
     bytes[at..at + 4].copy_from_slice(&crc.to_le_bytes());
 }
 
-/// Whether the file at `path` starts with the raster magic.
+/// Whether `path` is a regular file starting with the raster magic. Only
+/// a regular file is read: the first bytes of a pipe, a FIFO or a
+/// terminal (`/dev/stdin`) read here would be lost to the scene parser
+/// that reads it next, and a raster is mapped, which needs a regular
+/// file anyway.
 #[must_use]
 pub fn is_raster_file(path: &Path) -> bool {
     let mut magic = [0u8; 8];
     File::open(path)
-        .and_then(|mut f| f.read_exact(&mut magic))
-        .is_ok_and(|()| magic == MAGIC)
+        .and_then(|mut f| {
+            if !f.metadata()?.is_file() {
+                return Ok(false);
+            }
+            f.read_exact(&mut magic)?;
+            Ok(magic == MAGIC)
+        })
+        .unwrap_or(false)
 }
 
 /// The summary `rrt info` prints, read from the header and meta section
