@@ -485,5 +485,12 @@ resolution 4 4
             &["render", nff, "--min-weight", "2"],
             "expected a number from 0 to 1, found 2",
         );
+        // A negative value is read as the option's value, and refused.
+        fails_with(
+            &["render", nff, "--min-weight", "-0.5"],
+            "expected a number from 0 to 1, found -0.5",
+        );
+        let (_, minus_zero, _) = render("3", "-0", "minus-zero.png");
+        assert!(minus_zero == whole);
     });
 }

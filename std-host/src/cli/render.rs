@@ -61,7 +61,7 @@ pub struct RenderArgs {
     /// below one step of a 16-bit linear image for a ray that sees at
     /// most white. A material with both `Ks` and `T` doubles the ray tree
     /// at every level until the weights fall below W.
-    #[arg(long, value_name = "W", default_value_t = crate::trace::DEFAULT_MIN_WEIGHT, value_parser = parse_min_weight)]
+    #[arg(long, value_name = "W", default_value_t = crate::trace::DEFAULT_MIN_WEIGHT, value_parser = parse_min_weight, allow_hyphen_values = true)]
     pub min_weight: f64,
     /// K×K rays per pixel, box-filtered, K from 1 to 16 (and at most
     /// 2^32 rays in all).
