@@ -162,7 +162,8 @@ pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene
 /// duplicate key), or else the key of the line `at` is on (an error deep
 /// inside its value, such as nesting past toml's limit), or empty. A key
 /// at the start of its line is given with the path of the table header
-/// above it (`object[1].material`, counting `[[object]]` headers from 0).
+/// above it (`object[1].material`, counting `[[object]]` headers from 0),
+/// a table header with its path.
 fn key_near(text: &str, at: usize) -> String {
     let is_key = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.';
     let Some(before) = text.get(..at) else {
@@ -203,6 +204,10 @@ fn key_near(text: &str, at: usize) -> String {
         }
     } else if !lead.is_empty() {
         with_table(lead)
+    } else if whole.trim_start().starts_with('[') {
+        // A table header (defined twice, say): the table's own path.
+        let end = line_start + whole.len();
+        table_path(text.get(..end).unwrap_or("")).unwrap_or_default()
     } else {
         String::new()
     }
@@ -227,7 +232,7 @@ fn table_path(before: &str) -> Option<String> {
         Some(format!("{}[{}]", name.trim(), k.saturating_sub(1)))
     } else {
         let name = last.strip_prefix('[')?.strip_suffix(']')?;
-        Some(name.trim().to_owned())
+        (!name.contains(['[', ']'])).then(|| name.trim().to_owned())
     }
 }
 
@@ -263,6 +268,14 @@ mod tests {
         // A key inside an inline table keeps its bare name.
         let e = error(&format!("{CAMERA}[[light]]\nposition = {{ x = }}\n"));
         assert!(e.starts_with("x.toml:7:"), "{e}");
+        // A table defined twice: the table; a broken header: nothing.
+        let e = error(&format!("{CAMERA}{OBJECT}[material.m]\n"));
+        assert!(
+            e.starts_with("x.toml:10:11: material.m: duplicate key"),
+            "{e}"
+        );
+        let e = error(&format!("{CAMERA}[[object]\n"));
+        assert!(e.starts_with("x.toml:6:10: unclosed array table"), "{e}");
         let e = error(&CAMERA.replace("angle = 40", "angle = 4 0"));
         assert!(e.starts_with("x.toml:4:"), "{e}");
         assert!(e.contains(": camera.angle: "), "{e}");
