@@ -1031,6 +1031,13 @@ fn every_bad_value_is_located_at_itself() {
             "expected 1 to 65536",
         ),
         (
+            "raw spacing",
+            raw("file = \"x.raw\", dims = [2, 2, 2], type = \"u8\", spacing = [1, 1e-300, 1]"),
+            "[1, 1e-300, 1]",
+            "volume.v.raw.spacing",
+            "expected numbers from 1e-12 to 1e60",
+        ),
+        (
             "raw type",
             raw("file = \"x.raw\", dims = [2, 2, 2], type = \"double\""),
             "\"double\"",

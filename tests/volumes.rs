@@ -783,6 +783,10 @@ fn bad_headers_name_the_line() {
             "bad.nrrd:6: spacings: `0` is not a finite non-zero spacing",
         ),
         (
+            "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 5 4 3\nencoding: raw\nspacings: 1 1e-300 1\n\n",
+            "bad.nrrd:6: spacings: axis 1: step [0e0, 1e-300, 0e0] is not finite, or shorter than 1e-12",
+        ),
+        (
             "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 5 4 3\nencoding: raw\nspace: RAST\n\n",
             "bad.nrrd:6: space: `RAST` is 4D; only 3D spaces are supported",
         ),

@@ -296,13 +296,16 @@ impl Grid {
     /// # Errors
     /// A description of what is wrong.
     pub fn validate(&self) -> Result<(), String> {
+        // In scientific notation: a step of 1e-300 is not 300 digits.
+        let e = |v: DVec3| format!("[{:e}, {:e}, {:e}]", v.x, v.y, v.z);
         if !self.origin.is_finite() {
-            return Err(format!("origin {} is not finite", self.origin));
+            return Err(format!("origin {} is not finite", e(self.origin)));
         }
         for (axis, d) in self.directions.iter().enumerate() {
             if !d.is_finite() || d.length() < 1e-12 {
                 return Err(format!(
-                    "axis {axis}: step {d} is not a finite non-zero vector"
+                    "axis {axis}: step {} is not finite, or shorter than 1e-12",
+                    e(*d)
                 ));
             }
         }

@@ -755,7 +755,10 @@ fn parse_geometry(fields: &Fields) -> Result<Option<Grid>, (usize, String)> {
                 }
                 *slot = x;
             }
-            Ok(Some(Grid::axis_aligned(sp, origin.unwrap_or(DVec3::ZERO))))
+            let grid = Grid::axis_aligned(sp, origin.unwrap_or(DVec3::ZERO));
+            grid.validate()
+                .map_err(|m| (s.line, format!("spacings: {m}")))?;
+            Ok(Some(grid))
         }
         (None, None) => Ok(origin.map(|o| Grid::axis_aligned([1.0; 3], o))),
     }

@@ -159,25 +159,80 @@ pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene
 
 /// In a document that does not parse: the key whose value starts at byte
 /// `at` (`key = value` on that line), or the key that starts at `at` (a
-/// duplicate key), or empty.
+/// duplicate key), or else the key of the line `at` is on (an error deep
+/// inside its value, such as nesting past toml's limit), or empty. A key
+/// at the start of its line is given with the path of the table header
+/// above it (`object[1].material`, counting `[[object]]` headers from 0),
+/// a table header with its path.
 fn key_near(text: &str, at: usize) -> String {
     let is_key = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.';
     let Some(before) = text.get(..at) else {
         return String::new();
     };
-    let line = before.rsplit('\n').next().unwrap_or("");
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let line = &before[line_start..];
+    let rest = text[at..].split('\n').next().unwrap_or("");
+    // The key this line starts with (not a table header).
+    let whole = format!("{line}{rest}");
+    let lead = whole
+        .split_once('=')
+        .map(|(lhs, _)| lhs.trim())
+        .filter(|k| !k.is_empty() && k.chars().all(is_key))
+        .unwrap_or("");
+    let with_table = |key: &str| match table_path(&text[..line_start]) {
+        Some(t) => format!("{t}.{key}"),
+        None => key.to_owned(),
+    };
     if let Some(lhs) = line.trim_end().strip_suffix('=') {
         let lhs = lhs.trim_end();
         let start = lhs.rfind(|c: char| !is_key(c)).map_or(0, |i| i + 1);
-        return lhs.get(start..).unwrap_or("").to_owned();
+        let key = lhs.get(start..).unwrap_or("");
+        return if !key.is_empty() && key == lead && lhs.trim_start() == key {
+            with_table(key)
+        } else {
+            key.to_owned()
+        };
     }
     let after = text.get(at..).unwrap_or("");
     let key = &after[..after.find(|c: char| !is_key(c)).unwrap_or(after.len())];
     // Only a key followed by `=`.
     if !key.is_empty() && after[key.len()..].trim_start().starts_with('=') {
-        key.to_owned()
+        if key == lead && line.trim().is_empty() {
+            with_table(key)
+        } else {
+            key.to_owned()
+        }
+    } else if !lead.is_empty() {
+        with_table(lead)
+    } else if whole.trim_start().starts_with('[') {
+        // A table header (defined twice, say): the table's own path.
+        let end = line_start + whole.len();
+        table_path(text.get(..end).unwrap_or("")).unwrap_or_default()
     } else {
         String::new()
+    }
+}
+
+/// The path of the table that the text after `before` continues: its last
+/// header, `[name]` as `name`, the k-th `[[name]]` as `name[k]` (from 0);
+/// `None` at the top level.
+fn table_path(before: &str) -> Option<String> {
+    let header = |l: &str| {
+        let l = l.trim();
+        let l = l.split_once('#').map_or(l, |(h, _)| h.trim_end());
+        l.starts_with('[').then(|| l.to_owned())
+    };
+    let last = before.lines().rev().find_map(header)?;
+    if let Some(name) = last.strip_prefix("[[").and_then(|n| n.strip_suffix("]]")) {
+        let k = before
+            .lines()
+            .filter_map(header)
+            .filter(|h| *h == last)
+            .count();
+        Some(format!("{}[{}]", name.trim(), k.saturating_sub(1)))
+    } else {
+        let name = last.strip_prefix('[')?.strip_suffix(']')?;
+        (!name.contains(['[', ']'])).then(|| name.trim().to_owned())
     }
 }
 
@@ -189,6 +244,42 @@ mod tests {
         "[camera]\nfrom = [0, -6, 2]\nat = [0, 0, 0]\nangle = 40\nresolution = [8, 8]\n";
     const OBJECT: &str =
         "[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = { centre = [0, 0, 0], radius = 1 }\n";
+
+    /// Errors of a document that does not parse name the key with the
+    /// table it is in, as far as the text shows it: a duplicate key, a bad
+    /// value, nesting past toml's limit (deep inside the value, at the key
+    /// of its line).
+    #[test]
+    fn unparsed_documents_name_the_key_and_its_table() {
+        let two = format!("{CAMERA}{OBJECT}[[object]]\nmaterial = \"m\"\nmaterial = \"m\"\n");
+        let e = error(&two);
+        assert!(
+            e.starts_with("x.toml:12:1: object[1].material: duplicate key"),
+            "{e}"
+        );
+        let deep = format!(
+            "{CAMERA}{OBJECT}[[object]]\nmaterial = \"m\"\ncsg = {}\"a\"{}\n",
+            "{ union = [\"a\", ".repeat(60),
+            "] }".repeat(60)
+        );
+        let e = error(&deep);
+        assert!(e.starts_with("x.toml:12:"), "{e}");
+        assert!(e.contains(": object[1].csg: "), "{e}");
+        // A key inside an inline table keeps its bare name.
+        let e = error(&format!("{CAMERA}[[light]]\nposition = {{ x = }}\n"));
+        assert!(e.starts_with("x.toml:7:"), "{e}");
+        // A table defined twice: the table; a broken header: nothing.
+        let e = error(&format!("{CAMERA}{OBJECT}[material.m]\n"));
+        assert!(
+            e.starts_with("x.toml:10:11: material.m: duplicate key"),
+            "{e}"
+        );
+        let e = error(&format!("{CAMERA}[[object]\n"));
+        assert!(e.starts_with("x.toml:6:10: unclosed array table"), "{e}");
+        let e = error(&CAMERA.replace("angle = 40", "angle = 4 0"));
+        assert!(e.starts_with("x.toml:4:"), "{e}");
+        assert!(e.contains(": camera.angle: "), "{e}");
+    }
 
     /// The error of `text`, read without files.
     fn error(text: &str) -> String {

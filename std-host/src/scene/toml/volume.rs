@@ -73,8 +73,18 @@ impl Builder<'_> {
                     ),
                 ));
             }
-            if !r.spacing.iter().all(|&x| x.is_finite() && x > 0.0) {
-                return Err(self.err(s, &key("raw.spacing"), "expected numbers > 0"));
+            // A grid step below 1e-12 is degenerate (`Grid::validate`), one
+            // above the world's limit cannot be placed.
+            if !r
+                .spacing
+                .iter()
+                .all(|&x| (1e-12..=crate::world::WORLD_LIMIT).contains(&x))
+            {
+                return Err(self.err(
+                    s,
+                    &key("raw.spacing"),
+                    "expected numbers from 1e-12 to 1e60",
+                ));
             }
             let (path, _) = self.path(&r.file, &key("raw.file"))?;
             let spec = RawSpec {
