@@ -570,6 +570,18 @@ fn view_lines_in_order() {
         err("v\nfrom 0 0 5\nat 0 0 0\nup 0 0 0\n"),
         "scene.nff:4:1: view up: zero or parallel to the view direction (at − from): the image has no up"
     );
+    // Directions however short are directions: the camera of each view
+    // is the one of the same view with unit vectors.
+    let view = |from: &str, up: &str| {
+        let src = format!(
+            "v\nfrom {from}\nat 0 0 0\nup {up}\nangle 45\nhither 1\nresolution 8 8\ns 0 0 0 1\n"
+        );
+        let v = parse(&src).unwrap().view;
+        let camera = rrt_host::render::camera::Camera::new(&v, 8, 8).unwrap();
+        [0, 7].map(|p| camera.primary(p, p).dir)
+    };
+    assert_eq!(view("0 0 5", "0 1e-300 0"), view("0 0 5", "0 1 0"));
+    assert_eq!(view("0 0 1e-300", "0 1 0"), view("0 0 1", "0 1 0"));
     for a in ["0", "180", "-10", "400"] {
         assert_eq!(
             err(&format!("v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle {a}\n")),

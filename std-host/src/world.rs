@@ -39,6 +39,34 @@ pub fn within_world(v: DVec3) -> bool {
     v.abs().cmple(DVec3::splat(WORLD_LIMIT)).all()
 }
 
+/// The unit vector along `v`, for every finite non-zero `v`, however
+/// short or long: `v.try_normalize()` where that succeeds (the same bits),
+/// else `v` scaled by its largest coordinate first, so that its squared
+/// length neither underflows nor overflows. `None` for zero or
+/// non-finite vectors.
+///
+/// ```
+/// use glam::DVec3;
+/// use rrt_host::world::unit;
+/// assert_eq!(unit(DVec3::new(0.0, 0.0, 1e-300)), Some(DVec3::Z));
+/// let v = DVec3::new(3.0, 4.0, 0.0);
+/// assert_eq!(unit(v), Some(v.normalize()));
+/// assert!((unit(v * 1e-300).unwrap() - v.normalize()).length() < 1e-15);
+/// assert_eq!(unit(DVec3::ZERO), None);
+/// assert_eq!(unit(DVec3::new(f64::NAN, 1.0, 0.0)), None);
+/// ```
+#[must_use]
+pub fn unit(v: DVec3) -> Option<DVec3> {
+    v.try_normalize().or_else(|| {
+        let m = v.abs().max_element();
+        if m > 0.0 && m.is_finite() {
+            (v / m).try_normalize()
+        } else {
+            None
+        }
+    })
+}
+
 /// An axis-aligned box in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {

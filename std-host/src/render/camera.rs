@@ -101,12 +101,10 @@ impl Camera {
         if !(within_world(from) && (within_world(at) || !at.is_finite())) {
             return Err(CameraError::BeyondWorld);
         }
-        let forward = (at - from)
-            .try_normalize()
-            .ok_or(CameraError::NoDirection)?;
+        let forward = crate::world::unit(at - from).ok_or(CameraError::NoDirection)?;
         // Normalise `up` first, as the parser's check does, so that every
         // view the parser accepts makes a camera.
-        let up_dir = up.try_normalize().ok_or(CameraError::NoUp)?;
+        let up_dir = crate::world::unit(up).ok_or(CameraError::NoUp)?;
         let right = forward
             .cross(up_dir)
             .try_normalize()

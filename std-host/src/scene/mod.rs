@@ -87,11 +87,13 @@ pub(crate) enum ViewDefect {
 impl ViewDefect {
     /// The defect of `from`, `at`, `up`, if any.
     pub(crate) fn of(from: DVec3, at: DVec3, up: DVec3) -> Option<Self> {
-        if at == from {
+        // The camera's own normalization (`world::unit`), so that every
+        // view accepted here makes a camera.
+        let Some(forward) = crate::world::unit(at - from) else {
             return Some(Self::NoDirection);
-        }
-        let forward = (at - from).normalize_or_zero();
-        (forward.cross(up.normalize_or_zero()).length_squared() < 1e-24).then_some(Self::NoUp)
+        };
+        let up = crate::world::unit(up).unwrap_or(DVec3::ZERO);
+        (forward.cross(up).length_squared() < 1e-24).then_some(Self::NoUp)
     }
 
     /// What is wrong, for a message about `at` or `up`.
