@@ -25,6 +25,13 @@ pub const BRICK_LEVEL_BYTES: u64 = 1 + size_of::<u32>() as u64;
 /// `|nx| + |ny| + |nz| ≤ √3` voxels thick.
 pub const SURFACE_VOXELS_PER_AREA: f64 = 1.8;
 
+/// Bytes an object takes in the tables a build makes of it: its fitted
+/// form ([`FittedObject`](super::FittedObject)), the core's object-table
+/// entry and the renderer's world object (its shape and material index).
+pub const OBJECT_BYTES: u64 = (size_of::<super::FittedObject>()
+    + size_of::<rrt_core::object_table::Object>()
+    + size_of::<(crate::shape::Shape, u16)>()) as u64;
+
 /// Voxel counts per axis, printed as `nx×ny×nz`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Dims(pub [u32; 3]);
@@ -75,6 +82,11 @@ pub struct MemoryEstimate {
     pub record_voxels: u64,
     /// Their records: [`RECORD_BYTES`] each.
     pub records: u64,
+    /// Surface primitives of the object table (spheres, cones, polygon
+    /// triangles, tori).
+    pub objects: u64,
+    /// Their entries: [`OBJECT_BYTES`] each.
+    pub object_table: u64,
 }
 
 impl MemoryEstimate {
@@ -85,6 +97,7 @@ impl MemoryEstimate {
             .saturating_add(self.lines)
             .saturating_add(self.directory)
             .saturating_add(self.records)
+            .saturating_add(self.object_table)
     }
 }
 
@@ -92,12 +105,14 @@ impl fmt::Display for MemoryEstimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "plane {}, line level {}, brick directory and level {}, records for up to {} voxels {}",
+            "plane {}, line level {}, brick directory and level {}, records for up to {} voxels {}, object table of {} objects {}",
             Bytes(self.plane),
             Bytes(self.lines),
             Bytes(self.directory),
             self.record_voxels,
-            Bytes(self.records)
+            Bytes(self.records),
+            self.objects,
+            Bytes(self.object_table)
         )
     }
 }
@@ -183,7 +198,8 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
     let [nx, ny, nz] = frame.dims().map(u64::from);
     let voxels = nx.saturating_mul(ny).saturating_mul(nz);
     let s = frame.voxel_size;
-    let mut count = SurfaceMeasure::of(scene).voxels(s);
+    let measure = SurfaceMeasure::of(scene);
+    let mut count = measure.voxels(s);
     if solid_spheres {
         for sp in &scene.spheres {
             let rv = sp.shape.radius / s + 1.0;
@@ -204,5 +220,7 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
             .saturating_mul(BRICK_ENTRY_BYTES + BRICK_LEVEL_BYTES),
         record_voxels,
         records: record_voxels.saturating_mul(RECORD_BYTES),
+        objects: measure.objects as u64,
+        object_table: (measure.objects as u64).saturating_mul(OBJECT_BYTES),
     }
 }

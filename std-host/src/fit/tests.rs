@@ -6,6 +6,7 @@ use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::NORMAL_ONE;
 
 use super::meminfo::FALLBACK_TOTAL_MEMORY;
+use super::memory::OBJECT_BYTES;
 use crate::shape::{Sphere, Triangle};
 use crate::world::Ray;
 
@@ -245,8 +246,10 @@ fn memory_estimate_and_refusal() {
         "at least one layer of the square"
     );
 
-    // 43264 + 676 + 765 + 19240·20 = 429505 bytes = 419.4 KiB.
-    assert_eq!(m.total(), 429_505);
+    // The object table: the two triangles.
+    assert_eq!((m.objects, m.object_table), (2, 2 * OBJECT_BYTES));
+    // 43264 + 676 + 765 + 19240·20 = 429505 bytes, and the objects.
+    assert_eq!(m.total(), 429_505 + 2 * OBJECT_BYTES);
     let e = fit(
         &s,
         &FitOptions {
@@ -257,9 +260,14 @@ fn memory_estimate_and_refusal() {
     .unwrap_err();
     assert_eq!(
         e.to_string(),
-        "raster 104×104×4: needs about 419.4 KiB (plane 42.2 KiB, line level 676 B, brick \
-         directory and level 765 B, records for up to 19240 voxels 375.8 KiB), more than the limit of 256.0 KiB; use a \
-         smaller raster or a larger memory limit"
+        format!(
+            "raster 104×104×4: needs about {} (plane 42.2 KiB, line level 676 B, brick \
+             directory and level 765 B, records for up to 19240 voxels 375.8 KiB, object table \
+             of 2 objects {}), more than the limit of 256.0 KiB; use a smaller raster or a \
+             larger memory limit",
+            Bytes(m.total()),
+            Bytes(2 * OBJECT_BYTES)
+        )
     );
     assert!(
         fit(

@@ -221,7 +221,7 @@ pub enum BuildError {
         what: &'static str,
     },
     /// The exact record count exceeds the memory limit.
-    #[error("raster {dims}: the scene has {records} surface voxels; plane, directory and records need {}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), Bytes(*limit))]
+    #[error("raster {dims}: the scene has {records} surface voxels; plane, directory, records and object table need {}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), Bytes(*limit))]
     TooMuchMemory {
         /// Voxels per axis.
         dims: fit::Dims,
@@ -360,7 +360,9 @@ pub fn build(
                 .saturating_add(c.records.saturating_mul(2 * size_of::<VoxelRecord>()))
                 .saturating_add(c.list_entries.saturating_mul(size_of::<u32>())),
         )
-        .unwrap_or(u64::MAX);
+        .unwrap_or(u64::MAX)
+        // The object table's forms (fitted, the core's, the world's).
+        .saturating_add((n as u64).saturating_mul(fit::memory::OBJECT_BYTES));
         if needed > opts.fit.max_memory {
             return Err(BuildError::TooMuchMemory {
                 dims: fit::Dims(extent.dims()),
