@@ -75,7 +75,11 @@
 //! segment has a surface point on it, and every voxel its surface passes
 //! through lists it. So when every non-transparent voxel of the tube holds
 //! only objects of `O`, nothing but `O` can shadow any point of `v`, and a
-//! renderer needs to intersect only those: `Visible`. Otherwise
+//! renderer needs to intersect only those: `Visible`. A foreign sphere in
+//! the tube does not stand in the way when the segment from `v`'s centre
+//! to `L` passes farther than its radius plus half the cube's diagonal
+//! from its centre (with a margin for the rounding to fixed point): every
+//! segment from a point of the cube to `L` then passes outside it. Otherwise
 //! `Translucent`: a render-time shadow ray decides. The answer does not
 //! depend on the stored normal (the renderer decides which side faces the
 //! light from the true normal), and the walk reads the distance field:
@@ -442,17 +446,7 @@ fn shade_record<const N: usize>(
             })
         };
         let vis = match (exact, params.exact_records) {
-            (true, _)
-                if dark_side(
-                    |id| match objects.get(id)?.shape {
-                        Shape::Sphere(s) => Some(s),
-                        _ => None,
-                    },
-                    own,
-                    v,
-                    light.position,
-                ) =>
-            {
+            (true, _) if dark_side(sphere_of(objects), own, v, light.position) => {
                 report.dark_side = report.dark_side.saturating_add(1);
                 LightVisibility::Translucent
             }
@@ -462,7 +456,7 @@ fn shade_record<const N: usize>(
             }
             (true, _) => {
                 report.rays = report.rays.saturating_add(1);
-                classify(raster, view, v, own, c0, light.position)?
+                classify(raster, view, v, own, sphere_of(objects), light.position)?
             }
             (false, _) => {
                 let (lit_dir, ndl) = n_dot_l();
@@ -552,6 +546,94 @@ fn dark_side(
         && own
             .iter()
             .all(|&id| sphere(id).is_some_and(|s| cube_beyond_terminator(&s, v, light)))
+}
+
+/// The fixed-point sphere of object `id` of `objects`, `None` for every
+/// other shape.
+fn sphere_of<'t>(objects: &'t ObjectTable<'_>) -> impl Fn(u32) -> Option<Sphere> + 't {
+    |id| match objects.get(id)?.shape {
+        Shape::Sphere(s) => Some(s),
+        _ => None,
+    }
+}
+
+/// Half the diagonal of a voxel's cube, rounded up: every point of the
+/// closed cube lies within it of the centre (√3/2 · 2^16 < 56756).
+const HALF_DIAGONAL: i128 = 56_756;
+
+/// What [`sphere_clears`] adds to a sphere's radius for the rounding of
+/// the renderer's exact sphere and light to fixed point (under one unit
+/// per coordinate, and under 2^-11 voxel for a light taken by its
+/// direction) and of the shading point to its voxel: 1/256 voxel.
+const CLEARANCE_MARGIN: i128 = 256;
+
+/// Whether sphere `s` provably meets no segment from a point of voxel
+/// `v`'s closed cube to the light at `light`, with
+/// [`CLEARANCE_MARGIN`] to spare: the segment from `v`'s centre `C` to
+/// `L` stays farther than `R + HALF_DIAGONAL + CLEARANCE_MARGIN` from the
+/// sphere's centre. Such a segment from a cube point `p` is within
+/// `HALF_DIAGONAL` of it everywhere (`p + t(L − p)` is `(1 − t)(p − C)`
+/// from `C + t(L − C)`), so it passes outside the sphere.
+///
+/// Integer arithmetic without overflow: the offsets of the sphere's centre
+/// and the light from `C` are shifted right until every coordinate is
+/// below 2^28; the floors move the centre and the segment by under `2√3`
+/// shifted units, which the required clearance adds (4).
+fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
+    let c = v.map(voxel_centre);
+    let off = |p: [i64; 3]| -> [i128; 3] {
+        core::array::from_fn(|k| i128::from(p[k]).saturating_sub(i128::from(c[k])))
+    };
+    let (w, u) = (off(s.centre), off(light));
+    let big = w
+        .iter()
+        .chain(u.iter())
+        .map(|x| x.unsigned_abs())
+        .max()
+        .unwrap_or(0);
+    // big < 2^65: at most 38 halvings.
+    let mut shift = 0u32;
+    while shift < 127 && (big >> shift) >= 1 << 28 {
+        shift = shift.saturating_add(1);
+    }
+    let w = w.map(|x| x >> shift);
+    let u = u.map(|x| x >> shift);
+    let need = i128::from(s.radius)
+        .saturating_add(HALF_DIAGONAL)
+        .saturating_add(CLEARANCE_MARGIN);
+    // ⌈need / 2^shift⌉ + 4, in shifted units.
+    let step = 1i128 << shift;
+    let need = need.saturating_add(step.saturating_sub(1)) >> shift;
+    let need = need.saturating_add(4);
+    if need >= 1 << 29 {
+        return false;
+    }
+    let dot = |a: [i128; 3], b: [i128; 3]| -> i128 {
+        a.iter().zip(b.iter()).fold(0i128, |acc, (x, y)| {
+            acc.saturating_add(x.saturating_mul(*y))
+        })
+    };
+    let need2 = need.saturating_mul(need);
+    let (uu, wu) = (dot(u, u), dot(w, u));
+    if wu <= 0 {
+        // Nearest the segment's start.
+        return dot(w, w) > need2;
+    }
+    if wu >= uu {
+        // Nearest the light.
+        let d = [0, 1, 2].map(|k| w[k].saturating_sub(u[k]));
+        return dot(d, d) > need2;
+    }
+    // Within: |w × u|² / |u|² is the squared distance to the line.
+    let x = [
+        w[1].saturating_mul(u[2])
+            .saturating_sub(w[2].saturating_mul(u[1])),
+        w[2].saturating_mul(u[0])
+            .saturating_sub(w[0].saturating_mul(u[2])),
+        w[0].saturating_mul(u[1])
+            .saturating_sub(w[1].saturating_mul(u[0])),
+    ];
+    dot(x, x) > need2.saturating_mul(uu)
 }
 
 /// The test of [`dark_side`] for one sphere.
@@ -713,7 +795,8 @@ fn blocks<const N: usize>(
 /// without a walk when the cube lies wholly on the dark side of its
 /// objects, all spheres. `sphere` gives the fixed-point sphere of an
 /// object by id, as the object table holds it, and `None` for every other
-/// object. A renderer that skipped the classification in the pass
+/// object: it decides the dark side, and which foreign spheres in the
+/// tube stand clear of the cube's segments to the light. A renderer that skipped the classification in the pass
 /// ([`ExactRecords::Skip`]) computes it here for the voxels its hits need;
 /// the answer depends on nothing but the raster, the store, the spheres,
 /// `v` and the light, so it may be memoized and computed in any order. The
@@ -741,7 +824,7 @@ pub fn classify_voxel(
         return Err(LightError::ExtentMismatch);
     }
     let own = store.objects(rec);
-    if dark_side(sphere, own, v, light) {
+    if dark_side(&sphere, own, v, light) {
         return Ok(LightVisibility::Translucent);
     }
     if let Some(b) = bricks
@@ -749,24 +832,26 @@ pub fn classify_voxel(
     {
         return Ok(LightVisibility::Visible);
     }
-    classify(raster, store, v, own, v.map(voxel_centre), light)
+    classify(raster, store, v, own, sphere, light)
 }
 
 /// The shadow classification of voxel `v` (centre `c0`, objects `own`)
 /// for a light at `light` (module docs, *Shadow classification*):
 /// [`LightVisibility::Visible`] when every non-transparent voxel within
 /// chessboard distance 1 of the 6-connected segment from `c0` to the
-/// light holds only objects of `own`, else [`LightVisibility::Translucent`]
-/// (undecided: a render-time shadow ray decides). A voxel without a record
-/// undecides too.
+/// light holds only objects of `own` and spheres (`sphere`) that no
+/// segment from the cube to the light meets ([`sphere_clears`]), else
+/// [`LightVisibility::Translucent`] (undecided: a render-time shadow ray
+/// decides). A voxel without a record undecides too.
 fn classify(
     raster: &Raster<'_>,
     view: &RecordStore<'_>,
     v: [u32; 3],
     own: &[u32],
-    c0: [i64; 3],
+    sphere: impl Fn(u32) -> Option<Sphere>,
     light: [i64; 3],
 ) -> Result<LightVisibility, LightError> {
+    let c0 = v.map(voxel_centre);
     let extent = raster.extent();
     let plane = raster.plane();
     // The voxel tested last: when the walk moves to a face neighbour of
@@ -779,11 +864,29 @@ fn classify(
     let signed = strides.map(usize::cast_signed);
     let dims = extent.dims();
     let own_index = extent.index(v);
-    // Whether the opaque voxel `w` (cell `c`) holds an object not in
-    // `own`, or has no record.
+    // The last object found clear of every segment from the cube to the
+    // light ([`sphere_clears`]): neighbouring tube voxels mostly hold it.
+    let cleared = core::cell::Cell::new(None::<u32>);
+    let clear = |o: u32| -> bool {
+        if cleared.get() == Some(o) {
+            return true;
+        }
+        let yes = sphere(o).is_some_and(|s| sphere_clears(&s, v, light));
+        if yes {
+            cleared.set(Some(o));
+        }
+        yes
+    };
+    // Whether the opaque voxel `w` (cell `c`) has no record or holds an
+    // object not in `own` that may meet a segment from the cube to the
+    // light.
     let holds_foreign = |w: [u32; 3], c: u8| -> bool {
-        view.get_hinted(w, c)
-            .is_none_or(|rec| !view.objects(rec).iter().all(|o| own.contains(o)))
+        view.get_hinted(w, c).is_none_or(|rec| {
+            !view
+                .objects(rec)
+                .iter()
+                .all(|&o| own.contains(&o) || clear(o))
+        })
     };
     let mut foreign = |index: usize, _: u8| -> bool {
         let (u, from) = match last.and_then(|(at, p)| face_step(extent, strides, at, p, index)) {

@@ -1064,3 +1064,137 @@ fn adaptive_shadow_rays_on_a_finished_plane_are_six_connected_ones() {
         "{total:?}"
     );
 }
+
+/// Whether the segment from `p` to `l` passes farther than `r` from `c`,
+/// exactly (offsets below 2^38, so every product fits).
+fn passes_outside(p: [i64; 3], l: [i64; 3], c: [i64; 3], r: i64) -> bool {
+    let w: [i128; 3] = core::array::from_fn(|k| i128::from(c[k] - p[k]));
+    let u: [i128; 3] = core::array::from_fn(|k| i128::from(l[k] - p[k]));
+    let dot = |a: [i128; 3], b: [i128; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let r2 = i128::from(r) * i128::from(r);
+    let (uu, wu) = (dot(u, u), dot(w, u));
+    if wu <= 0 {
+        return dot(w, w) > r2;
+    }
+    if wu >= uu {
+        let d = [w[0] - u[0], w[1] - u[1], w[2] - u[2]];
+        return dot(d, d) > r2;
+    }
+    let x = [
+        w[1] * u[2] - w[2] * u[1],
+        w[2] * u[0] - w[0] * u[2],
+        w[0] * u[1] - w[1] * u[0],
+    ];
+    dot(x, x) > r2 * uu
+}
+
+/// [`sphere_clears`] never clears a sphere that a segment from a point of
+/// the cube (corners, centre, random points) to the light meets: random
+/// spheres near the voxel, lights near and up to 2^36 units away (the
+/// offsets then shifted before the products).
+#[test]
+fn a_cleared_sphere_meets_no_segment_from_the_cube() {
+    let mut rng = testkit::Rng(0xc1ea_4a9c);
+    let (mut cleared, mut close) = (0u32, 0u32);
+    for case in 0..20_000 {
+        let v = [0; 3].map(|_| rng.below_u32(64));
+        let centre = [0; 3].map(|_| rng.range(0, 64 * VOXEL));
+        let radius = rng.range(VOXEL / 8, 8 * VOXEL);
+        let light = if case % 2 == 0 {
+            [0; 3].map(|_| rng.range(-64 * VOXEL, 128 * VOXEL))
+        } else {
+            [0; 3].map(|_| rng.range(-(1 << 36), 1 << 36))
+        };
+        let s = Sphere { centre, radius };
+        if !sphere_clears(&s, v, light) {
+            continue;
+        }
+        cleared += 1;
+        let lo = v.map(|k| i64::from(k) * VOXEL);
+        let mut points: Vec<[i64; 3]> = (0..8)
+            .map(|c| core::array::from_fn(|k| lo[k] + ((c >> k) & 1) * VOXEL))
+            .collect();
+        points.push(v.map(voxel_centre));
+        for _ in 0..8 {
+            points.push(core::array::from_fn(|k| lo[k] + rng.range(0, VOXEL + 1)));
+        }
+        for p in points {
+            assert!(
+                passes_outside(p, light, centre, radius),
+                "{s:?} cleared for voxel {v:?} and light {light:?}, but the segment from {p:?} meets it"
+            );
+        }
+        // Within two voxels of the rule's bound: the test is not loose.
+        if !passes_outside(v.map(voxel_centre), light, centre, radius + 3 * VOXEL) {
+            close += 1;
+        }
+    }
+    assert!(
+        cleared > 5_000 && close > 200,
+        "{cleared} cleared, {close} close"
+    );
+}
+
+/// A sphere in the tube of a voxel's segment to the light, but clear of
+/// every segment from the voxel's cube, does not undecide it: the voxels
+/// on top of a ball under a light straight above, beside a small ball
+/// whose voxels reach into their tube, are lit; without the small ball's
+/// geometry they are undecided. Every voxel lit either way has segments
+/// from its cube that pass outside the small ball.
+#[test]
+fn a_clear_sphere_in_the_tube_leaves_the_voxel_lit() {
+    let e = Extent::cube(48).unwrap();
+    let a = Sphere {
+        centre: [20, 24, 24].map(voxel_centre),
+        radius: 9 * VOXEL / 2,
+    };
+    // 2 voxels beside the column x = 20.5 above the ball, radius 0.9: its
+    // voxels x = 21..=23 are within 1 of the column's, its surface 1.1
+    // voxels from it.
+    let b = Sphere {
+        centre: [voxel_centre(22), voxel_centre(40), voxel_centre(24)],
+        radius: 9 * VOXEL / 10,
+    };
+    let light = [voxel_centre(20), 400 * VOXEL, voxel_centre(24)];
+    let va =
+        |s: &mut dyn VoxelSink| testkit::sphere(e, a.centre, a.radius, Separation::TwentySix, s);
+    let vb =
+        |s: &mut dyn VoxelSink| testkit::sphere(e, b.centre, b.radius, Separation::TwentySix, s);
+    let mut scene = testkit::build(e, &[(attrs(0, 0), &va), (attrs(1, 0), &vb)], LIM);
+    crate::proximity::distance_field(
+        &mut crate::raster::RasterMut::new(e, &mut scene.plane).unwrap(),
+    );
+    let raster = Raster::new(e, &scene.plane).unwrap();
+    let store = scene.store();
+    let only_a = |id: u32| (id == 0).then_some(a);
+    let both = |id: u32| match id {
+        0 => Some(a),
+        1 => Some(b),
+        _ => None,
+    };
+    let mut gained = 0;
+    for (v, rec) in store.iter() {
+        if store.objects(rec) != [0] {
+            continue;
+        }
+        let without = classify_voxel(&raster, &store, None, only_a, v, rec, light).unwrap();
+        let with = classify_voxel(&raster, &store, None, both, v, rec, light).unwrap();
+        if without == LightVisibility::Visible {
+            assert_eq!(with, LightVisibility::Visible, "voxel {v:?}");
+        }
+        if with == LightVisibility::Visible {
+            let lo = v.map(|k| i64::from(k) * VOXEL);
+            for c in 0..8 {
+                let p = core::array::from_fn(|k| lo[k] + ((c >> k) & 1) * VOXEL);
+                assert!(passes_outside(p, light, b.centre, b.radius), "voxel {v:?}");
+            }
+            if without != LightVisibility::Visible {
+                gained += 1;
+            }
+        }
+    }
+    assert!(
+        gained > 0,
+        "no voxel lit thanks to the small ball's geometry"
+    );
+}
