@@ -225,8 +225,8 @@ fn built_planes_are_their_records_planes() {
                 .unwrap_or_else(|e| panic!("{}: {e}", scene.file))
                 .0;
             let [_, _, nz] = vs.extent().dims();
-            let (derived, z0) =
-                derive_plane(vs.extent(), &vs.directory, &vs.records, &vs.lists, [0, nz]).unwrap();
+            let store = vs.store().unwrap();
+            let (derived, z0) = derive_plane(&store, [0, nz]).unwrap();
             assert_eq!(z0, 0);
             assert!(
                 derived[..] == vs.plane[..],
@@ -235,13 +235,7 @@ fn built_planes_are_their_records_planes() {
                 vs.exact
             );
             // What saving a built raster checks instead.
-            assert!(plane_matches_records(
-                vs.extent(),
-                &vs.plane,
-                &vs.directory,
-                &vs.records,
-                &vs.lists
-            ));
+            assert!(plane_matches_records(&vs.plane, &store));
             compared += 1;
         }
     }

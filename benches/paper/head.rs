@@ -167,7 +167,9 @@ pub fn build(
     records = lit;
     let lights_time = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let lines = finish_plane(extent, &mut plane, &directory, &records, &[]);
+    let store = rrt_core::store::RecordStore::new(extent, &directory, &records)
+        .map_err(|e| e.to_string())?;
+    let lines = finish_plane(&mut plane, &store);
     voxelize += t2.elapsed().as_secs_f64();
 
     let view = View {

@@ -611,7 +611,10 @@ const SAVE_SLAB_BYTES: usize = 256 << 20;
 /// from its records ([`derive_plane`]), in brick order: none for a raster
 /// as the builder makes it. Made slab by slab, so that the extra memory
 /// is about [`SAVE_SLAB_BYTES`] plus the margins.
-fn differing_bricks(scene: &VoxelScene) -> std::io::Result<Vec<PlaneBrick>> {
+fn differing_bricks(
+    scene: &VoxelScene,
+    store: &RecordStore<'_>,
+) -> std::io::Result<Vec<PlaneBrick>> {
     let extent = scene.extent();
     let [nx, ny, nz] = extent.dims();
     let [bx, by, _] = brick_dims(extent);
@@ -621,13 +624,7 @@ fn differing_bricks(scene: &VoxelScene) -> std::io::Result<Vec<PlaneBrick>> {
     let mut z0 = 0;
     while z0 < nz {
         let z1 = z0.saturating_add(slab).min(nz);
-        let (derived, d0) = derive_plane(
-            extent,
-            &scene.directory,
-            &scene.records,
-            &scene.lists,
-            [z0, z1],
-        )?;
+        let (derived, d0) = derive_plane(store, [z0, z1])?;
         let rows: Vec<(u32, u32)> = (z0 / BRICK..z1.div_ceil(BRICK))
             .flat_map(|bz| (0..by).map(move |byi| (bz, byi)))
             .collect();
@@ -850,18 +847,12 @@ fn sparse_sections(
     plane: Trust,
 ) -> std::io::Result<Vec<(u32, Vec<u8>)>> {
     let codec = if compress { CODEC_BLOCKS } else { CODEC_RAW };
-    let built = plane == Trust::Built
-        && plane_matches_records(
-            scene.extent(),
-            &scene.plane,
-            &scene.directory,
-            &scene.records,
-            &scene.lists,
-        );
+    let store = scene.store().map_err(std::io::Error::other)?;
+    let built = plane == Trust::Built && plane_matches_records(&scene.plane, &store);
     let bricks = if built {
         Vec::new()
     } else {
-        differing_bricks(scene)?
+        differing_bricks(scene, &store)?
     };
     Ok(vec![
         (CODEC_RAW, meta_bytes(scene, 3)),
@@ -1783,6 +1774,10 @@ fn load_from(
     expect(5, u64::from(m.materials) * MATERIAL_LEN)?;
     expect(6, u64::from(m.lights) * LIGHT_LEN)?;
     let raw = |k: usize| section(bytes, path, &h, k, progress, |_, _| {});
+    let materials = materials_from(raw(5)?).map_err(|e| h.invalid_in(path, 5, &e))?;
+    let objects = objects_from(raw(4)?, materials.len()).map_err(|e| h.invalid_in(path, 4, &e))?;
+    let lights = lights_from(raw(6)?).map_err(|e| h.invalid_in(path, 6, &e))?;
+    let tables = (objects.len(), materials.len());
     let Raster {
         plane,
         directory,
@@ -1790,7 +1785,7 @@ fn load_from(
         lists,
         derived,
     } = if h.version == 3 {
-        load_sparse(bytes, path, &h, &m, extent, progress, max_memory)?
+        load_sparse(bytes, path, &h, &m, extent, tables, progress, max_memory)?
     } else {
         // Every length below is checked against the section table, whose
         // sections all lie inside the file.
@@ -1825,7 +1820,7 @@ fn load_from(
             plane[at..at + piece.len()].copy_from_slice(piece);
         })?;
         let words = |b: &[u8]| b.chunks_exact(4).map(u32_from).collect::<Vec<u32>>();
-        Raster {
+        let raster = Raster {
             plane,
             directory: words(raw(2)?),
             records: raw(3)?
@@ -1834,29 +1829,13 @@ fn load_from(
                 .collect(),
             lists: words(raw(7)?),
             derived: false,
-        }
+        };
+        let store =
+            RecordStore::with_lists(extent, &raster.directory, &raster.records, &raster.lists)
+                .map_err(|e| h.invalid_in(path, store_section(e), &e.to_string()))?;
+        in_tables(&store, tables).map_err(|e| h.invalid_in(path, 3, &e))?;
+        raster
     };
-    let materials = materials_from(raw(5)?).map_err(|e| h.invalid_in(path, 5, &e))?;
-    let objects = objects_from(raw(4)?, materials.len()).map_err(|e| h.invalid_in(path, 4, &e))?;
-    let lights = lights_from(raw(6)?).map_err(|e| h.invalid_in(path, 6, &e))?;
-    let store = RecordStore::with_lists(extent, &directory, &records, &lists)
-        .map_err(|e| h.invalid_in(path, store_section(e), &e.to_string()))?;
-    for (i, r) in records.iter().enumerate() {
-        let ids = store.objects(r);
-        if ids.iter().any(|&o| o as usize >= objects.len())
-            || usize::from(r.material) >= materials.len()
-        {
-            return Err(h.invalid_in(
-                path,
-                3,
-                &format!(
-                    "record {i} names object {} and material {}, beyond the tables",
-                    ids.iter().max().copied().unwrap_or(u32::MAX),
-                    r.material
-                ),
-            ));
-        }
-    }
     Ok(VoxelScene {
         frame: RasterFrame {
             extent,
@@ -1886,6 +1865,23 @@ fn load_from(
     })
 }
 
+/// Whether every record of `store` names objects and a material within
+/// tables of `(objects, materials)` entries; the first that does not, in
+/// words.
+fn in_tables(store: &RecordStore<'_>, (objects, materials): (usize, usize)) -> Result<(), String> {
+    for (i, r) in store.records().iter().enumerate() {
+        let ids = store.objects(r);
+        if ids.iter().any(|&o| o as usize >= objects) || usize::from(r.material) >= materials {
+            return Err(format!(
+                "record {i} names object {} and material {}, beyond the tables",
+                ids.iter().max().copied().unwrap_or(u32::MAX),
+                r.material
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The section (its index in the table) holding what `e` finds wrong:
 /// the brick directory, the records or the object lists.
 fn store_section(e: StoreError) -> usize {
@@ -1900,15 +1896,18 @@ fn store_section(e: StoreError) -> usize {
     }
 }
 
-/// The raster of a version 3 file: its entries decoded, the plane made
-/// from the records ([`derive_plane`]) and its stored bricks written over
-/// it.
+/// The raster of a version 3 file: its entries decoded and validated (a
+/// store whose records name objects and materials within `tables`), the
+/// plane made from the records ([`derive_plane`]) and its stored bricks
+/// written over it.
+#[allow(clippy::too_many_arguments)] // the file's parts, read once
 fn load_sparse(
     bytes: &[u8],
     path: &Path,
     h: &Header,
     m: &Meta,
     extent: Extent,
+    tables: (usize, usize),
     progress: &ProgressBar,
     max_memory: u64,
 ) -> Result<Raster, RasterFileError> {
@@ -1991,17 +1990,15 @@ fn load_sparse(
         },
     )
     .map_err(|e| invalid(1, e))?;
-    RecordStore::with_lists(extent, &directory, &records, &lists)
+    let store = RecordStore::with_lists(extent, &directory, &records, &lists)
         .map_err(|e| invalid(store_section(e), e.to_string()))?;
+    in_tables(&store, tables).map_err(|e| invalid(3, e))?;
     let nz = extent.dims()[2];
-    let (mut plane, _) =
-        derive_plane(extent, &directory, &records, &lists, [0, nz]).map_err(|source| {
-            RasterFileError::Io {
-                path: path.to_path_buf(),
-                what: "cannot make the raster plane",
-                source,
-            }
-        })?;
+    let (mut plane, _) = derive_plane(&store, [0, nz]).map_err(|source| RasterFileError::Io {
+        path: path.to_path_buf(),
+        what: "cannot make the raster plane",
+        source,
+    })?;
     let [bx, by, _] = brick_dims(extent).map(u64::from);
     let mut prev = None;
     for (i, b) in bricks.iter().enumerate() {
@@ -2190,7 +2187,11 @@ mod tests {
     #[test]
     fn a_built_raster_stores_no_plane_brick() {
         let s = built(BuildOptions::new(64));
-        assert!(differing_bricks(&s).unwrap().is_empty());
+        assert!(
+            differing_bricks(&s, &s.store().unwrap())
+                .unwrap()
+                .is_empty()
+        );
         let sparse = save_bytes(&s, Path::new("t.rrt")).unwrap();
         let dense = save_bytes_as(&s, Path::new("t.rrt"), Format::Dense).unwrap();
         assert!(
@@ -2269,7 +2270,7 @@ mod tests {
         let mid = e.index([nx / 3, ny / 2, nz / 2]).unwrap();
         s.plane[far] ^= 0x04;
         s.plane[mid] ^= 0x08;
-        let bricks = differing_bricks(&s).unwrap();
+        let bricks = differing_bricks(&s, &s.store().unwrap()).unwrap();
         assert_eq!(bricks.len(), 2);
         for format in [Format::default(), Format::Sparse { compress: false }] {
             let bytes = save_bytes_as(&s, Path::new("t.rrt"), format).unwrap();
@@ -2298,9 +2299,7 @@ mod tests {
             out.into_inner()
         };
         let s = built(BuildOptions::new(37));
-        let matches = |s: &VoxelScene| {
-            plane_matches_records(s.extent(), &s.plane, &s.directory, &s.records, &s.lists)
-        };
+        let matches = |s: &VoxelScene| plane_matches_records(&s.plane, &s.store().unwrap());
         assert!(matches(&s));
         assert_eq!(bytes(&s, Trust::Built), bytes(&s, Trust::Any));
         let opaque: Vec<usize> = (0..s.plane.len())

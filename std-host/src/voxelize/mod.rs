@@ -383,7 +383,9 @@ pub fn build(
     // The light pass changes no cell and no record's place: the plane can
     // be finished first, so that its walks read the distance field and
     // the rank hints.
-    let lines = pool.install(|| finish_plane(extent, &mut plane, &directory, &records, &lists));
+    let store = rrt_core::store::RecordStore::with_lists(extent, &directory, &records, &lists)
+        .map_err(|e| BuildError::Raster(e.to_string()))?;
+    let lines = pool.install(|| finish_plane(&mut plane, &store));
     let voxelize = t0.elapsed();
 
     let t1 = Instant::now();
@@ -398,8 +400,6 @@ pub fn build(
     crate::progress::phase(progress, "light visibility", Unit::Voxels, records_n as u64);
     let raster = rrt_core::raster::Raster::new(extent, &plane)
         .and_then(|r| r.with_lines(&lines))
-        .map_err(|e| BuildError::Raster(e.to_string()))?;
-    let store = rrt_core::store::RecordStore::with_lists(extent, &directory, &records, &lists)
         .map_err(|e| BuildError::Raster(e.to_string()))?;
     // The brick level serves the shadow classification only.
     let level = match light.exact_records {

@@ -12,8 +12,8 @@ use rayon::prelude::*;
 use rrt_core::light::ExactRecords;
 use rrt_core::proximity::field::{self, Area};
 use rrt_core::proximity::{coarse_bounds, coarse_extent, coarse_level, line_stand_ins};
-use rrt_core::raster::{Extent, Raster, RasterMut, cell, line_count};
-use rrt_core::store::{BRICK, RecordStore, StoreError, brick_dims, rank_hint, write_rank_hints};
+use rrt_core::raster::{Extent, Raster, cell, line_count};
+use rrt_core::store::{BRICK, RecordStore, StoreError, brick_dims, rank_hint};
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
@@ -227,33 +227,29 @@ impl std::fmt::Write for CrcText {
     }
 }
 
-/// The last pass over a voxelized plane, once its records are final: the
-/// proximity distance field (empty-space skipping for 26-runs; it sets the
-/// same PROXIMITY flags the builder set), the records' rank hints in their
-/// opaque cells (which the field clears), and the line level, returned.
-/// On the current rayon pool; the bytes are those of
+/// The last pass over a voxelized plane, once its records (`store`) are
+/// final: the proximity distance field (empty-space skipping for 26-runs;
+/// it sets the same PROXIMITY flags the builder set), the records' rank
+/// hints in their opaque cells (which the field clears; as
+/// [`write_rank_hints`](rrt_core::store::write_rank_hints)), and the line
+/// level, returned. On the current rayon pool; the bytes are those of
 /// [`distance_field`](rrt_core::proximity::distance_field) and
-/// [`write_rank_hints`] whatever the number of threads. A plane,
-/// directory, record or list array that does not match `extent` is left
-/// as it is, with no line level.
-pub fn finish_plane(
-    extent: Extent,
-    plane: &mut [u8],
-    directory: &[u32],
-    records: &[VoxelRecord],
-    lists: &[u32],
-) -> Vec<u8> {
+/// `write_rank_hints` whatever the number of threads. A plane that does
+/// not match the store's extent is left as it is, with no line level.
+pub fn finish_plane(plane: &mut [u8], store: &RecordStore<'_>) -> Vec<u8> {
+    let extent = store.extent();
     if plane.len() != extent.len() {
         return Vec::new();
     }
-    let rows = BrickRows::of(extent, directory, 0);
+    let rows = BrickRows::of(extent, store.directory(), 0);
     distance_field(extent, plane, rows.as_ref());
-    if let Ok(mut raster) = RasterMut::new(extent, plane)
-        && let Ok(store) = RecordStore::with_lists(extent, directory, records, lists)
-    {
-        write_rank_hints(&mut raster, &store);
-    }
-    line_level(extent, plane, directory)
+    let [_, _, nz] = extent.dims();
+    for_record_cells(store, plane, 0, [0, nz], |c, hint| {
+        if *c & cell::OPAQUE != 0 {
+            *c = (*c & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
+        }
+    });
+    line_level(extent, plane, store.directory())
 }
 
 /// Slices around a run of slices whose opaque voxels decide the run's
@@ -264,122 +260,127 @@ pub fn finish_plane(
 pub const DERIVE_MARGIN: u32 = 16;
 
 /// The finished plane ([`finish_plane`]) of the raster whose opaque voxels
-/// are exactly the records' (`directory`, `records` and `lists` a valid
-/// store over `extent`), computed for the slices `slices[0]..slices[1]`
-/// with [`DERIVE_MARGIN`] slices on either side (clipped to the raster):
-/// the cells of slices `z0..z1` of the raster in a plane of `nx·ny·(z1 −
-/// z0)` cells, with `z0` (a multiple of the brick edge). Its slices
-/// `slices[0]..slices[1]` are byte for byte the whole raster's finished
-/// cells; with `slices = [0, nz]` the plane is the whole raster's:
-/// distance field, PROXIMITY flags, OPAQUE cells with their records' rank
-/// hints ([`write_rank_hints`]). A saved raster's plane is made on load so
-/// (the builder's plane is exactly this for the records it made). On the
-/// current rayon pool.
+/// are exactly the records of `store`, computed for the slices
+/// `slices[0]..slices[1]` with [`DERIVE_MARGIN`] slices on either side
+/// (clipped to the raster): the cells of slices `z0..z1` of the raster in a
+/// plane of `nx·ny·(z1 − z0)` cells, with `z0` (a multiple of the brick
+/// edge). Its slices `slices[0]..slices[1]` are byte for byte the whole
+/// raster's finished cells; with `slices = [0, nz]` the plane is the whole
+/// raster's: distance field, PROXIMITY flags, OPAQUE cells with their
+/// records' rank hints
+/// ([`write_rank_hints`](rrt_core::store::write_rank_hints)). A saved raster's plane is
+/// made on load so (the builder's plane is exactly this for the records
+/// it made). On the current rayon pool.
 ///
 /// # Errors
-/// The system's refusal of the plane's memory, or a store that breaks an
-/// invariant.
-pub fn derive_plane(
-    extent: Extent,
-    directory: &[u32],
-    records: &[VoxelRecord],
-    lists: &[u32],
-    slices: [u32; 2],
-) -> std::io::Result<(Plane, u32)> {
-    RecordStore::with_lists(extent, directory, records, lists).map_err(std::io::Error::other)?;
+/// The system's refusal of the plane's memory.
+pub fn derive_plane(store: &RecordStore<'_>, slices: [u32; 2]) -> std::io::Result<(Plane, u32)> {
+    let extent = store.extent();
     let [nx, ny, nz] = extent.dims();
     let z0 = slices[0].min(nz).saturating_sub(DERIVE_MARGIN) & !(BRICK - 1);
     let z1 = slices[1].saturating_add(DERIVE_MARGIN).min(nz).max(z0 + 1);
     let sub = Extent::new(nx, ny, z1 - z0).map_err(std::io::Error::other)?;
     let mut plane = Plane::zeroed(sub.len())?;
-    let cells = || record_cells(extent, directory, records, [z0, z1]);
-    // Indices in the sub-plane: the slices from z0 on.
-    let offset = nx as usize * ny as usize * z0 as usize;
-    for (i, _) in cells() {
-        plane[i - offset] = cell::OPAQUE;
-    }
-    let rows = BrickRows::of(extent, directory, z0);
+    for_record_cells(store, &mut plane, z0, [z0, z1], |c, _| *c = cell::OPAQUE);
+    let rows = BrickRows::of(extent, store.directory(), z0);
     distance_field(sub, &mut plane, rows.as_ref());
-    for (i, hint) in cells() {
-        let i = i - offset;
-        plane[i] = (plane[i] & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
-    }
+    for_record_cells(store, &mut plane, z0, [z0, z1], |c, hint| {
+        *c = (*c & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
+    });
     Ok((plane, z0))
 }
 
-/// The voxels of the records in the brick layers of slices
-/// `slices[0]..slices[1]` (`slices[0]` a multiple of the brick edge), in
-/// storage order, each as its index in the whole raster's plane with its
-/// record's rank hint; records whose position lies outside the extent or
-/// the slices are left out (a valid store has none of the former).
-fn record_cells<'a>(
-    extent: Extent,
-    directory: &'a [u32],
-    records: &'a [VoxelRecord],
-    slices: [u32; 2],
-) -> impl Iterator<Item = (usize, u8)> + 'a {
+/// The records of `store` in brick layer `bz` whose voxels lie in slices
+/// `slices[0]..slices[1]`, in storage order: `f(i, hint)` with `i` the
+/// voxel's index among the layer's cells (x fastest, from the layer's
+/// first slice) and its record's rank hint.
+fn layer_cells(store: &RecordStore<'_>, bz: usize, slices: [u32; 2], mut f: impl FnMut(usize, u8)) {
+    let extent = store.extent();
+    let [nx, ny, _] = extent.dims().map(|n| n as usize);
     let [bx, by, _] = brick_dims(extent).map(|b| b as usize);
-    let dir_at = move |b: usize| directory.get(b).map_or(records.len(), |&d| d as usize);
-    let first_brick = (slices[0] / BRICK) as usize * bx * by;
-    let end_brick =
-        (slices[1].div_ceil(BRICK) as usize * bx * by).min(directory.len().saturating_sub(1));
-    (first_brick..end_brick)
-        .filter(move |&b| dir_at(b) < dir_at(b + 1))
-        .flat_map(move |b| {
-            let (lo, hi) = (dir_at(b), dir_at(b + 1));
-            let origin = [b % bx, (b / bx) % by, b / (bx * by)].map(|c| c as u32 * BRICK);
-            let len = hi.saturating_sub(lo);
-            records
-                .get(lo..hi)
-                .unwrap_or(&[])
-                .iter()
-                .enumerate()
-                .filter_map(move |(j, r)| {
-                    let p = u32::from(r.position());
-                    let v = [p & 7, (p >> 3) & 7, p >> 6];
-                    let v = [0, 1, 2].map(|a| origin[a] + v[a]);
-                    if v[2] < slices[0] || v[2] >= slices[1] {
-                        return None;
-                    }
-                    Some((extent.index(v)?, rank_hint(j, len)))
-                })
-        })
+    let (directory, records) = (store.directory(), store.records());
+    let first = bz * bx * by;
+    for b in first..first + bx * by {
+        let (Some(&lo), Some(&hi)) = (directory.get(b), directory.get(b + 1)) else {
+            return;
+        };
+        let Some(bricks) = records.get(lo as usize..hi as usize) else {
+            continue;
+        };
+        let origin = [(b % bx) * BRICK as usize, (b / bx % by) * BRICK as usize];
+        for (j, r) in bricks.iter().enumerate() {
+            let p = usize::from(r.position());
+            let (x, y, dz) = (origin[0] + (p & 7), origin[1] + ((p >> 3) & 7), p >> 6);
+            let z = bz * BRICK as usize + dz;
+            // A valid store's voxels lie in the raster.
+            if z < slices[0] as usize || z >= slices[1] as usize || x >= nx || y >= ny {
+                continue;
+            }
+            f((dz * ny + y) * nx + x, rank_hint(j, bricks.len()));
+        }
+    }
+}
+
+/// Calls `f(cell, hint)` on the cell of every record of `store` in slices
+/// `slices[0]..slices[1]`, with its rank hint; `plane` holds the cells of
+/// the raster's slices from `z0` (a multiple of the brick edge, at most
+/// `slices[0]`) on. Brick layers on the current rayon pool: each writes
+/// only its own slices.
+fn for_record_cells(
+    store: &RecordStore<'_>,
+    plane: &mut [u8],
+    z0: u32,
+    slices: [u32; 2],
+    f: impl Fn(&mut u8, u8) + Sync,
+) {
+    let [nx, ny, _] = store.extent().dims().map(|n| n as usize);
+    let layer = nx * ny * BRICK as usize;
+    let bz0 = (z0 / BRICK) as usize;
+    plane
+        .par_chunks_mut(layer)
+        .enumerate()
+        .for_each(|(l, cells)| {
+            layer_cells(store, bz0 + l, slices, |i, hint| {
+                if let Some(c) = cells.get_mut(i) {
+                    f(c, hint);
+                }
+            });
+        });
 }
 
 /// Whether `plane` is the plane [`derive_plane`] makes from the records
-/// (`directory`, `records`, `lists` a valid store over `extent`), given
-/// that its transparent cells are the distance field
+/// of `store`, given that its transparent cells are the distance field
 /// ([`finish_plane`]) of its opaque ones, as the builder leaves a plane:
 /// then it is exactly when the opaque cells are the records' voxels, each
 /// with its rank hint. One pass over the records and one over the plane,
 /// on the current rayon pool, instead of making the plane again.
 #[must_use]
-pub fn plane_matches_records(
-    extent: Extent,
-    plane: &[u8],
-    directory: &[u32],
-    records: &[VoxelRecord],
-    lists: &[u32],
-) -> bool {
-    if plane.len() != extent.len()
-        || RecordStore::with_lists(extent, directory, records, lists).is_err()
-    {
+pub fn plane_matches_records(plane: &[u8], store: &RecordStore<'_>) -> bool {
+    let extent = store.extent();
+    if plane.len() != extent.len() {
         return false;
     }
     let finished = cell::OPAQUE | cell::PROXIMITY;
-    let [_, _, nz] = extent.dims();
-    let mut count = 0usize;
-    for (i, hint) in record_cells(extent, directory, records, [0, nz]) {
-        if plane.get(i) != Some(&(finished | (hint << cell::DISTANCE_SHIFT))) {
-            return false;
-        }
-        count += 1;
-    }
-    let opaque: usize = plane
-        .par_chunks(1 << 20)
-        .map(|c| c.iter().filter(|&&b| b & cell::OPAQUE != 0).count())
-        .sum();
-    count == records.len() && opaque == count
+    let [nx, ny, nz] = extent.dims().map(|n| n as usize);
+    // Per brick layer: whether every record's cell is opaque with its
+    // hint, with the count of records and of opaque cells.
+    let layers: Vec<(bool, usize, usize)> = plane
+        .par_chunks(nx * ny * BRICK as usize)
+        .enumerate()
+        .map(|(bz, cells)| {
+            let (mut ok, mut count) = (true, 0usize);
+            layer_cells(store, bz, [0, nz as u32], |i, hint| {
+                ok &= cells.get(i) == Some(&(finished | (hint << cell::DISTANCE_SHIFT)));
+                count += 1;
+            });
+            let opaque = cells.iter().filter(|&&b| b & cell::OPAQUE != 0).count();
+            (ok, count, opaque)
+        })
+        .collect();
+    let ok = layers.iter().all(|l| l.0);
+    let count: usize = layers.iter().map(|l| l.1).sum();
+    let opaque: usize = layers.iter().map(|l| l.2).sum();
+    ok && count == store.len() && opaque == count
 }
 
 /// Boxes of fewer cells than this are relaxed on one thread.
