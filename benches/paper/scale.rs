@@ -259,11 +259,12 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
             "What bounds these figures: the plane is one byte per voxel of the raster's box \
              in address space ({} GiB at raster {}), but only its pages within 16 voxels of a \
              surface are ever written (the distance field leaves farther cells empty; skipping \
-             there reads the line level and the coarse level over 8³ bricks). The plane asks \
-             the kernel for 2 MiB pages, so a written cell brings its whole 2 MiB page in: that \
+             there reads the line level and the coarse level over 8³ bricks). A plane of up to \
+             256 MiB asks the kernel for 2 MiB pages, a larger one for 4 KiB pages (a row or \
+             two of the raster each), so that a written cell brings in only its own rows: that \
              resident part of the plane is still most of the peak memory, and the kernel's \
              zeroing of those pages the largest part of the load time, before the line level \
-             (profiled at 4096). The light visibility phase walks the tube of every surface \
+             (profiled at 4096; it varies between runs with the kernel's state). The light visibility phase walks the tube of every surface \
              voxel towards every light: the surface voxels grow with the square of the raster's \
              side and the walks with the side. The render takes more steps per ray as the \
              voxels shrink (jumps through empty space are bounded by the line level's 63 \

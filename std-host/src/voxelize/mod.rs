@@ -6,7 +6,8 @@
 //! their number:
 //! 1. **fit** ([`crate::fit`]): the raster's frame, the memory estimate
 //!    against the limit, every primitive and light in fixed point;
-//! 2. **allocate** the plane ([`Plane`]: an anonymous map with huge pages);
+//! 2. **allocate** the plane ([`Plane`]: an anonymous map, with huge pages
+//!    when it is small);
 //! 3. **count pass** ([`slabs`]: the raster cut into z-slabs, each built on
 //!    its own by the core's builder and joined): every object of the
 //!    object table ([`objects::in_id_order`]) through its voxelizer into

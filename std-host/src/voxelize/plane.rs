@@ -1,15 +1,23 @@
-//! Memory for the raster plane: an anonymous memory map asking the kernel
-//! for transparent huge pages.
+//! Memory for the raster plane: an anonymous memory map, with transparent
+//! huge pages up to [`HUGE_PAGES_UP_TO`] bytes and normal pages beyond.
 //!
-//! The plane is one byte per voxel (a 2048³ raster is 8 GiB) and discrete
-//! rays read it in long strides, so TLB misses dominate a cold walk; 2 MiB
-//! pages cut them. The pages come zeroed and are only backed by memory
-//! when touched. `madvise` is a hint: where huge pages are unavailable the
-//! map works with normal pages.
+//! The plane is one byte per voxel (a 2048³ raster is 8 GiB). Its pages
+//! come zeroed and are only backed by memory when touched, and only the
+//! rows within the distance field's reach of a surface are ever touched.
+//! Discrete rays read the plane in long strides, so TLB misses dominate a
+//! cold walk, and 2 MiB pages cut them; but a 2 MiB page spans whole
+//! slices of a large raster, so one surface voxel brings it all in. A
+//! small plane is mostly touched anyway and gets huge pages; a large one
+//! gets 4 KiB pages (one or a few rows each), so that its memory follows
+//! the surfaces. `madvise` is a hint: where it is refused the map works
+//! with the kernel's default pages.
 
 use std::ops::{Deref, DerefMut};
 
 use memmap2::{Advice, MmapMut, MmapOptions};
+
+/// The largest plane, in bytes, that asks for transparent huge pages.
+pub const HUGE_PAGES_UP_TO: usize = 256 << 20;
 
 /// A zero-initialised byte buffer in an anonymous memory map.
 #[derive(Debug)]
@@ -24,8 +32,13 @@ impl Plane {
     /// The system's refusal to map that much memory.
     pub fn zeroed(len: usize) -> std::io::Result<Self> {
         let map = MmapOptions::new().len(len.max(1)).map_anon()?;
-        // A hint only: keep going with normal pages where it is refused.
-        let _ = map.advise(Advice::HugePage);
+        // A hint only: keep going with the default pages where it is
+        // refused.
+        let _ = map.advise(if len <= HUGE_PAGES_UP_TO {
+            Advice::HugePage
+        } else {
+            Advice::NoHugePage
+        });
         Ok(Self { map })
     }
 
