@@ -567,8 +567,8 @@ const HALF_DIAGONAL: i128 = 56_756;
 /// direction) and of the shading point to its voxel: 1/256 voxel.
 const CLEARANCE_MARGIN: i128 = 256;
 
-/// Whether sphere `s` provably meets no segment from a point of voxel
-/// `v`'s closed cube to the light at `light`, with
+/// Whether sphere `s` (of positive radius) provably meets no segment from
+/// a point of voxel `v`'s closed cube to the light at `light`, with
 /// [`CLEARANCE_MARGIN`] to spare: the segment from `v`'s centre `C` to
 /// `L` stays farther than `R + HALF_DIAGONAL + CLEARANCE_MARGIN` from the
 /// sphere's centre. Such a segment from a cube point `p` is within
@@ -580,6 +580,10 @@ const CLEARANCE_MARGIN: i128 = 256;
 /// below 2^28; the floors move the centre and the segment by under `2√3`
 /// shifted units, which the required clearance adds (4).
 fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
+    // A table that holds no valid sphere proves nothing.
+    if s.radius <= 0 {
+        return false;
+    }
     let c = v.map(voxel_centre);
     let off = |p: [i64; 3]| -> [i128; 3] {
         core::array::from_fn(|k| i128::from(p[k]).saturating_sub(i128::from(c[k])))
