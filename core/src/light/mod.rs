@@ -595,7 +595,7 @@ fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
         .map(|x| x.unsigned_abs())
         .max()
         .unwrap_or(0);
-    // big < 2^65: at most 38 halvings.
+    // big < 2^64: at most 36 halvings.
     let mut shift = 0u32;
     while shift < 127 && (big >> shift) >= 1 << 28 {
         shift = shift.saturating_add(1);
@@ -800,8 +800,9 @@ fn blocks<const N: usize>(
 /// objects, all spheres. `sphere` gives the fixed-point sphere of an
 /// object by id, as the object table holds it, and `None` for every other
 /// object: it decides the dark side, and which foreign spheres in the
-/// tube stand clear of the cube's segments to the light. A renderer that skipped the classification in the pass
-/// ([`ExactRecords::Skip`]) computes it here for the voxels its hits need;
+/// tube stand clear of the cube's segments to the light. A renderer that
+/// skipped the classification in the pass ([`ExactRecords::Skip`])
+/// computes it here for the voxels its hits need;
 /// the answer depends on nothing but the raster, the store, the spheres,
 /// `v` and the light, so it may be memoized and computed in any order. The
 /// caller checks that the objects are exact. The raster's brick level
@@ -839,11 +840,11 @@ pub fn classify_voxel(
     classify(raster, store, v, own, sphere, light)
 }
 
-/// The shadow classification of voxel `v` (centre `c0`, objects `own`)
-/// for a light at `light` (module docs, *Shadow classification*):
+/// The shadow classification of voxel `v` (objects `own`) for a light at
+/// `light` (module docs, *Shadow classification*):
 /// [`LightVisibility::Visible`] when every non-transparent voxel within
-/// chessboard distance 1 of the 6-connected segment from `c0` to the
-/// light holds only objects of `own` and spheres (`sphere`) that no
+/// chessboard distance 1 of the 6-connected segment from `v`'s centre to
+/// the light holds only objects of `own` and spheres (`sphere`) that no
 /// segment from the cube to the light meets ([`sphere_clears`]), else
 /// [`LightVisibility::Translucent`] (undecided: a render-time shadow ray
 /// decides). A voxel without a record undecides too.
