@@ -304,11 +304,11 @@ fn layer_cells(store: &RecordStore<'_>, bz: usize, slices: [u32; 2], mut f: impl
         let (Some(&lo), Some(&hi)) = (directory.get(b), directory.get(b + 1)) else {
             return;
         };
-        let Some(bricks) = records.get(lo as usize..hi as usize) else {
+        let Some(brick) = records.get(lo as usize..hi as usize) else {
             continue;
         };
         let origin = [(b % bx) * BRICK as usize, (b / bx % by) * BRICK as usize];
-        for (j, r) in bricks.iter().enumerate() {
+        for (j, r) in brick.iter().enumerate() {
             let p = usize::from(r.position());
             let (x, y, dz) = (origin[0] + (p & 7), origin[1] + ((p >> 3) & 7), p >> 6);
             let z = bz * BRICK as usize + dz;
@@ -316,7 +316,7 @@ fn layer_cells(store: &RecordStore<'_>, bz: usize, slices: [u32; 2], mut f: impl
             if z < slices[0] as usize || z >= slices[1] as usize || x >= nx || y >= ny {
                 continue;
             }
-            f((dz * ny + y) * nx + x, rank_hint(j, bricks.len()));
+            f((dz * ny + y) * nx + x, rank_hint(j, brick.len()));
         }
     }
 }
