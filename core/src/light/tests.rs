@@ -1065,6 +1065,14 @@ fn adaptive_shadow_rays_on_a_finished_plane_are_six_connected_ones() {
     );
 }
 
+/// The eight corners of voxel `v`'s closed cube, in fixed units.
+fn cube_corners(v: [u32; 3]) -> Vec<[i64; 3]> {
+    let lo = v.map(|k| i64::from(k) * VOXEL);
+    (0..8)
+        .map(|c| core::array::from_fn(|k| lo[k] + ((c >> k) & 1) * VOXEL))
+        .collect()
+}
+
 /// Whether the segment from `p` to `l` passes farther than `r` from `c`,
 /// exactly (offsets below 2^38, so every product fits).
 fn passes_outside(p: [i64; 3], l: [i64; 3], c: [i64; 3], r: i64) -> bool {
@@ -1111,9 +1119,7 @@ fn a_cleared_sphere_meets_no_segment_from_the_cube() {
         }
         cleared += 1;
         let lo = v.map(|k| i64::from(k) * VOXEL);
-        let mut points: Vec<[i64; 3]> = (0..8)
-            .map(|c| core::array::from_fn(|k| lo[k] + ((c >> k) & 1) * VOXEL))
-            .collect();
+        let mut points = cube_corners(v);
         points.push(v.map(voxel_centre));
         for _ in 0..8 {
             points.push(core::array::from_fn(|k| lo[k] + rng.range(0, VOXEL + 1)));
@@ -1124,7 +1130,8 @@ fn a_cleared_sphere_meets_no_segment_from_the_cube() {
                 "{s:?} cleared for voxel {v:?} and light {light:?}, but the segment from {p:?} meets it"
             );
         }
-        // Within two voxels of the rule's bound: the test is not loose.
+        // Within about two voxels of the rule's bound (radius plus half
+        // the diagonal): the rule does not only clear far spheres.
         if !passes_outside(v.map(voxel_centre), light, centre, radius + 3 * VOXEL) {
             close += 1;
         }
@@ -1183,9 +1190,7 @@ fn a_clear_sphere_in_the_tube_leaves_the_voxel_lit() {
             assert_eq!(with, LightVisibility::Visible, "voxel {v:?}");
         }
         if with == LightVisibility::Visible {
-            let lo = v.map(|k| i64::from(k) * VOXEL);
-            for c in 0..8 {
-                let p = core::array::from_fn(|k| lo[k] + ((c >> k) & 1) * VOXEL);
+            for p in cube_corners(v) {
                 assert!(passes_outside(p, light, b.centre, b.radius), "voxel {v:?}");
             }
             if without != LightVisibility::Visible {
