@@ -242,6 +242,83 @@ fn built_planes_are_their_records_planes() {
     assert!(compared >= 12, "{compared} scenes compared");
 }
 
+/// The plane the builder and the loader make (the distance field on the
+/// thread pool, over the rows and boxes the records' bricks allow) is the
+/// core's plain distance field of the records' voxels (every slice read,
+/// on one thread) with their rank hints, byte for byte: for scenes of a
+/// few spheres far apart (most of the raster far from every surface),
+/// large ones spanning many bricks, spheres cut by the raster's faces,
+/// rasters whose sides are not multiples of the brick edge, and the runs of
+/// slices a loader makes one at a time.
+#[test]
+fn built_and_loaded_planes_are_the_plain_distance_field() {
+    use rrt_core::proximity::distance_field;
+    use rrt_core::raster::{RasterMut, cell};
+    use rrt_core::store::write_rank_hints;
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut unit = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..12 {
+        let count = 1 + case % 5;
+        let mut text = String::from(
+            "v\nfrom 0 -30 10\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 8 8\n\
+             b 0 0 0\nl 5 -20 30\nf 1 1 1 1 0 10 0 1\ns 1 -2 0 1.5\n",
+        );
+        for _ in 0..count {
+            // Centres anywhere in the box (spheres at its faces are cut);
+            // radii from a fraction of a voxel to a third of the box.
+            let c = [unit(), unit(), unit()].map(|u| (u - 0.5) * 20.0);
+            let r = 0.05 + unit().powi(3) * 7.0;
+            text.push_str(&format!("s {} {} {} {r}\n", c[0], c[1], c[2]));
+        }
+        let scene = Scene::parse("spheres.nff", text.as_bytes()).unwrap();
+        let raster = [40, 61, 97, 130][case % 4];
+        let mut opts = if case % 3 == 0 {
+            BuildOptions::paper(raster)
+        } else {
+            BuildOptions::new(raster)
+        };
+        // A box cutting the spheres above z = 6.5.
+        opts.fit.bounds = Some(rrt_host::world::Bounds {
+            min: DVec3::splat(-10.0),
+            max: DVec3::new(10.0, 10.0, 6.5),
+        });
+        let vs = build(&scene, &opts, &ProgressBar::hidden())
+            .unwrap_or_else(|e| panic!("case {case}: {e}"))
+            .0;
+        let store = vs.store().unwrap();
+        let extent = store.extent();
+        let [_, _, nz] = extent.dims();
+        // The records' voxels opaque, every other cell empty.
+        let mut plain = vec![cell::EMPTY; extent.len()];
+        for (v, _) in store.iter() {
+            plain[extent.index(v).unwrap()] = cell::OPAQUE;
+        }
+        let mut r = RasterMut::new(extent, &mut plain).unwrap();
+        distance_field(&mut r);
+        write_rank_hints(&mut r, &store);
+        assert!(
+            vs.plane[..] == plain[..],
+            "case {case}: the built plane is not the plain distance field"
+        );
+        let slice = (extent.dims()[0] * extent.dims()[1]) as usize;
+        for part in [[0, nz], [nz / 3, nz / 3 + 1], [nz / 2, nz]] {
+            let (derived, z0) = derive_plane(&store, part).unwrap();
+            let (a, b) = (part[0] as usize, part[1] as usize);
+            let from = (part[0] - z0) as usize * slice;
+            assert!(
+                derived[from..from + (b - a) * slice] == plain[a * slice..b * slice],
+                "case {case}: slices {a}..{b} made on load differ from the plain field"
+            );
+        }
+    }
+}
+
 #[test]
 fn toml_scene_renders_through_the_cli() {
     let d = features_dir("cli");
