@@ -11,8 +11,14 @@
 //! gets 4 KiB pages (one or a few rows each), so that its memory follows
 //! the surfaces. `madvise` is a hint: where it is refused the map works
 //! with the kernel's default pages.
+//!
+//! A page that is read before it is first written is mapped to the
+//! kernel's shared zero page, and the write then copies it, which flushes
+//! that page from the TLB of every CPU the process has run on (an
+//! interrupt to each, costly in a virtual machine). Where the writes to
+//! come are known, [`Plane::back_for_writing`] backs their pages first.
 
-use std::ops::{Deref, DerefMut};
+use std::ops::{Deref, DerefMut, Range};
 
 use memmap2::{Advice, MmapMut, MmapOptions};
 
@@ -40,6 +46,21 @@ impl Plane {
             Advice::NoHugePage
         });
         Ok(Self { map })
+    }
+
+    /// Asks the kernel to back the pages of the bytes `range` with
+    /// writable memory now (`MADV_POPULATE_WRITE`), as writing each would,
+    /// leaving their contents alone. A hint: where it is refused, or
+    /// outside Linux, the pages are backed when first touched.
+    pub fn back_for_writing(&self, range: Range<usize>) {
+        #[cfg(target_os = "linux")]
+        if range.start < range.end && range.end <= self.map.len() {
+            let _ =
+                self.map
+                    .advise_range(Advice::PopulateWrite, range.start, range.end - range.start);
+        }
+        #[cfg(not(target_os = "linux"))]
+        let _ = range;
     }
 
     /// The plane's length in bytes.

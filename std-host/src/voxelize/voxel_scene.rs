@@ -236,20 +236,105 @@ impl std::fmt::Write for CrcText {
 /// [`distance_field`](rrt_core::proximity::distance_field) and
 /// `write_rank_hints` whatever the number of threads. A plane that does
 /// not match the store's extent is left as it is, with no line level.
-pub fn finish_plane(plane: &mut [u8], store: &RecordStore<'_>) -> Vec<u8> {
+pub fn finish_plane(plane: &mut Plane, store: &RecordStore<'_>) -> Vec<u8> {
     let extent = store.extent();
     if plane.len() != extent.len() {
         return Vec::new();
     }
+    let [_, _, nz] = extent.dims();
+    back_field_rows(plane, store, 0, [0, nz]);
     let rows = BrickRows::of(extent, store.directory(), 0);
     distance_field(extent, plane, rows.as_ref());
-    let [_, _, nz] = extent.dims();
     for_record_cells(store, plane, 0, [0, nz], |c, hint| {
         if *c & cell::OPAQUE != 0 {
             *c = (*c & (cell::OPAQUE | cell::PROXIMITY)) | (hint << cell::DISTANCE_SHIFT);
         }
     });
     line_level(extent, plane, store.directory())
+}
+
+/// Backs for writing ([`Plane::back_for_writing`]) the rows of `plane`
+/// (the raster's slices from `z0`, a multiple of the brick edge, on) that
+/// the distance field of the records of `store` in slices `slices[0]..
+/// slices[1]` may write: those within [`field::FIELD_REACH`] rows and
+/// slices of a row holding one of those records. The field reads rows
+/// before it writes them; backed first, they are not copied from the zero
+/// page on the write. The rows are the ones the field writes anyway (each
+/// holds a cell within its reach), so no more memory is backed, except
+/// where a row spans several pages of which the field writes only some.
+fn back_field_rows(plane: &Plane, store: &RecordStore<'_>, z0: u32, slices: [u32; 2]) {
+    let [nx, ny, _] = store.extent().dims().map(|n| n as usize);
+    let Some(nz) = plane.len().checked_div(nx * ny) else {
+        return;
+    };
+    // Rows holding a record, per brick layer of the plane on the pool.
+    let mut rows = vec![false; nz * ny];
+    let bz0 = (z0 / BRICK) as usize;
+    rows.par_chunks_mut(ny * BRICK as usize)
+        .enumerate()
+        .for_each(|(l, rows)| {
+            layer_cells(store, bz0 + l, slices, |i, _| {
+                if let Some(r) = rows.get_mut(i / nx) {
+                    *r = true;
+                }
+            });
+        });
+    let reach = field::FIELD_REACH as usize;
+    let rows = dilate(&rows, ny, 1, reach);
+    let rows = dilate(&rows, nz, ny, reach);
+    // Runs of those rows, as byte ranges (runs go on across slices).
+    let mut start = None;
+    for (r, &back) in rows.iter().chain(std::iter::once(&false)).enumerate() {
+        match (back, start) {
+            (true, None) => start = Some(r),
+            (false, Some(s)) => {
+                plane.back_for_writing(s * nx..r * nx);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+}
+
+/// `flags` with each `true` spread over the `reach` elements on either
+/// side along one axis, whose elements lie `stride` apart, `n` of them
+/// (the array holds whole groups of `n · stride`).
+fn dilate(flags: &[bool], n: usize, stride: usize, reach: usize) -> Vec<bool> {
+    let mut out = vec![false; flags.len()];
+    let block = n * stride;
+    if block == 0 {
+        return out;
+    }
+    for (src, dst) in flags.chunks(block).zip(out.chunks_mut(block)) {
+        for i in 0..stride {
+            // The nearest flagged element before, then after, each one.
+            let mut last: Option<usize> = None;
+            for k in 0..n {
+                let j = k * stride + i;
+                if src.get(j) == Some(&true) {
+                    last = Some(k);
+                }
+                if last.is_some_and(|l| k - l <= reach)
+                    && let Some(d) = dst.get_mut(j)
+                {
+                    *d = true;
+                }
+            }
+            let mut next: Option<usize> = None;
+            for k in (0..n).rev() {
+                let j = k * stride + i;
+                if src.get(j) == Some(&true) {
+                    next = Some(k);
+                }
+                if next.is_some_and(|m| m - k <= reach)
+                    && let Some(d) = dst.get_mut(j)
+                {
+                    *d = true;
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Slices around a run of slices whose opaque voxels decide the run's
@@ -281,6 +366,7 @@ pub fn derive_plane(store: &RecordStore<'_>, slices: [u32; 2]) -> std::io::Resul
     let z1 = slices[1].saturating_add(DERIVE_MARGIN).min(nz).max(z0 + 1);
     let sub = Extent::new(nx, ny, z1 - z0).map_err(std::io::Error::other)?;
     let mut plane = Plane::zeroed(sub.len())?;
+    back_field_rows(&plane, store, z0, [z0, z1]);
     for_record_cells(store, &mut plane, z0, [z0, z1], |c, _| *c = cell::OPAQUE);
     let rows = BrickRows::of(extent, store.directory(), z0);
     distance_field(sub, &mut plane, rows.as_ref());
