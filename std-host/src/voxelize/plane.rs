@@ -50,11 +50,17 @@ impl Plane {
 
     /// Asks the kernel to back the pages of the bytes `range` with
     /// writable memory now (`MADV_POPULATE_WRITE`), as writing each would,
-    /// leaving their contents alone. A hint: where it is refused, or
-    /// outside Linux, the pages are backed when first touched.
+    /// leaving their contents alone, in a plane of normal pages (larger
+    /// than [`HUGE_PAGES_UP_TO`]). A plane of huge pages is left to its
+    /// faults: its zero page is copied once per 2 MiB, and asking for its
+    /// huge pages at once stalled some loads. A hint: where it is refused,
+    /// or outside Linux, the pages are backed when first touched.
     pub fn back_for_writing(&self, range: Range<usize>) {
         #[cfg(target_os = "linux")]
-        if range.start < range.end && range.end <= self.map.len() {
+        if self.map.len() > HUGE_PAGES_UP_TO
+            && range.start < range.end
+            && range.end <= self.map.len()
+        {
             let _ =
                 self.map
                     .advise_range(Advice::PopulateWrite, range.start, range.end - range.start);
