@@ -57,16 +57,21 @@ impl Plane {
     /// or outside Linux, the pages are backed when first touched.
     pub fn back_for_writing(&self, range: Range<usize>) {
         #[cfg(target_os = "linux")]
-        if self.map.len() > HUGE_PAGES_UP_TO
-            && range.start < range.end
-            && range.end <= self.map.len()
-        {
+        if !self.asks_for_huge_pages() && range.start < range.end && range.end <= self.map.len() {
             let _ =
                 self.map
                     .advise_range(Advice::PopulateWrite, range.start, range.end - range.start);
         }
         #[cfg(not(target_os = "linux"))]
         let _ = range;
+    }
+
+    /// Whether the plane asked for transparent huge pages (it is at most
+    /// [`HUGE_PAGES_UP_TO`] bytes long); [`Plane::back_for_writing`] then
+    /// does nothing.
+    #[must_use]
+    pub fn asks_for_huge_pages(&self) -> bool {
+        self.map.len() <= HUGE_PAGES_UP_TO
     }
 
     /// The plane's length in bytes.

@@ -262,7 +262,12 @@ pub fn finish_plane(plane: &mut Plane, store: &RecordStore<'_>) -> Vec<u8> {
 /// page on the write. The rows are the ones the field writes anyway (each
 /// holds a cell within its reach), so no more memory is backed, except
 /// where a row spans several pages of which the field writes only some.
+/// Nothing is done (not even the search for rows) for a plane of huge
+/// pages.
 fn back_field_rows(plane: &Plane, store: &RecordStore<'_>, z0: u32, slices: [u32; 2]) {
+    if plane.asks_for_huge_pages() {
+        return;
+    }
     let [nx, ny, _] = store.extent().dims().map(|n| n as usize);
     let Some(nz) = plane.len().checked_div(nx * ny) else {
         return;
