@@ -164,6 +164,75 @@ fn lit_voxels_have_only_their_own_objects_between_them_and_each_light() {
     assert!(lit > 2_000, "{lit} lit (voxel, light) pairs");
 }
 
+/// Every voxel classified occluded for a light: the segments from its
+/// corners, its centre and random points of its cube to the light each
+/// meet an object that lets no light through, from outside it. Returns
+/// the (voxel, light) pairs checked.
+fn check_occluded_voxels(vs: &VoxelScene, seed: u64) -> usize {
+    let store = vs.store().unwrap();
+    let mut rng = Rng(seed);
+    let mut occluded = 0;
+    for (v, rec) in store.iter() {
+        let own = store.objects(rec);
+        if !own.iter().all(|&o| vs.objects[o as usize].shape.is_exact()) {
+            continue;
+        }
+        let lo = vs.frame.origin + DVec3::from(v.map(f64::from)) * vs.frame.voxel_size;
+        let mut points: Vec<DVec3> = (0..8)
+            .map(|c| {
+                let corner = DVec3::new(
+                    f64::from(c & 1),
+                    f64::from((c >> 1) & 1),
+                    f64::from((c >> 2) & 1),
+                );
+                lo + corner * vs.frame.voxel_size
+            })
+            .collect();
+        points.push(lo + DVec3::splat(0.5 * vs.frame.voxel_size));
+        for _ in 0..4 {
+            points.push(lo + point(&mut rng, 0.0, 1.0) * vs.frame.voxel_size);
+        }
+        for (k, light) in vs.lights.iter().enumerate() {
+            if rec.light(k) != LightVisibility::Occluded {
+                continue;
+            }
+            occluded += 1;
+            for &p in &points {
+                let to = light.position - p;
+                let dist = to.length();
+                let ray = Ray::new(p, to / dist);
+                let blocked = vs.objects.iter().any(|o| {
+                    vs.materials[usize::from(o.material)].transmittance == 0.0
+                        && o.shape
+                            .intersect(&ray, 0.0, dist)
+                            .is_some_and(|h| h.t > 1e-9 * dist)
+                });
+                assert!(
+                    blocked,
+                    "seed {seed}: voxel {v:?} (objects {own:?}) classified occluded for light \
+                     {k}, but no opaque object meets the segment from {p}"
+                );
+            }
+        }
+    }
+    occluded
+}
+
+/// Scenes of larger spheres (a few voxels across) shadow some voxels
+/// wholly: every voxel the classification calls occluded is.
+#[test]
+fn occluded_voxels_have_an_opaque_object_between_them_and_each_light() {
+    let mut occluded = 0;
+    for seed in 60..66u64 {
+        let vs = exact(&random_scene(seed, 25, 0.3), 40, ExactRecords::Classify);
+        occluded += check_occluded_voxels(&vs, seed);
+        // Large objects: the lit proofs still hold.
+        check_lit_voxels(&vs, seed);
+    }
+    eprintln!("{occluded} occluded (voxel, light) pairs checked");
+    assert!(occluded > 200, "{occluded} occluded (voxel, light) pairs");
+}
+
 /// The scene's view rendered `size`² with `opts`: the image and counts.
 fn draw(vs: &VoxelScene, opts: TraceOptions, size: u32) -> (Image, RayStats) {
     let tracer = Tracer::new(vs, opts).unwrap();
@@ -180,8 +249,14 @@ fn draw(vs: &VoxelScene, opts: TraceOptions, size: u32) -> (Image, RayStats) {
 
 #[test]
 fn classified_shadows_render_as_exact_shadow_rays() {
-    for seed in 20..26u64 {
-        let nff = random_scene(seed, 40, 0.05);
+    let mut occluded = 0;
+    for seed in 20..28u64 {
+        // Small objects, and larger ones that shadow whole voxels.
+        let nff = if seed < 26 {
+            random_scene(seed, 40, 0.05)
+        } else {
+            random_scene(seed, 25, 0.3)
+        };
         let vs = exact(&nff, 40, ExactRecords::Classify);
         let rays_only = exact(&nff, 40, ExactRecords::Skip);
         let without = TraceOptions {
@@ -203,9 +278,18 @@ fn classified_shadows_render_as_exact_shadow_rays() {
         );
         // The same function of (voxel, light) either way.
         assert_eq!(sa.classified, sb.classified, "seed {seed}");
+        assert_eq!(sa.occluded, sb.occluded, "seed {seed}");
         assert_eq!(sa.shadow, sb.shadow, "seed {seed}");
-        assert_eq!(sa.classified + sa.shadow, sc.shadow, "seed {seed}");
+        assert_eq!(
+            sa.classified + sa.occluded + sa.shadow,
+            sc.shadow,
+            "seed {seed}"
+        );
+        assert_eq!(sc.occluded, 0, "seed {seed}");
+        occluded += sa.occluded;
     }
+    // Some lights of hits were proven occluded, without a shadow ray.
+    assert!(occluded > 0);
 }
 
 /// The classification computed on demand is the pass's: for every record
@@ -240,11 +324,27 @@ fn on_demand_classification_is_the_pass_classification() {
                     Shape::Sphere(s) => s.to_fixed(&vs.frame).ok(),
                     _ => None,
                 };
-                let got = classify_voxel(&raster, &store, None, shape, v, rec, light).unwrap();
+                let blocker = |id: u32| {
+                    let o = &vs.objects[id as usize];
+                    (vs.materials[usize::from(o.material)].transmittance == 0.0)
+                        .then(|| shape(id))
+                        .flatten()
+                };
+                let got =
+                    classify_voxel(&raster, &store, None, shape, blocker, v, rec, light).unwrap();
                 assert_eq!(got, rec.light(k), "seed {seed}: voxel {v:?}, light {k}");
                 // With the brick level, as a renderer asks: the same.
-                let got =
-                    classify_voxel(&raster, &store, bricks.as_ref(), shape, v, rec, light).unwrap();
+                let got = classify_voxel(
+                    &raster,
+                    &store,
+                    bricks.as_ref(),
+                    shape,
+                    blocker,
+                    v,
+                    rec,
+                    light,
+                )
+                .unwrap();
                 assert_eq!(
                     got,
                     rec.light(k),

@@ -121,13 +121,15 @@ pub const MAX_LIGHTS: usize = 8;
 /// What a voxel sees of one light source (2 bits in [`VoxelRecord::lights`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum LightVisibility {
-    /// Blocked by an opaque voxel, or the surface faces away from the light.
+    /// Blocked by an opaque voxel, or the surface faces away from the light;
+    /// from the shadow classification, proven blocked by an opaque sphere
+    /// at every point of the voxel ([`crate::light`]).
     #[default]
     Occluded = 0,
     /// Nothing between the voxel and the light.
     Visible = 1,
     /// Only translucent material (transmission `T > 0`) in between, or,
-    /// from the shadow classification, not proven lit
+    /// from the shadow classification, proven neither lit nor occluded
     /// ([`crate::light::ExactRecords`]): the renderer fires a shadow ray
     /// to decide.
     Translucent = 2,

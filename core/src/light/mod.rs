@@ -79,8 +79,15 @@
 //! the tube does not stand in the way when the segment from `v`'s centre
 //! to `L` passes farther than its radius plus half the cube's diagonal
 //! from its centre (with a margin for the rounding to fixed point): every
-//! segment from a point of the cube to `L` then passes outside it. Otherwise
-//! `Translucent`: a render-time shadow ray decides. The answer does not
+//! segment from a point of the cube to `L` then passes outside it. And an
+//! opaque sphere met in the tube *occludes* the voxel (`Occluded`) when the
+//! segment from `v`'s centre to `L` passes within its radius less half the
+//! cube's diagonal and half a voxel of its centre, the cube lies that much
+//! outside it, and it lies inside the raster: every segment from a point
+//! of the cube to `L` (and the renderer's, which starts and ends within a
+//! few ε of one) then enters it, from outside and inside the raster, where
+//! an exact shadow ray meets it. Otherwise `Translucent`: a render-time
+//! shadow ray decides. The answer does not
 //! depend on the stored normal (the renderer decides which side faces the
 //! light from the true normal), and the walk reads the distance field:
 //! the plane must be finished before the pass. Given the raster's brick
@@ -167,8 +174,10 @@ pub enum ExactRecords {
     /// The shadow classification (module docs, *Shadow classification*):
     /// [`LightVisibility::Visible`] where it is proven that only the
     /// voxel's own objects can stand between any point of the voxel and
-    /// the light, [`LightVisibility::Translucent`] (a render-time shadow
-    /// ray decides) elsewhere.
+    /// the light, [`LightVisibility::Occluded`] where an opaque sphere is
+    /// proven to block every segment from the voxel to the light,
+    /// [`LightVisibility::Translucent`] (a render-time shadow ray decides)
+    /// elsewhere.
     Classify,
     /// No rays: every light [`LightVisibility::Translucent`], for a
     /// renderer that decides every light of a verified hit itself: with an
@@ -456,7 +465,15 @@ fn shade_record<const N: usize>(
             }
             (true, _) => {
                 report.rays = report.rays.saturating_add(1);
-                classify(raster, view, v, own, sphere_of(objects), light.position)?
+                classify(
+                    raster,
+                    view,
+                    v,
+                    own,
+                    sphere_of(objects),
+                    opaque_sphere_of(objects, materials),
+                    light.position,
+                )?
             }
             (false, _) => {
                 let (lit_dir, ndl) = n_dot_l();
@@ -557,6 +574,21 @@ fn sphere_of<'t>(objects: &'t ObjectTable<'_>) -> impl Fn(u32) -> Option<Sphere>
     }
 }
 
+/// The fixed-point sphere of object `id` of `objects` when its material
+/// lets no light through (transmission 0), `None` for every other object.
+fn opaque_sphere_of<'t, const N: usize>(
+    objects: &'t ObjectTable<'_>,
+    materials: &'t Materials<N>,
+) -> impl Fn(u32) -> Option<Sphere> + 't {
+    |id| {
+        let o = objects.get(id)?;
+        match o.shape {
+            Shape::Sphere(s) if materials.get(o.material)?.transmission == 0 => Some(s),
+            _ => None,
+        }
+    }
+}
+
 /// Half the diagonal of a voxel's cube, rounded up: every point of the
 /// closed cube lies within it of the centre (√3/2 · 2^16 < 56756).
 const HALF_DIAGONAL: i128 = 56_756;
@@ -566,6 +598,13 @@ const HALF_DIAGONAL: i128 = 56_756;
 /// per coordinate, and under 2^-11 voxel for a light taken by its
 /// direction) and of the shading point to its voxel: 1/256 voxel.
 const CLEARANCE_MARGIN: i128 = 256;
+
+/// The least shift that brings `big` below 2^28 (at most 100).
+fn shift_below_2_28(big: u128) -> u32 {
+    128u32
+        .saturating_sub(big.leading_zeros())
+        .saturating_sub(28)
+}
 
 /// Whether sphere `s` (of positive radius) provably meets no segment from
 /// a point of voxel `v`'s closed cube to the light at `light`, with
@@ -595,11 +634,7 @@ fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
         .map(|x| x.unsigned_abs())
         .max()
         .unwrap_or(0);
-    // big < 2^64: at most 36 halvings.
-    let mut shift = 0u32;
-    while shift < 127 && (big >> shift) >= 1 << 28 {
-        shift = shift.saturating_add(1);
-    }
+    let shift = shift_below_2_28(big);
     let w = w.map(|x| x >> shift);
     let u = u.map(|x| x >> shift);
     let need = i128::from(s.radius)
@@ -638,6 +673,125 @@ fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
             .saturating_sub(w[1].saturating_mul(u[0])),
     ];
     dot(x, x) > need2.saturating_mul(uu)
+}
+
+/// What [`sphere_blocks`] keeps between a sphere's surface and the
+/// segments it proves blocked, and between the sphere and the voxel's
+/// cube: half a voxel. It covers the renderer's exact shadow segment,
+/// which starts ε off the surface in the voxel and ends `2ε` short of the
+/// light in the direction from the hit point (within `3ε` of the segment
+/// from its start to the light, ε under an eighth of a voxel where the
+/// renderer reads the classification), the shading point's rounding to
+/// its voxel and the rounding of the sphere and the light to fixed point
+/// ([`CLEARANCE_MARGIN`]).
+const BLOCK_MARGIN: i128 = (VOXEL as i128) / 2;
+
+/// Whether sphere `s` (of positive radius) provably blocks every segment
+/// from a point of voxel `v`'s closed cube to the light at `light`: the
+/// segment from `v`'s centre `C` to `L` passes within `R − HALF_DIAGONAL −
+/// BLOCK_MARGIN` of the sphere's centre, while `C` lies farther than `R +
+/// HALF_DIAGONAL + BLOCK_MARGIN` from it, and the ball with its margin lies
+/// inside the raster box of `dims`. A segment from a cube point `p` (or
+/// within [`BLOCK_MARGIN`] of one) is everywhere within `HALF_DIAGONAL +
+/// BLOCK_MARGIN` of the centre's (as in [`sphere_clears`]), so it passes
+/// through the sphere's interior, entering it at a positive distance from
+/// `p` and inside the raster, where a walk along it meets a voxel that
+/// lists the sphere.
+///
+/// Integer arithmetic without overflow: the cube's distance and the
+/// direction exactly; the segment's distance shifted as in
+/// [`sphere_clears`], whose floors move the centre and the segment by
+/// under `2√3` shifted units, which the bound gives away (4).
+fn sphere_blocks(s: &Sphere, v: [u32; 3], light: [i64; 3], dims: [u32; 3]) -> bool {
+    let r = i128::from(s.radius);
+    let inner = r.saturating_sub(HALF_DIAGONAL).saturating_sub(BLOCK_MARGIN);
+    if inner <= 0 {
+        return false;
+    }
+    let c = v.map(voxel_centre);
+    let off = |p: [i64; 3]| -> [i128; 3] {
+        core::array::from_fn(|k| i128::from(p[k]).saturating_sub(i128::from(c[k])))
+    };
+    let (w, u) = (off(s.centre), off(light));
+    let dot = |a: [i128; 3], b: [i128; 3]| -> i128 {
+        a.iter().zip(b.iter()).fold(0i128, |acc, (x, y)| {
+            acc.saturating_add(x.saturating_mul(*y))
+        })
+    };
+    // The cube outside, and the sphere ahead of it towards the light
+    // (first: most spheres met in a tube touch the voxel). Unshifted: the
+    // products of the offsets (below 2^64) saturate only where the sphere
+    // lies far outside the raster, which the next test refuses, and a
+    // saturated direction test only refuses.
+    let outer = r.saturating_add(HALF_DIAGONAL).saturating_add(BLOCK_MARGIN);
+    if dot(w, w) <= outer.saturating_mul(outer) || dot(w, u) <= 0 {
+        return false;
+    }
+    let reach = r.saturating_add(BLOCK_MARGIN);
+    let inside = (0..3).all(|k| {
+        let (Some(&c), Some(&n)) = (s.centre.get(k), dims.get(k)) else {
+            return false;
+        };
+        let c = i128::from(c);
+        c.saturating_sub(reach) >= 0
+            && c.saturating_add(reach) <= i128::from(n).saturating_mul(i128::from(VOXEL))
+    });
+    if !inside {
+        return false;
+    }
+    let big = w
+        .iter()
+        .chain(u.iter())
+        .map(|x| x.unsigned_abs())
+        .max()
+        .unwrap_or(0);
+    let shift = shift_below_2_28(big);
+    let w = w.map(|x| x >> shift);
+    let u = u.map(|x| x >> shift);
+    // The segment's distance, rounded down, less 4 (shifted units).
+    let inner = (inner >> shift).saturating_sub(4);
+    if inner <= 0 {
+        return false;
+    }
+    let inner2 = inner.saturating_mul(inner);
+    let (uu, wu) = (dot(u, u), dot(w, u));
+    if wu <= 0 {
+        // Nearest the segment's start, which lies outside.
+        return false;
+    }
+    if wu >= uu {
+        // Nearest the light.
+        let d = [0, 1, 2].map(|k| w[k].saturating_sub(u[k]));
+        return dot(d, d) < inner2;
+    }
+    // Within: |w × u|² / |u|² is the squared distance to the line.
+    let x = [
+        w[1].saturating_mul(u[2])
+            .saturating_sub(w[2].saturating_mul(u[1])),
+        w[2].saturating_mul(u[0])
+            .saturating_sub(w[0].saturating_mul(u[2])),
+        w[0].saturating_mul(u[1])
+            .saturating_sub(w[1].saturating_mul(u[0])),
+    ];
+    dot(x, x) < inner2.saturating_mul(uu)
+}
+
+/// Whether one of `objects` outside `own` is a sphere of `blocker` that
+/// blocks every segment from voxel `v`'s cube to the light
+/// ([`sphere_blocks`]). Out of line: a classification asks at most once,
+/// where its walk ends.
+#[inline(never)]
+fn blocks_all(
+    objects: &[u32],
+    own: &[u32],
+    blocker: impl Fn(u32) -> Option<Sphere>,
+    v: [u32; 3],
+    light: [i64; 3],
+    dims: [u32; 3],
+) -> bool {
+    objects.iter().any(|&o| {
+        !own.contains(&o) && blocker(o).is_some_and(|s| sphere_blocks(&s, v, light, dims))
+    })
 }
 
 /// The test of [`dark_side`] for one sphere.
@@ -795,12 +949,17 @@ fn blocks<const N: usize>(
 /// ([`ExactRecords::Classify`], module docs, *Shadow classification* and
 /// *Dark side*): [`LightVisibility::Visible`] when only `rec`'s own objects
 /// can stand between any point of the voxel's closed cube and the light,
+/// [`LightVisibility::Occluded`] when an opaque sphere met in the tube
+/// blocks every segment from the cube to the light,
 /// [`LightVisibility::Translucent`] (undecided) otherwise, and undecided
 /// without a walk when the cube lies wholly on the dark side of its
 /// objects, all spheres. `sphere` gives the fixed-point sphere of an
 /// object by id, as the object table holds it, and `None` for every other
 /// object: it decides the dark side, and which foreign spheres in the
-/// tube stand clear of the cube's segments to the light. A renderer that
+/// tube stand clear of the cube's segments to the light. `blocker` gives
+/// the same sphere for the objects whose material lets no light through
+/// (transmission 0), `None` for every other object: those may prove the
+/// voxel occluded. A renderer that
 /// skipped the classification in the pass ([`ExactRecords::Skip`])
 /// computes it here for the voxels its hits need;
 /// the answer depends on nothing but the raster, the store, the spheres,
@@ -815,11 +974,13 @@ fn blocks<const N: usize>(
 /// # Errors
 /// [`LightError::ExtentMismatch`] if `raster`, `store` and `bricks` differ
 /// in size; [`LightError::Ray`] for a light beyond the fixed-point range.
+#[allow(clippy::too_many_arguments)] // the voxel, its light, and what the proofs read
 pub fn classify_voxel(
     raster: &Raster<'_>,
     store: &RecordStore<'_>,
     bricks: Option<&ShadowBricks<'_>>,
     sphere: impl Fn(u32) -> Option<Sphere>,
+    blocker: impl Fn(u32) -> Option<Sphere>,
     v: [u32; 3],
     rec: &VoxelRecord,
     light: [i64; 3],
@@ -837,7 +998,7 @@ pub fn classify_voxel(
     {
         return Ok(LightVisibility::Visible);
     }
-    classify(raster, store, v, own, sphere, light)
+    classify(raster, store, v, own, sphere, blocker, light)
 }
 
 /// The shadow classification of voxel `v` (objects `own`) for a light at
@@ -845,7 +1006,10 @@ pub fn classify_voxel(
 /// [`LightVisibility::Visible`] when every non-transparent voxel within
 /// chessboard distance 1 of the 6-connected segment from `v`'s centre to
 /// the light holds only objects of `own` and spheres (`sphere`) that no
-/// segment from the cube to the light meets ([`sphere_clears`]), else
+/// segment from the cube to the light meets ([`sphere_clears`]);
+/// [`LightVisibility::Occluded`] when a foreign object of the first
+/// voxel of the tube that holds any is a sphere of `blocker` that blocks
+/// every such segment ([`sphere_blocks`]); else
 /// [`LightVisibility::Translucent`] (undecided: a render-time shadow ray
 /// decides). A voxel without a record undecides too.
 fn classify(
@@ -854,6 +1018,7 @@ fn classify(
     v: [u32; 3],
     own: &[u32],
     sphere: impl Fn(u32) -> Option<Sphere>,
+    blocker: impl Fn(u32) -> Option<Sphere>,
     light: [i64; 3],
 ) -> Result<LightVisibility, LightError> {
     let c0 = v.map(voxel_centre);
@@ -882,15 +1047,21 @@ fn classify(
         }
         yes
     };
+    // The objects of the voxel where the walk found a foreign object,
+    // asked after the walk whether one blocks every segment from the cube
+    // to the light ([`sphere_blocks`]).
+    let found: core::cell::Cell<&[u32]> = core::cell::Cell::new(&[]);
     // Whether the opaque voxel `w` (cell `c`) has no record or holds an
     // object not in `own` that may meet a segment from the cube to the
     // light.
     let holds_foreign = |w: [u32; 3], c: u8| -> bool {
         view.get_hinted(w, c).is_none_or(|rec| {
-            !view
-                .objects(rec)
-                .iter()
-                .all(|&o| own.contains(&o) || clear(o))
+            let objects = view.objects(rec);
+            let foreign = !objects.iter().all(|&o| own.contains(&o) || clear(o));
+            if foreign {
+                found.set(objects);
+            }
+            foreign
         })
     };
     let mut foreign = |index: usize, _: u8| -> bool {
@@ -982,6 +1153,9 @@ fn classify(
     })?;
     Ok(match outcome {
         Piece::Clear => LightVisibility::Visible,
+        Piece::Blocked if blocks_all(found.get(), own, &blocker, v, light, dims) => {
+            LightVisibility::Occluded
+        }
         Piece::Blocked => LightVisibility::Translucent,
     })
 }

@@ -627,8 +627,17 @@ fn classification_is_the_tube_rule() {
                     };
                     for &light in &lights {
                         // No shapes: the tube rule alone.
-                        let got =
-                            classify_voxel(&raster, &store, None, |_| None, v, rec, light).unwrap();
+                        let got = classify_voxel(
+                            &raster,
+                            &store,
+                            None,
+                            |_| None,
+                            |_| None,
+                            v,
+                            rec,
+                            light,
+                        )
+                        .unwrap();
                         let want = tube_rule(&raster, &store, v, light);
                         assert_eq!(
                             got == LightVisibility::Visible,
@@ -750,7 +759,16 @@ fn brick_level_changes_no_classification() {
         }
         for (v, rec) in store.iter() {
             for &light in &lights {
-                let with = classify_voxel(&raster, &store, Some(&bricks), |_| None, v, rec, light);
+                let with = classify_voxel(
+                    &raster,
+                    &store,
+                    Some(&bricks),
+                    |_| None,
+                    |_| None,
+                    v,
+                    rec,
+                    light,
+                );
                 let want = tube_rule(&raster, &store, v, light);
                 assert_eq!(
                     with.unwrap() == LightVisibility::Visible,
@@ -957,7 +975,8 @@ fn classification_leaves_the_dark_side_undecided() {
     let (mut dark, mut walked) = (0u32, 0u32);
     for light in [vox([200, 90, 30]), vox([24, 24, -40]), vox([30, 20, 26])] {
         for (v, rec) in store.iter() {
-            let got = classify_voxel(&raster, &store, None, shape, v, rec, light).unwrap();
+            let got =
+                classify_voxel(&raster, &store, None, shape, |_| None, v, rec, light).unwrap();
             if cube_beyond_terminator(&sphere, v, light) {
                 assert_eq!(got, LightVisibility::Translucent, "voxel {v:?}");
                 dark += 1;
@@ -1142,6 +1161,106 @@ fn a_cleared_sphere_meets_no_segment_from_the_cube() {
     );
 }
 
+/// [`shift_below_2_28`] is the least shift that brings its argument below
+/// 2^28.
+#[test]
+fn the_shift_is_the_least_that_brings_below_2_28() {
+    let mut rng = testkit::Rng(0x5_41f7);
+    let mut values = vec![0u128, 1, (1 << 28) - 1, 1 << 28, (1 << 29) - 1, u128::MAX];
+    for _ in 0..10_000 {
+        let bits = rng.below_u32(128);
+        values.push(((u128::from(rng.next_u64()) << 64) | u128::from(rng.next_u64())) >> bits);
+    }
+    for big in values {
+        let s = shift_below_2_28(big);
+        assert!(big >> s < 1 << 28, "{big}");
+        assert!(s == 0 || big >> (s - 1) >= 1 << 28, "{big}");
+    }
+}
+
+/// [`sphere_blocks`] blocks only spheres that every segment from a point
+/// of the cube (or within 1/256 voxel of it) to a point within 3/8 voxel
+/// of the light (the renderer's ε-shifted segment) enters, from outside,
+/// and that lie inside the raster; and it blocks every sphere that does so
+/// with an eighth of a voxel to spare beyond its margins. Random spheres
+/// near the voxel, lights near and up to 2^36 units away.
+#[test]
+fn a_blocking_sphere_stands_on_every_segment_from_the_cube() {
+    let mut rng = testkit::Rng(0xb10c_4ed5);
+    let dims = [64; 3];
+    let (mut blocked, mut due) = (0u32, 0u32);
+    let slack = VOXEL / 8;
+    for case in 0..40_000 {
+        let v = [0; 3].map(|_| rng.below_u32(64));
+        let c0 = v.map(voxel_centre);
+        let radius = rng.range(VOXEL / 8, 16 * VOXEL);
+        let light = if case % 2 == 0 {
+            [0; 3].map(|_| rng.range(-64 * VOXEL, 128 * VOXEL))
+        } else {
+            [0; 3].map(|_| rng.range(-(1 << 36), 1 << 36))
+        };
+        // Anywhere, or near the segment to the light (most cases).
+        let centre = if case % 4 == 3 {
+            [0; 3].map(|_| rng.range(0, 64 * VOXEL))
+        } else {
+            let d: [f64; 3] = core::array::from_fn(|k| (light[k] - c0[k]) as f64);
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1.0);
+            let along = rng.range(0, 40 * VOXEL) as f64;
+            let jitter = 2 * radius;
+            core::array::from_fn(|k| {
+                c0[k] + (d[k] / len * along) as i64 + rng.range(-jitter, jitter + 1)
+            })
+        };
+        let s = Sphere { centre, radius };
+        let outer = HALF_DIAGONAL as i64 + BLOCK_MARGIN as i64;
+        let inside = (0..3).all(|k| {
+            centre[k] - radius - BLOCK_MARGIN as i64 - slack >= 0
+                && centre[k] + radius + BLOCK_MARGIN as i64 + slack <= 64 * VOXEL
+        });
+        let clearly = inside
+            && radius > outer + slack
+            && passes_outside(c0, c0, centre, radius + outer + slack)
+            && !passes_outside(c0, light, centre, radius - outer - slack);
+        if !sphere_blocks(&s, v, light, dims) {
+            assert!(
+                !clearly,
+                "{s:?} not blocking voxel {v:?} for light {light:?}, with room to spare"
+            );
+            continue;
+        }
+        blocked += 1;
+        if clearly {
+            due += 1;
+        }
+        for c in centre {
+            assert!(c - radius >= 0 && c + radius <= 64 * VOXEL);
+        }
+        let lo = v.map(|k| i64::from(k) * VOXEL);
+        let mut points = cube_corners(v);
+        points.push(c0);
+        for _ in 0..8 {
+            let m = VOXEL / 256;
+            points.push(core::array::from_fn(|k| {
+                lo[k] + rng.range(-m, VOXEL + m + 1)
+            }));
+        }
+        for p in points {
+            // Outside, and the segment to a point near the light enters it.
+            assert!(
+                passes_outside(p, p, centre, radius),
+                "{s:?} blocking voxel {v:?} holds {p:?}"
+            );
+            let reach = 3 * VOXEL / 8 / 2;
+            let l: [i64; 3] = core::array::from_fn(|k| light[k] + rng.range(-reach, reach + 1));
+            assert!(
+                !passes_outside(p, l, centre, radius - 1),
+                "{s:?} blocking voxel {v:?} for light {light:?}, but the segment from {p:?} to {l:?} misses it"
+            );
+        }
+    }
+    assert!(blocked > 500 && due > 300, "{blocked} blocked, {due} due");
+}
+
 /// A sphere in the tube of a voxel's segment to the light, but clear of
 /// every segment from the voxel's cube, does not undecide it: the voxels
 /// on top of a ball under a light straight above, beside a small ball
@@ -1184,8 +1303,9 @@ fn a_clear_sphere_in_the_tube_leaves_the_voxel_lit() {
         if store.objects(rec) != [0] {
             continue;
         }
-        let without = classify_voxel(&raster, &store, None, only_a, v, rec, light).unwrap();
-        let with = classify_voxel(&raster, &store, None, both, v, rec, light).unwrap();
+        let without =
+            classify_voxel(&raster, &store, None, only_a, |_| None, v, rec, light).unwrap();
+        let with = classify_voxel(&raster, &store, None, both, |_| None, v, rec, light).unwrap();
         if without == LightVisibility::Visible {
             assert_eq!(with, LightVisibility::Visible, "voxel {v:?}");
         }

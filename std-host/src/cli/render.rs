@@ -363,7 +363,7 @@ fn summary(
     let rays = stats.rays().max(1);
     writeln!(
         out,
-        "{}: {size}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted{}, {} shadow ({} lights proven lit, {} blocked by the last blocker, {:.1} steps/shadow ray walked); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays){}",
+        "{}: {size}, raster {}×{}×{} ({} mode, {}), depth {}: {prep}, render {}; rays {} primary, {} reflected, {} refracted{}, {} shadow ({} lights proven lit, {} proven occluded, {} blocked by the last blocker, {:.1} steps/shadow ray walked); {:.1} steps/ray; {} hits ({} in shared voxels), {} false hits ({:.2}% of rays){}",
         path.display(),
         d[0],
         d[1],
@@ -385,6 +385,7 @@ fn summary(
         },
         stats.shadow,
         stats.classified,
+        stats.occluded,
         stats.last_blocker,
         stats.shadow_steps as f64 / (stats.shadow - stats.last_blocker).max(1) as f64,
         stats.steps as f64 / rays as f64,

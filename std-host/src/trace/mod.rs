@@ -23,7 +23,9 @@
 //! once). In the exact mode every light a verified hit faces is decided
 //! exactly: where the voxel holding the shadow ray's start is proven lit by
 //! the shadow classification ([`rrt_core::light`], *Shadow
-//! classification*), only the voxel's own objects are intersected;
+//! classification*), only the voxel's own objects are intersected; where
+//! it is proven occluded (an opaque sphere blocks every segment from the
+//! voxel to the light), the light is blocked without a ray;
 //! otherwise the object that last blocked a shadow ray towards the light
 //! in the tile is tried (met inside the raster, it is the walk's answer
 //! too), and else an exact shadow ray walks adaptively with empty-space skipping
@@ -314,12 +316,16 @@ pub struct RayStats {
     pub pruned: u64,
     /// Render-time shadow rays (lights seen through translucent material;
     /// in the exact mode, every light of a verified hit the shadow
-    /// classification does not prove lit).
+    /// classification proves neither lit nor occluded).
     pub shadow: u64,
     /// Lights of verified hits (exact mode) that the shadow classification
     /// proved lit: only the voxel's own objects were intersected, no ray
     /// walked.
     pub classified: u64,
+    /// Lights of verified hits (exact mode) that the shadow classification
+    /// proved occluded: an opaque object blocks every segment from the
+    /// voxel to the light; nothing intersected, no ray walked.
+    pub occluded: u64,
     /// Voxels visited by all rays (an empty-space jump counts as one).
     pub steps: u64,
     /// Of `steps`, the voxels visited by render-time shadow rays.
@@ -364,6 +370,7 @@ impl RayStats {
         self.pruned += o.pruned;
         self.shadow += o.shadow;
         self.classified += o.classified;
+        self.occluded += o.occluded;
         self.steps += o.steps;
         self.shadow_steps += o.shadow_steps;
         self.hits += o.hits;
@@ -509,7 +516,8 @@ enum Classification {
     /// Computed when a hit first needs it, per record and light, and kept:
     /// two bits per light and record (index as in
     /// [`RecordStore::records`]), [`Classification::UNKNOWN`],
-    /// [`Classification::LIT`] or [`Classification::UNDECIDED`]. The
+    /// [`Classification::LIT`], [`Classification::OCCLUDED`] or
+    /// [`Classification::UNDECIDED`]. The
     /// answer is a function of the record and the light alone, so the
     /// order in which threads fill it in changes nothing.
     OnDemand(Arc<OnDemand>),
@@ -538,6 +546,7 @@ impl Classification {
     const UNKNOWN: u16 = 0;
     const LIT: u16 = 1;
     const UNDECIDED: u16 = 2;
+    const OCCLUDED: u16 = 3;
 
     /// The classification a tracer over `scene` with `opts` can use.
     fn of(scene: &VoxelScene, store: &RecordStore<'_>, opts: &TraceOptions) -> Self {

@@ -234,7 +234,10 @@ impl Tracer<'_> {
     /// [`rrt_core::light`]; from its record's bits, or computed on demand
     /// and kept, [`TraceOptions::classify_on_demand`](super::TraceOptions::classify_on_demand)),
     /// those objects are intersected with the
-    /// segment and nothing is walked; otherwise an exact shadow ray
+    /// segment and nothing is walked; where it has *occluded* (an opaque
+    /// sphere blocks every segment from the voxel to the light, with half
+    /// a voxel to spare, which covers the 3ε), the light is blocked and
+    /// nothing is intersected; otherwise an exact shadow ray
     /// decides ([`Tracer::exact_shadow`]). Both give the exact answer: the
     /// segment stays within 3ε of the one from `origin` to the light,
     /// and the classification's tube covers that much and more while 3ε
@@ -260,7 +263,12 @@ impl Tracer<'_> {
         let segment = Ray::new(origin, to / dist);
         let tmax = dist - 2.0 * self.offset_at(h);
         let voxel = *origin_voxel.get_or_insert_with(|| self.origin_voxel(origin));
-        if let Some(own) = voxel.and_then(|v| self.classified_lit(&v, k)) {
+        let answer = voxel.map_or(Classified::Undecided, |v| self.classified(&v, k));
+        if answer == Classified::Occluded {
+            stats.occluded += 1;
+            return 0.0;
+        }
+        if let Classified::Lit(own) = answer {
             stats.classified += 1;
             let mut att = 1.0;
             let skip = (!self.meets_itself(h, n)).then_some(h.object);
@@ -278,61 +286,78 @@ impl Tracer<'_> {
         self.exact_shadow(h, n, &segment, tmax, k, stats)
     }
 
-    /// The objects of voxel `o` (the one holding a shadow ray's origin,
-    /// [`Tracer::origin_voxel`]), when the shadow classification says it
-    /// is lit for light `k`: every object of the voxel has exact geometry
-    /// and the classification (its record's bits for the light, or the one
-    /// computed on demand and kept) is [`LightVisibility::Visible`].
-    fn classified_lit<'v>(&self, o: &OriginVoxel<'v>, k: usize) -> Option<&'v [u32]> {
+    /// What the shadow classification says of voxel `o` (the one holding a
+    /// shadow ray's origin, [`Tracer::origin_voxel`]) for light `k`: its
+    /// record's bits for the light, or the answer computed on demand and
+    /// kept; [`Classified::Undecided`] unless every object of the voxel has
+    /// exact geometry.
+    fn classified<'v>(&self, o: &OriginVoxel<'v>, k: usize) -> Classified<'v> {
         if !o.exact {
-            return None;
+            return Classified::Undecided;
         }
-        let lit = match &self.classification {
-            Classification::Unavailable => false,
-            Classification::Records => o.rec.light(k) == LightVisibility::Visible,
+        let answer = match &self.classification {
+            Classification::Unavailable => Classification::UNDECIDED,
+            Classification::Records => match o.rec.light(k) {
+                LightVisibility::Visible => Classification::LIT,
+                LightVisibility::Occluded => Classification::OCCLUDED,
+                _ => Classification::UNDECIDED,
+            },
             Classification::OnDemand(d) => {
                 let (Some(slot), Some(Some(light)), Ok(shift)) = (
                     d.memo.get(o.at),
                     self.lights_fx.get(k),
                     u32::try_from(2 * k),
                 ) else {
-                    return None;
+                    return Classified::Undecided;
                 };
                 if shift >= 16 {
-                    return None;
+                    return Classified::Undecided;
                 }
                 let known = (slot.load(Ordering::Relaxed) >> shift) & 3;
-                let answer = if known == Classification::UNKNOWN {
+                if known == Classification::UNKNOWN {
                     // A sphere's fixed-point geometry as the fit makes it,
                     // made when asked: no copy of the object table is kept.
                     let shape = |id: u32| match self.objects.get(usize::try_from(id).ok()?)?.shape {
                         Shape::Sphere(s) => s.to_fixed(&self.frame).ok(),
                         _ => None,
                     };
+                    // The same, for the spheres that let no light through.
+                    let blocker = |id: u32| {
+                        let o = self.objects.get(usize::try_from(id).ok()?)?;
+                        match o.shape {
+                            Shape::Sphere(s) if self.transmittance(o.material) == 0.0 => {
+                                s.to_fixed(&self.frame).ok()
+                            }
+                            _ => None,
+                        }
+                    };
                     let bricks = d.level.as_ref().and_then(|l| l.bricks(&self.store));
-                    let lit = classify_voxel(
+                    let answer = match classify_voxel(
                         &self.raster,
                         &self.store,
                         bricks.as_ref(),
                         shape,
+                        blocker,
                         o.voxel,
                         o.rec,
                         *light,
-                    ) == Ok(LightVisibility::Visible);
-                    let answer = if lit {
-                        Classification::LIT
-                    } else {
-                        Classification::UNDECIDED
+                    ) {
+                        Ok(LightVisibility::Visible) => Classification::LIT,
+                        Ok(LightVisibility::Occluded) => Classification::OCCLUDED,
+                        _ => Classification::UNDECIDED,
                     };
                     slot.fetch_or(answer << shift, Ordering::Relaxed);
                     answer
                 } else {
                     known
-                };
-                answer == Classification::LIT
+                }
             }
         };
-        lit.then_some(o.own)
+        match answer {
+            Classification::LIT => Classified::Lit(o.own),
+            Classification::OCCLUDED => Classified::Occluded,
+            _ => Classified::Undecided,
+        }
     }
 
     /// The opaque voxel holding world point `p` with its record, for the
@@ -524,6 +549,19 @@ impl Tracer<'_> {
         let dims = self.extent.dims();
         (0..3).all(|a| r[a] > 0.0 && r[a] < f64::from(dims[a]))
     }
+}
+
+/// What the shadow classification says of the voxel holding a shadow
+/// ray's origin for one light ([`Tracer::classified`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Classified<'a> {
+    /// Only the voxel's own objects (these) can stand between any of its
+    /// points and the light.
+    Lit(&'a [u32]),
+    /// An opaque object blocks every segment from the voxel to the light.
+    Occluded,
+    /// A shadow ray decides.
+    Undecided,
 }
 
 /// The voxel holding a hit's shadow-ray origin, looked up once for all

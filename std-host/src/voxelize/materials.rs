@@ -122,7 +122,14 @@ fn core_material(m: &Material) -> table::Material {
         kd: scalar(m.kd),
         ks: scalar(m.ks),
         shine: scalar(m.shine),
-        transmission: scalar(m.transmittance),
+        // Any transmission at all lets light through: the renderer's
+        // shadow rays attenuate by it, so the light pass must not count
+        // the object as opaque.
+        transmission: if m.transmittance > 0.0 {
+            scalar(m.transmittance).max(1)
+        } else {
+            0
+        },
         ior: scalar(m.ior),
     }
 }
