@@ -323,6 +323,8 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             + saved_last.count("refracted");
         let shadow = saved_last.count("shadow");
         let lit = saved_last.count("lights proven lit");
+        let occluded = saved_last.count("proven occluded");
+        let queries = (shadow + lit + occluded).max(1.0);
         if median(&loads) > slowest_load.1 || slowest_load.1.is_nan() {
             slowest_load = (stem.to_string(), median(&loads));
         }
@@ -338,7 +340,8 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             secs(median(&ts[1][1])),
             secs(median(&ts[1][2])),
             f(median(&ts[1][0]) / median(&ts[1][2]), 2),
-            f(100.0 * shadow / (shadow + lit), 1),
+            f(100.0 * shadow / queries, 1),
+            f(100.0 * occluded / queries, 1),
             f(
                 100.0 * saved_last.count("blocked by the last blocker") / shadow.max(1.0),
                 1,
@@ -455,8 +458,10 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
          file. **File**: the saved raster's size (format version 3: the plane made on load \
          from the records, the large sections LZ4-compressed); **load**: the load phase of \
          rrt's summary line (mapping, checksums, decoding, making the plane). **Uncertain**: \
-         the share of the shadow queries of verified hits that the classification did not \
-         prove lit, which fired an exact shadow ray; **blocked by the last blocker**: the share \
+         the share of the shadow queries of verified hits that the classification proved \
+         neither lit nor occluded, which fired an exact shadow ray; **occluded**: the share it \
+         proved occluded (an opaque sphere blocks every segment from the voxel to the light), \
+         answered without a ray; **blocked by the last blocker**: the share \
          of those the object that last blocked a shadow ray towards the same light in the tile \
          was found to block, without a walk; **steps per shadow ray**: the voxels each walked \
          one visited (an empty-space jump counts as one). \
@@ -478,6 +483,7 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
             "Embree s, 2 threads",
             "rrt / Embree",
             "uncertain %",
+            "occluded %",
             "blocked by the last blocker %",
             "steps per shadow ray",
             "false hits per 100 rays",
