@@ -461,9 +461,9 @@ pub(crate) fn whole(ctx: &mut Ctx) -> Res<()> {
          the share of the shadow queries of verified hits that the classification proved \
          neither lit nor occluded, which fired an exact shadow ray; **occluded**: the share it \
          proved occluded (an opaque sphere blocks every segment from the voxel to the light), \
-         answered without a ray; **blocked by the last blocker**: the share \
-         of those the object that last blocked a shadow ray towards the same light in the tile \
-         was found to block, without a walk; **steps per shadow ray**: the voxels each walked \
+         answered without a ray; **blocked by the last blocker**: the share of the uncertain \
+         ones that the object that last blocked a shadow ray towards the same light in the \
+         tile was found to block, without a walk; **steps per shadow ray**: the voxels each walked \
          one visited (an empty-space jump counts as one). \
          **False hits**: discrete hits verification rejected, per traced ray (eye, reflected, \
          refracted). **Shared-voxel hits**: the share of verified hits found in a voxel that \
