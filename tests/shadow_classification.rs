@@ -2,7 +2,9 @@
 //! scenes of small and overlapping spheres, triangles and cones, with
 //! lights inside and outside the raster, every voxel classified *lit* for
 //! a light has nothing but its own objects between any of its points and
-//! the light; the classification computed on demand is the pass's; and
+//! the light, and every voxel classified *occluded* an opaque object on
+//! every segment from its points to the light; the classification
+//! computed on demand is the pass's; and
 //! the exact mode's image with the classification (from the records or
 //! on demand) is the image with an exact shadow ray for every light.
 
