@@ -91,6 +91,27 @@ fn exact(nff: &str, raster: u32, records: ExactRecords) -> VoxelScene {
     vs
 }
 
+/// The corners, the centre and four random points of voxel `v`'s cube,
+/// in world coordinates.
+fn cube_points(vs: &VoxelScene, v: [u32; 3], rng: &mut Rng) -> Vec<DVec3> {
+    let lo = vs.frame.origin + DVec3::from(v.map(f64::from)) * vs.frame.voxel_size;
+    let mut points: Vec<DVec3> = (0..8)
+        .map(|c| {
+            let corner = DVec3::new(
+                f64::from(c & 1),
+                f64::from((c >> 1) & 1),
+                f64::from((c >> 2) & 1),
+            );
+            lo + corner * vs.frame.voxel_size
+        })
+        .collect();
+    points.push(lo + DVec3::splat(0.5 * vs.frame.voxel_size));
+    for _ in 0..4 {
+        points.push(lo + point(rng, 0.0, 1.0) * vs.frame.voxel_size);
+    }
+    points
+}
+
 /// Every voxel classified lit for a light: segments from its corners, its
 /// centre and random points of its cube to the light meet no object but
 /// the voxel's own. Returns the (voxel, light) pairs checked.
@@ -103,21 +124,7 @@ fn check_lit_voxels(vs: &VoxelScene, seed: u64) -> usize {
         if !own.iter().all(|&o| vs.objects[o as usize].shape.is_exact()) {
             continue;
         }
-        let lo = vs.frame.origin + DVec3::from(v.map(f64::from)) * vs.frame.voxel_size;
-        let mut points: Vec<DVec3> = (0..8)
-            .map(|c| {
-                let corner = DVec3::new(
-                    f64::from(c & 1),
-                    f64::from((c >> 1) & 1),
-                    f64::from((c >> 2) & 1),
-                );
-                lo + corner * vs.frame.voxel_size
-            })
-            .collect();
-        points.push(lo + DVec3::splat(0.5 * vs.frame.voxel_size));
-        for _ in 0..4 {
-            points.push(lo + point(&mut rng, 0.0, 1.0) * vs.frame.voxel_size);
-        }
+        let points = cube_points(vs, v, &mut rng);
         for (k, light) in vs.lights.iter().enumerate() {
             if rec.light(k) != LightVisibility::Visible {
                 continue;
@@ -179,21 +186,7 @@ fn check_occluded_voxels(vs: &VoxelScene, seed: u64) -> usize {
         if !own.iter().all(|&o| vs.objects[o as usize].shape.is_exact()) {
             continue;
         }
-        let lo = vs.frame.origin + DVec3::from(v.map(f64::from)) * vs.frame.voxel_size;
-        let mut points: Vec<DVec3> = (0..8)
-            .map(|c| {
-                let corner = DVec3::new(
-                    f64::from(c & 1),
-                    f64::from((c >> 1) & 1),
-                    f64::from((c >> 2) & 1),
-                );
-                lo + corner * vs.frame.voxel_size
-            })
-            .collect();
-        points.push(lo + DVec3::splat(0.5 * vs.frame.voxel_size));
-        for _ in 0..4 {
-            points.push(lo + point(&mut rng, 0.0, 1.0) * vs.frame.voxel_size);
-        }
+        let points = cube_points(vs, v, &mut rng);
         for (k, light) in vs.lights.iter().enumerate() {
             if rec.light(k) != LightVisibility::Occluded {
                 continue;

@@ -600,10 +600,71 @@ const HALF_DIAGONAL: i128 = 56_756;
 const CLEARANCE_MARGIN: i128 = 256;
 
 /// The least shift that brings `big` below 2^28 (at most 100).
+#[inline(always)]
 fn shift_below_2_28(big: u128) -> u32 {
     128u32
         .saturating_sub(big.leading_zeros())
         .saturating_sub(28)
+}
+
+/// The offsets of a sphere's centre (`w`) and of the light (`u`) from
+/// voxel `v`'s centre.
+#[inline(always)]
+fn offsets(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> ([i128; 3], [i128; 3]) {
+    let c = v.map(voxel_centre);
+    let off = |p: [i64; 3]| -> [i128; 3] {
+        core::array::from_fn(|k| i128::from(p[k]).saturating_sub(i128::from(c[k])))
+    };
+    (off(s.centre), off(light))
+}
+
+/// `w` and `u` shifted right by the least shift that brings every
+/// coordinate of both below 2^28, and that shift.
+#[inline(always)]
+fn shifted(w: [i128; 3], u: [i128; 3]) -> ([i128; 3], [i128; 3], u32) {
+    let big = w
+        .iter()
+        .chain(u.iter())
+        .map(|x| x.unsigned_abs())
+        .max()
+        .unwrap_or(0);
+    let shift = shift_below_2_28(big);
+    (w.map(|x| x >> shift), u.map(|x| x >> shift), shift)
+}
+
+/// The dot product, saturating.
+#[inline(always)]
+fn dot3(a: [i128; 3], b: [i128; 3]) -> i128 {
+    a.iter().zip(b.iter()).fold(0i128, |acc, (x, y)| {
+        acc.saturating_add(x.saturating_mul(*y))
+    })
+}
+
+/// The squared distance from point `w` to the segment from the origin to
+/// `u` against `r2`: [`Ordering::Greater`](core::cmp::Ordering) when it
+/// is larger. Exact for coordinates below 2^28 and `r2` below 2^58.
+#[inline(always)]
+fn segment_distance_cmp(w: [i128; 3], u: [i128; 3], r2: i128) -> core::cmp::Ordering {
+    let (uu, wu) = (dot3(u, u), dot3(w, u));
+    if wu <= 0 {
+        // Nearest the segment's start.
+        return dot3(w, w).cmp(&r2);
+    }
+    if wu >= uu {
+        // Nearest the segment's end.
+        let d = [0, 1, 2].map(|k| w[k].saturating_sub(u[k]));
+        return dot3(d, d).cmp(&r2);
+    }
+    // Within: |w × u|² / |u|² is the squared distance to the line.
+    let x = [
+        w[1].saturating_mul(u[2])
+            .saturating_sub(w[2].saturating_mul(u[1])),
+        w[2].saturating_mul(u[0])
+            .saturating_sub(w[0].saturating_mul(u[2])),
+        w[0].saturating_mul(u[1])
+            .saturating_sub(w[1].saturating_mul(u[0])),
+    ];
+    dot3(x, x).cmp(&r2.saturating_mul(uu))
 }
 
 /// Whether sphere `s` (of positive radius) provably meets no segment from
@@ -623,20 +684,8 @@ fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
     if s.radius <= 0 {
         return false;
     }
-    let c = v.map(voxel_centre);
-    let off = |p: [i64; 3]| -> [i128; 3] {
-        core::array::from_fn(|k| i128::from(p[k]).saturating_sub(i128::from(c[k])))
-    };
-    let (w, u) = (off(s.centre), off(light));
-    let big = w
-        .iter()
-        .chain(u.iter())
-        .map(|x| x.unsigned_abs())
-        .max()
-        .unwrap_or(0);
-    let shift = shift_below_2_28(big);
-    let w = w.map(|x| x >> shift);
-    let u = u.map(|x| x >> shift);
+    let (w, u) = offsets(s, v, light);
+    let (w, u, shift) = shifted(w, u);
     let need = i128::from(s.radius)
         .saturating_add(HALF_DIAGONAL)
         .saturating_add(CLEARANCE_MARGIN);
@@ -647,32 +696,7 @@ fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
     if need >= 1 << 29 {
         return false;
     }
-    let dot = |a: [i128; 3], b: [i128; 3]| -> i128 {
-        a.iter().zip(b.iter()).fold(0i128, |acc, (x, y)| {
-            acc.saturating_add(x.saturating_mul(*y))
-        })
-    };
-    let need2 = need.saturating_mul(need);
-    let (uu, wu) = (dot(u, u), dot(w, u));
-    if wu <= 0 {
-        // Nearest the segment's start.
-        return dot(w, w) > need2;
-    }
-    if wu >= uu {
-        // Nearest the light.
-        let d = [0, 1, 2].map(|k| w[k].saturating_sub(u[k]));
-        return dot(d, d) > need2;
-    }
-    // Within: |w × u|² / |u|² is the squared distance to the line.
-    let x = [
-        w[1].saturating_mul(u[2])
-            .saturating_sub(w[2].saturating_mul(u[1])),
-        w[2].saturating_mul(u[0])
-            .saturating_sub(w[0].saturating_mul(u[2])),
-        w[0].saturating_mul(u[1])
-            .saturating_sub(w[1].saturating_mul(u[0])),
-    ];
-    dot(x, x) > need2.saturating_mul(uu)
+    segment_distance_cmp(w, u, need.saturating_mul(need)).is_gt()
 }
 
 /// What [`sphere_blocks`] keeps between a sphere's surface and the
@@ -708,23 +732,14 @@ fn sphere_blocks(s: &Sphere, v: [u32; 3], light: [i64; 3], dims: [u32; 3]) -> bo
     if inner <= 0 {
         return false;
     }
-    let c = v.map(voxel_centre);
-    let off = |p: [i64; 3]| -> [i128; 3] {
-        core::array::from_fn(|k| i128::from(p[k]).saturating_sub(i128::from(c[k])))
-    };
-    let (w, u) = (off(s.centre), off(light));
-    let dot = |a: [i128; 3], b: [i128; 3]| -> i128 {
-        a.iter().zip(b.iter()).fold(0i128, |acc, (x, y)| {
-            acc.saturating_add(x.saturating_mul(*y))
-        })
-    };
+    let (w, u) = offsets(s, v, light);
     // The cube outside, and the sphere ahead of it towards the light
     // (first: most spheres met in a tube touch the voxel). Unshifted: the
     // products of the offsets (below 2^64) saturate only where the sphere
     // lies far outside the raster, which the next test refuses, and a
     // saturated direction test only refuses.
     let outer = r.saturating_add(HALF_DIAGONAL).saturating_add(BLOCK_MARGIN);
-    if dot(w, w) <= outer.saturating_mul(outer) || dot(w, u) <= 0 {
+    if dot3(w, w) <= outer.saturating_mul(outer) || dot3(w, u) <= 0 {
         return false;
     }
     let reach = r.saturating_add(BLOCK_MARGIN);
@@ -739,41 +754,10 @@ fn sphere_blocks(s: &Sphere, v: [u32; 3], light: [i64; 3], dims: [u32; 3]) -> bo
     if !inside {
         return false;
     }
-    let big = w
-        .iter()
-        .chain(u.iter())
-        .map(|x| x.unsigned_abs())
-        .max()
-        .unwrap_or(0);
-    let shift = shift_below_2_28(big);
-    let w = w.map(|x| x >> shift);
-    let u = u.map(|x| x >> shift);
+    let (w, u, shift) = shifted(w, u);
     // The segment's distance, rounded down, less 4 (shifted units).
     let inner = (inner >> shift).saturating_sub(4);
-    if inner <= 0 {
-        return false;
-    }
-    let inner2 = inner.saturating_mul(inner);
-    let (uu, wu) = (dot(u, u), dot(w, u));
-    if wu <= 0 {
-        // Nearest the segment's start, which lies outside.
-        return false;
-    }
-    if wu >= uu {
-        // Nearest the light.
-        let d = [0, 1, 2].map(|k| w[k].saturating_sub(u[k]));
-        return dot(d, d) < inner2;
-    }
-    // Within: |w × u|² / |u|² is the squared distance to the line.
-    let x = [
-        w[1].saturating_mul(u[2])
-            .saturating_sub(w[2].saturating_mul(u[1])),
-        w[2].saturating_mul(u[0])
-            .saturating_sub(w[0].saturating_mul(u[2])),
-        w[0].saturating_mul(u[1])
-            .saturating_sub(w[1].saturating_mul(u[0])),
-    ];
-    dot(x, x) < inner2.saturating_mul(uu)
+    inner > 0 && segment_distance_cmp(w, u, inner.saturating_mul(inner)).is_lt()
 }
 
 /// Whether one of `objects` outside `own` is a sphere of `blocker` that

@@ -1203,12 +1203,16 @@ fn a_blocking_sphere_stands_on_every_segment_from_the_cube() {
         let centre = if case % 4 == 3 {
             [0; 3].map(|_| rng.range(0, 64 * VOXEL))
         } else {
-            let d: [f64; 3] = core::array::from_fn(|k| (light[k] - c0[k]) as f64);
-            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1.0);
-            let along = rng.range(0, 40 * VOXEL) as f64;
+            // `along` units from the voxel's centre towards the light.
+            let d: [i128; 3] = core::array::from_fn(|k| i128::from(light[k] - c0[k]));
+            let len = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                .unsigned_abs()
+                .isqrt() as i128)
+                .max(1);
+            let along = i128::from(rng.range(0, 40 * VOXEL));
             let jitter = 2 * radius;
             core::array::from_fn(|k| {
-                c0[k] + (d[k] / len * along) as i64 + rng.range(-jitter, jitter + 1)
+                c0[k] + (d[k] * along / len) as i64 + rng.range(-jitter, jitter + 1)
             })
         };
         let s = Sphere { centre, radius };
