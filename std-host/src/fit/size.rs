@@ -76,6 +76,14 @@ pub fn frame(scene: &Scene, opts: &FitOptions) -> Result<RasterFrame, FitError> 
 pub const MIN_DEFAULT_RASTER: u32 = 64;
 /// The most voxels along the longest axis [`default_raster`] picks.
 pub const MAX_DEFAULT_RASTER: u32 = 1024;
+/// Rays per image for each estimated surface voxel of the default raster
+/// ([`default_raster`]): where objects have exact geometry the image is
+/// the same at any raster, and a finer one costs more to voxelize, to
+/// classify for shadows and to walk than its smaller voxels save in
+/// intersection tests, until voxels crowd with objects ([`CROWDING`]).
+/// Set where the whole job (build and render) was fastest on the SPD
+/// scenes (the *whole job* section of `BENCHMARKS.md`).
+pub const RAYS_PER_VOXEL: f64 = 16.0;
 /// The fewest estimated surface voxels per surface primitive
 /// [`default_raster`] accepts, in units of the 8 voxels a tiny primitive's
 /// conservative voxelization takes: with fewer, voxels hold so many
@@ -103,11 +111,11 @@ pub struct RasterNeed<'v> {
 /// Objects with exact geometry are rendered exactly whatever the raster
 /// (verification), so for them the raster is an acceleration structure:
 /// the size is the largest whose estimated surface voxels
-/// ([`SurfaceMeasure::voxels`]) do not exceed the rays per image (more
-/// voxels cost more to build than they save), but at least the size at
-/// which voxels do not crowd ([`CROWDING`]); a scene without surface
-/// primitives (volumes, `.vox` models, CSG only) starts
-/// from [`MIN_DEFAULT_RASTER`]. Where voxels are the picture (the paper's mode;
+/// ([`SurfaceMeasure::voxels`]) do not exceed the rays per image over
+/// [`RAYS_PER_VOXEL`] (more voxels cost more to build and to walk than
+/// they save), but at least the size at which voxels do not crowd
+/// ([`CROWDING`]); a scene without surface primitives (volumes, `.vox`
+/// models, CSG only) starts from [`MIN_DEFAULT_RASTER`]. Where voxels are the picture (the paper's mode;
 /// volumes, `.vox` models and CSG results, which have no exact geometry),
 /// a voxel is in addition no larger than a pixel's footprint at the
 /// scene's nearest point to the eye. With volumes rendered directly, a
@@ -131,7 +139,7 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
     let within = if surface.objects == 0 {
         lo
     } else {
-        last_true(lo, hi, |r| voxels_at(r) <= rays.max(1.0))
+        last_true(lo, hi, |r| voxels_at(r) * RAYS_PER_VOXEL <= rays.max(1.0))
     };
     let crowd = 8.0 * CROWDING * surface.objects as f64;
     let uncrowded = if voxels_at(lo) < crowd {
