@@ -64,7 +64,7 @@ pub(crate) fn table2(ctx: &mut Ctx) -> Res<()> {
         let mut vox2 = Vec::new();
         let mut light2 = Vec::new();
         let mut built = None;
-        for _ in 0..cfg.reps.min(3) {
+        for _ in 0..cfg.reps {
             let b = build_nff(&scene, 256, Connectivity::Adaptive, 1, Some(bounds))?;
             vox.push(b.report.voxelize.as_secs_f64());
             light.push(b.report.lights.as_secs_f64());
