@@ -82,7 +82,8 @@ pub const MAX_DEFAULT_RASTER: u32 = 1024;
 /// classify for shadows and to walk than its smaller voxels save in
 /// intersection tests, until voxels crowd with objects ([`CROWDING`]).
 /// Set where the whole job (build and render) was fastest on the SPD
-/// scenes (the *whole job* section of `BENCHMARKS.md`).
+/// scenes (`BENCHMARKS.md`, *The default raster where objects have exact
+/// geometry*).
 pub const RAYS_PER_VOXEL: f64 = 16.0;
 /// The fewest estimated surface voxels per surface primitive
 /// [`default_raster`] accepts, in units of the 8 voxels a tiny primitive's
