@@ -89,7 +89,12 @@ pub const RAYS_PER_VOXEL: f64 = 16.0;
 /// [`default_raster`] accepts, in units of the 8 voxels a tiny primitive's
 /// conservative voxelization takes: with fewer, voxels hold so many
 /// objects that verifying them costs more than a finer raster saves.
-pub const CROWDING: f64 = 8.0;
+pub const CROWDING: f64 = 4.0;
+/// The most objects [`default_raster`] lets a small primitive share its
+/// voxel with on average ([`clustering`]) where a raster at most twice
+/// as fine brings it there: objects clustered more tightly than the
+/// average over the scene shows (leaves on a tree) get the finer raster.
+pub const CLUSTERING: f64 = 64.0;
 
 /// What a raster is for, to [`default_raster`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,7 +120,8 @@ pub struct RasterNeed<'v> {
 /// ([`SurfaceMeasure::voxels`]) do not exceed the rays per image over
 /// [`RAYS_PER_VOXEL`] (more voxels cost more to build and to walk than
 /// they save), but at least the size at which voxels do not crowd
-/// ([`CROWDING`]); a scene without surface primitives (volumes, `.vox`
+/// ([`CROWDING`]), and finer where small primitives cluster
+/// ([`CLUSTERING`]); a scene without surface primitives (volumes, `.vox`
 /// models, CSG only) starts from [`MIN_DEFAULT_RASTER`]. Where voxels are the picture (the paper's mode;
 /// volumes, `.vox` models and CSG results, which have no exact geometry),
 /// a voxel is in addition no larger than a pixel's footprint at the
@@ -149,6 +155,9 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
         lo
     };
     let mut r = within.max(uncrowded.min(hi));
+    if surface.objects > 0 {
+        r = unclustered(scene, &bounds, |r| longest / inner(r), r, hi);
+    }
     let voxel_objects =
         !(scene.volumes.is_empty() && scene.voxes.is_empty() && scene.csgs.is_empty());
     if need.discrete || voxel_objects {
@@ -170,6 +179,88 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
         }
     }
     r.clamp(lo, hi)
+}
+
+/// The smallest raster size from `r` on, at most `2·r` and `hi`, at which
+/// the clustering of `scene`'s small primitives ([`clustering`], with
+/// voxels of edge `voxel(size)`) is at most [`CLUSTERING`]; `r` where it
+/// already is, or where no such size brings it there (primitives packed
+/// more tightly than any of those rasters resolves, which a finer raster
+/// only makes slower). Sizes are tried in steps of a tenth.
+fn unclustered(
+    scene: &Scene,
+    bounds: &crate::world::Bounds,
+    voxel: impl Fn(u32) -> f64,
+    r: u32,
+    hi: u32,
+) -> u32 {
+    let small = small_primitives(scene);
+    let ok = |size: u32| clustering(&small, bounds.min, voxel(size)) <= CLUSTERING;
+    if small.is_empty() || ok(r) {
+        return r;
+    }
+    let top = r.saturating_mul(2).min(hi);
+    let mut size = r;
+    while size < top {
+        size = size.saturating_add(size.div_ceil(10)).min(top);
+        if ok(size) {
+            return size;
+        }
+    }
+    r
+}
+
+/// The centre and longest side of the box of each of `scene`'s surface
+/// primitives (spheres, cones, the fan triangles of polygons, tori), as
+/// [`SurfaceMeasure`] counts them.
+fn small_primitives(scene: &Scene) -> Vec<(DVec3, f64)> {
+    use crate::shape::Primitive;
+    let of = |b: crate::world::Bounds| (0.5 * (b.min + b.max), (b.max - b.min).max_element());
+    let mut out: Vec<(DVec3, f64)> = Vec::new();
+    out.extend(scene.spheres.iter().map(|o| of(o.shape.bounds())));
+    out.extend(scene.cones.iter().map(|o| of(o.shape.bounds())));
+    for p in &scene.polygons {
+        let v = scene.polygon_vertices(p);
+        let Some(&v0) = v.first() else { continue };
+        for w in v.windows(2).skip(1) {
+            let (lo, hi) = (v0.min(w[0]).min(w[1]), v0.max(w[0]).max(w[1]));
+            out.push((0.5 * (lo + hi), (hi - lo).max_element()));
+        }
+    }
+    out.extend(scene.tori.iter().map(|o| of(o.shape.bounds())));
+    out
+}
+
+/// How many primitives a small one shares its cell with on average
+/// (itself included), over the primitives of `primitives` (box centre,
+/// longest side) at most two voxels long, binned by their centres into
+/// cells of edge `voxel` from `origin`: `Σ n² / Σ n` over the cells, `n`
+/// the small primitives in a cell; 0 without any. Such primitives cover
+/// few voxels, so those that share a cell crowd the same voxels' object
+/// lists.
+fn clustering(primitives: &[(DVec3, f64)], origin: DVec3, voxel: f64) -> f64 {
+    if !(voxel > 0.0 && voxel.is_finite()) {
+        return 0.0;
+    }
+    // Cells of a raster of at most 2^16 voxels a side: 21 bits each.
+    let cell = |x: f64| ((x / voxel).floor().clamp(0.0, f64::from((1u32 << 21) - 1))) as u64;
+    let mut keys: Vec<u64> = primitives
+        .iter()
+        .filter(|&&(_, side)| side <= 2.0 * voxel)
+        .map(|&(c, _)| {
+            let d = c - origin;
+            cell(d.x) | cell(d.y) << 21 | cell(d.z) << 42
+        })
+        .collect();
+    if keys.is_empty() {
+        return 0.0;
+    }
+    keys.sort_unstable();
+    let squares: f64 = keys
+        .chunk_by(|a, b| a == b)
+        .map(|run| (run.len() as f64).powi(2))
+        .sum();
+    squares / keys.len() as f64
 }
 
 /// The largest `r` in `lo..=hi` with `ok(r)` for a predicate true up to
@@ -204,5 +295,67 @@ fn pixel_raster(bounds: &crate::world::Bounds, longest: f64, need: &RasterNeed<'
         MAX_DEFAULT_RASTER
     } else {
         r as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `n³` spheres of radius `radius` on a grid of spacing `spacing`
+    /// about (5, 5, 5), and a sphere of radius 10 about the origin that
+    /// sets the scene's box.
+    fn cluster(n: usize, spacing: f64, radius: f64) -> Scene {
+        let mut s = String::from(
+            "v\nfrom 0 -60 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 64 64\ns 0 0 0 10\n",
+        );
+        for i in 0..n * n * n {
+            let p = [i % n, i / n % n, i / (n * n)].map(|k| 5.0 + spacing * k as f64);
+            s.push_str(&format!("s {} {} {} {radius}\n", p[0], p[1], p[2]));
+        }
+        Scene::parse("cluster.nff", s.as_bytes()).unwrap()
+    }
+
+    #[test]
+    fn clustering_counts_the_small_primitives_sharing_a_cell() {
+        let at = |x: f64, side: f64| (DVec3::splat(x), side);
+        // Four in one cell, one alone: (16 + 1) / 5.
+        let p = [0.1, 0.2, 0.3, 0.4, 5.5].map(|x| at(x, 0.05));
+        assert!((clustering(&p, DVec3::ZERO, 1.0) - 17.0 / 5.0).abs() < 1e-12);
+        // Each in its own cell.
+        assert_eq!(clustering(&p, DVec3::ZERO, 0.09), 1.0);
+        // Primitives over two voxels long do not count.
+        assert_eq!(clustering(&p, DVec3::ZERO, 0.02), 0.0);
+        assert_eq!(clustering(&[], DVec3::ZERO, 1.0), 0.0);
+    }
+
+    /// 729 tiny spheres packed in a box 0.16 across share the voxels of a
+    /// coarse raster of the 20-unit scene; the smallest raster up to twice
+    /// as fine where they share a cell with at most [`CLUSTERING`] is
+    /// chosen, and a cluster no such raster resolves keeps the size.
+    #[test]
+    fn clustered_small_primitives_get_a_finer_raster() {
+        let scene = cluster(9, 0.02, 0.001);
+        let bounds = scene.bounds();
+        let longest = bounds.size().max_element();
+        let voxel = |r: u32| longest / f64::from(r - 2 * DEFAULT_MARGIN);
+        let small = small_primitives(&scene);
+        assert_eq!(small.len(), 730);
+        let m = |r: u32| clustering(&small, bounds.min, voxel(r));
+        assert!(m(100) > CLUSTERING, "{}", m(100));
+        let r = unclustered(&scene, &bounds, voxel, 100, 1024);
+        assert!(r > 100 && r <= 200, "{r}");
+        assert!(m(r) <= CLUSTERING, "{}", m(r));
+        // A size before it in the steps of a tenth is still clustered.
+        assert!(m(r - r.div_ceil(11)) > CLUSTERING || r <= 111, "{r}");
+        // Already fine enough: unchanged.
+        assert_eq!(unclustered(&scene, &bounds, voxel, r, 1024), r);
+        // Packed a thousand times tighter: no raster up to twice as fine
+        // resolves them, so the size stays.
+        let tight = cluster(9, 2e-5, 1e-6);
+        let tb = tight.bounds();
+        assert_eq!(unclustered(&tight, &tb, voxel, 100, 1024), 100);
+        // Never past `hi`.
+        assert!(unclustered(&scene, &bounds, voxel, 100, 120) <= 120);
     }
 }
