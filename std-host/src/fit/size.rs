@@ -90,10 +90,12 @@ pub const RAYS_PER_VOXEL: f64 = 16.0;
 /// conservative voxelization takes: with fewer, voxels hold so many
 /// objects that verifying them costs more than a finer raster saves.
 pub const CROWDING: f64 = 4.0;
-/// The most objects [`default_raster`] lets a small primitive share its
-/// voxel with on average ([`clustering`]) where a raster at most twice
-/// as fine brings it there: objects clustered more tightly than the
-/// average over the scene shows (leaves on a tree) get the finer raster.
+/// The most primitives [`default_raster`] lets a small one (at most two
+/// voxels long) share its voxel-sized cell with on average (`Σ n² / Σ n`
+/// over the cells, `n` the small primitives whose box centre a cell
+/// holds), where a raster at most twice as fine brings it there:
+/// primitives clustered more tightly than the average over the scene
+/// shows (leaves on a tree) get the finer raster.
 pub const CLUSTERING: f64 = 64.0;
 
 /// What a raster is for, to [`default_raster`].
