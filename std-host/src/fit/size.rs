@@ -188,7 +188,9 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
 /// voxels of edge `voxel(size)`) is at most [`CLUSTERING`]; `r` where it
 /// already is, or where no such size brings it there (primitives packed
 /// more tightly than any of those rasters resolves, which a finer raster
-/// only makes slower). Sizes are tried in steps of a tenth.
+/// only makes slower). Sizes are tried in steps of a tenth. Scenes of more
+/// than [`CLUSTER_SAMPLE`] primitives are measured on every `k`-th one
+/// (the least `k` that keeps the sample within it).
 fn unclustered(
     scene: &Scene,
     bounds: &crate::world::Bounds,
@@ -196,9 +198,15 @@ fn unclustered(
     r: u32,
     hi: u32,
 ) -> u32 {
-    let small = small_primitives(scene);
-    let ok = |size: u32| clustering(&small, bounds.min, voxel(size)) <= CLUSTERING;
-    if small.is_empty() || ok(r) {
+    let n = primitive_boxes(scene).count();
+    if n == 0 {
+        return r;
+    }
+    let stride = n.div_ceil(CLUSTER_SAMPLE).max(1);
+    let ok = |size: u32| {
+        clustering(primitive_boxes(scene), stride, bounds.min, voxel(size)) <= CLUSTERING
+    };
+    if ok(r) {
         return r;
     }
     let top = r.saturating_mul(2).min(hi);
@@ -212,44 +220,57 @@ fn unclustered(
     r
 }
 
+/// The most primitives [`clustering`] bins at once (8 MiB of cell keys).
+const CLUSTER_SAMPLE: usize = 1 << 20;
+
 /// The centre and longest side of the box of each of `scene`'s surface
 /// primitives (spheres, cones, the fan triangles of polygons, tori), as
-/// [`SurfaceMeasure`] counts them.
-fn small_primitives(scene: &Scene) -> Vec<(DVec3, f64)> {
+/// [`SurfaceMeasure`] counts them, in that order.
+fn primitive_boxes(scene: &Scene) -> impl Iterator<Item = (DVec3, f64)> + '_ {
     use crate::shape::Primitive;
     let of = |b: crate::world::Bounds| (0.5 * (b.min + b.max), (b.max - b.min).max_element());
-    let mut out: Vec<(DVec3, f64)> = Vec::new();
-    out.extend(scene.spheres.iter().map(|o| of(o.shape.bounds())));
-    out.extend(scene.cones.iter().map(|o| of(o.shape.bounds())));
-    for p in &scene.polygons {
+    let fans = scene.polygons.iter().flat_map(move |p| {
         let v = scene.polygon_vertices(p);
-        let Some(&v0) = v.first() else { continue };
-        for w in v.windows(2).skip(1) {
+        let v0 = v.first().copied().unwrap_or(DVec3::ZERO);
+        v.windows(2).skip(1).map(move |w| {
             let (lo, hi) = (v0.min(w[0]).min(w[1]), v0.max(w[0]).max(w[1]));
-            out.push((0.5 * (lo + hi), (hi - lo).max_element()));
-        }
-    }
-    out.extend(scene.tori.iter().map(|o| of(o.shape.bounds())));
-    out
+            (0.5 * (lo + hi), (hi - lo).max_element())
+        })
+    });
+    scene
+        .spheres
+        .iter()
+        .map(move |o| of(o.shape.bounds()))
+        .chain(scene.cones.iter().map(move |o| of(o.shape.bounds())))
+        .chain(fans)
+        .chain(scene.tori.iter().map(move |o| of(o.shape.bounds())))
 }
 
 /// How many primitives a small one shares its cell with on average
-/// (itself included), over the primitives of `primitives` (box centre,
-/// longest side) at most two voxels long, binned by their centres into
-/// cells of edge `voxel` from `origin`: `Σ n² / Σ n` over the cells, `n`
-/// the small primitives in a cell; 0 without any. Such primitives cover
-/// few voxels, so those that share a cell crowd the same voxels' object
-/// lists.
-fn clustering(primitives: &[(DVec3, f64)], origin: DVec3, voxel: f64) -> f64 {
+/// (itself included), over the primitives `boxes` (box centre, longest
+/// side) at most two voxels long, binned by their centres into cells of
+/// edge `voxel` from `origin`: `m = Σ n² / Σ n` over the cells, `n` the
+/// small primitives in a cell; 0 without any. Such primitives cover few
+/// voxels, so those that share a cell crowd the same voxels' object lists.
+/// With `stride` `k > 1`, only every `k`-th primitive is binned and `m` is
+/// estimated as `1 + k·(m_k − 1)` from the sample's `m_k` (a cell's
+/// sampled count has mean `n/k` and variance about `n/k`).
+fn clustering(
+    boxes: impl Iterator<Item = (DVec3, f64)>,
+    stride: usize,
+    origin: DVec3,
+    voxel: f64,
+) -> f64 {
     if !(voxel > 0.0 && voxel.is_finite()) {
         return 0.0;
     }
+    let stride = stride.max(1);
     // Cells of a raster of at most 2^16 voxels a side: 21 bits each.
     let cell = |x: f64| ((x / voxel).floor().clamp(0.0, f64::from((1u32 << 21) - 1))) as u64;
-    let mut keys: Vec<u64> = primitives
-        .iter()
-        .filter(|&&(_, side)| side <= 2.0 * voxel)
-        .map(|&(c, _)| {
+    let mut keys: Vec<u64> = boxes
+        .step_by(stride)
+        .filter(|&(_, side)| side <= 2.0 * voxel)
+        .map(|(c, _)| {
             let d = c - origin;
             cell(d.x) | cell(d.y) << 21 | cell(d.z) << 42
         })
@@ -262,7 +283,8 @@ fn clustering(primitives: &[(DVec3, f64)], origin: DVec3, voxel: f64) -> f64 {
         .chunk_by(|a, b| a == b)
         .map(|run| (run.len() as f64).powi(2))
         .sum();
-    squares / keys.len() as f64
+    let sampled = squares / keys.len() as f64;
+    1.0 + stride as f64 * (sampled - 1.0)
 }
 
 /// The largest `r` in `lo..=hi` with `ok(r)` for a predicate true up to
@@ -323,12 +345,19 @@ mod tests {
         let at = |x: f64, side: f64| (DVec3::splat(x), side);
         // Four in one cell, one alone: (16 + 1) / 5.
         let p = [0.1, 0.2, 0.3, 0.4, 5.5].map(|x| at(x, 0.05));
-        assert!((clustering(&p, DVec3::ZERO, 1.0) - 17.0 / 5.0).abs() < 1e-12);
+        let m = |voxel: f64| clustering(p.iter().copied(), 1, DVec3::ZERO, voxel);
+        assert!((m(1.0) - 17.0 / 5.0).abs() < 1e-12);
         // Each in its own cell.
-        assert_eq!(clustering(&p, DVec3::ZERO, 0.09), 1.0);
+        assert_eq!(m(0.09), 1.0);
         // Primitives over two voxels long do not count.
-        assert_eq!(clustering(&p, DVec3::ZERO, 0.02), 0.0);
-        assert_eq!(clustering(&[], DVec3::ZERO, 1.0), 0.0);
+        assert_eq!(m(0.02), 0.0);
+        assert_eq!(clustering(std::iter::empty(), 1, DVec3::ZERO, 1.0), 0.0);
+        // Sampled: a thousand in one cell, every tenth binned, estimate
+        // 1 + 10·(100 − 1); a thousand in cells of their own stay at 1.
+        let one = (0..1000).map(|i| (DVec3::splat(f64::from(i) * 1e-4), 1e-5));
+        assert_eq!(clustering(one, 10, DVec3::ZERO, 1.0), 991.0);
+        let apart = (0..1000).map(|i| (DVec3::splat(f64::from(i)), 1e-5));
+        assert_eq!(clustering(apart, 10, DVec3::ZERO, 0.5), 1.0);
     }
 
     /// 729 tiny spheres packed in a box 0.16 across share the voxels of a
@@ -341,9 +370,8 @@ mod tests {
         let bounds = scene.bounds();
         let longest = bounds.size().max_element();
         let voxel = |r: u32| longest / f64::from(r - 2 * DEFAULT_MARGIN);
-        let small = small_primitives(&scene);
-        assert_eq!(small.len(), 730);
-        let m = |r: u32| clustering(&small, bounds.min, voxel(r));
+        assert_eq!(primitive_boxes(&scene).count(), 730);
+        let m = |r: u32| clustering(primitive_boxes(&scene), 1, bounds.min, voxel(r));
         assert!(m(100) > CLUSTERING, "{}", m(100));
         let r = unclustered(&scene, &bounds, voxel, 100, 1024);
         assert!(r > 100 && r <= 200, "{r}");
