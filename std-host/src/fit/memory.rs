@@ -153,15 +153,15 @@ impl SurfaceMeasure {
             let area = PI * (c.shape.base_radius + c.shape.apex_radius) * slant;
             add(area, 2.0 * PI * (c.shape.base_radius + c.shape.apex_radius));
         }
-        for p in &scene.polygons {
-            let v = scene.polygon_vertices(p);
-            let Some(&v0) = v.first() else { continue };
-            for w in v.windows(2).skip(1) {
-                let area = 0.5 * (w[0] - v0).cross(w[1] - v0).length();
-                let perimeter =
-                    (w[0] - v0).length() + (w[1] - w[0]).length() + (v0 - w[1]).length();
-                add(area, perimeter);
-            }
+        for t in scene
+            .polygons
+            .iter()
+            .flat_map(|p| scene.polygon_triangles(p))
+        {
+            let [a, b, c] = t.vertices;
+            let area = 0.5 * (b - a).cross(c - a).length();
+            let perimeter = (b - a).length() + (c - b).length() + (a - c).length();
+            add(area, perimeter);
         }
         for t in &scene.tori {
             let (big, small) = (t.shape.major, t.shape.minor);

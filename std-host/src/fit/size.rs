@@ -157,9 +157,14 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
         lo
     };
     let mut r = within.max(uncrowded.min(hi));
-    if surface.objects > 0 {
-        r = unclustered(scene, &bounds, |r| longest / inner(r), r, hi);
-    }
+    r = unclustered(
+        scene,
+        surface.objects,
+        &bounds,
+        |r| longest / inner(r),
+        r,
+        hi,
+    );
     let voxel_objects =
         !(scene.volumes.is_empty() && scene.voxes.is_empty() && scene.csgs.is_empty());
     if need.discrete || voxel_objects {
@@ -184,7 +189,7 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
 }
 
 /// The smallest raster size from `r` on, at most `2·r` and `hi`, at which
-/// the clustering of `scene`'s small primitives ([`clustering`], with
+/// the clustering of `scene`'s `n` surface primitives' small ones ([`clustering`], with
 /// voxels of edge `voxel(size)`) is at most [`CLUSTERING`]; `r` where it
 /// already is, or where no such size brings it there (primitives packed
 /// more tightly than any of those rasters resolves, which a finer raster
@@ -193,12 +198,12 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
 /// (the least `k` that keeps the sample within it).
 fn unclustered(
     scene: &Scene,
+    n: usize,
     bounds: &crate::world::Bounds,
     voxel: impl Fn(u32) -> f64,
     r: u32,
     hi: u32,
 ) -> u32 {
-    let n = primitive_boxes(scene).count();
     if n == 0 {
         return r;
     }
@@ -229,14 +234,10 @@ const CLUSTER_SAMPLE: usize = 1 << 20;
 fn primitive_boxes(scene: &Scene) -> impl Iterator<Item = (DVec3, f64)> + '_ {
     use crate::shape::Primitive;
     let of = |b: crate::world::Bounds| (0.5 * (b.min + b.max), (b.max - b.min).max_element());
-    let fans = scene.polygons.iter().flat_map(move |p| {
-        let v = scene.polygon_vertices(p);
-        let v0 = v.first().copied().unwrap_or(DVec3::ZERO);
-        v.windows(2).skip(1).map(move |w| {
-            let (lo, hi) = (v0.min(w[0]).min(w[1]), v0.max(w[0]).max(w[1]));
-            (0.5 * (lo + hi), (hi - lo).max_element())
-        })
-    });
+    let fans = scene
+        .polygons
+        .iter()
+        .flat_map(move |p| scene.polygon_triangles(p).map(move |t| of(t.bounds())));
     scene
         .spheres
         .iter()
@@ -370,22 +371,23 @@ mod tests {
         let bounds = scene.bounds();
         let longest = bounds.size().max_element();
         let voxel = |r: u32| longest / f64::from(r - 2 * DEFAULT_MARGIN);
-        assert_eq!(primitive_boxes(&scene).count(), 730);
+        let n = SurfaceMeasure::of(&scene).objects;
+        assert_eq!((n, primitive_boxes(&scene).count()), (730, 730));
         let m = |r: u32| clustering(primitive_boxes(&scene), 1, bounds.min, voxel(r));
         assert!(m(100) > CLUSTERING, "{}", m(100));
-        let r = unclustered(&scene, &bounds, voxel, 100, 1024);
+        let r = unclustered(&scene, n, &bounds, voxel, 100, 1024);
         assert!(r > 100 && r <= 200, "{r}");
         assert!(m(r) <= CLUSTERING, "{}", m(r));
         // A size before it in the steps of a tenth is still clustered.
         assert!(m(r - r.div_ceil(11)) > CLUSTERING || r <= 111, "{r}");
         // Already fine enough: unchanged.
-        assert_eq!(unclustered(&scene, &bounds, voxel, r, 1024), r);
+        assert_eq!(unclustered(&scene, n, &bounds, voxel, r, 1024), r);
         // Packed a thousand times tighter: no raster up to twice as fine
         // resolves them, so the size stays.
         let tight = cluster(9, 2e-5, 1e-6);
         let tb = tight.bounds();
-        assert_eq!(unclustered(&tight, &tb, voxel, 100, 1024), 100);
+        assert_eq!(unclustered(&tight, n, &tb, voxel, 100, 1024), 100);
         // Never past `hi`.
-        assert!(unclustered(&scene, &bounds, voxel, 100, 120) <= 120);
+        assert!(unclustered(&scene, n, &bounds, voxel, 100, 120) <= 120);
     }
 }
