@@ -33,7 +33,8 @@ pub struct RasterArgs {
     /// Voxels along the scene's longest axis, 5 to 65536 (two voxels of
     /// margin on each side) [default: fitted to the scene and the image,
     /// 64 to 1024: one surface voxel per 16 rays of the image, more where
-    /// voxels would crowd with objects or small objects cluster; at least
+    /// voxels would crowd with objects (adding at most two per ray) or
+    /// small objects cluster; at least
     /// a pixel's footprint where voxels are
     /// the picture (the paper's mode, volumes, .vox models, CSG)].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(MIN_RASTER..=MAX_RASTER))]

@@ -90,6 +90,12 @@ pub const RAYS_PER_VOXEL: f64 = 16.0;
 /// conservative voxelization takes: with fewer, voxels hold so many
 /// objects that verifying them costs more than a finer raster saves.
 pub const CROWDING: f64 = 4.0;
+/// The most estimated surface voxels per ray of the image, beyond those
+/// of [`MIN_DEFAULT_RASTER`] (the few every object takes however coarse
+/// the raster), that the crowding floor ([`CROWDING`]) adds: beyond,
+/// building the raster costs more than the render saves on voxels with
+/// fewer objects (scenes of tens of thousands of small primitives).
+pub const MAX_VOXELS_PER_RAY: f64 = 2.0;
 /// The most primitives [`default_raster`] lets a small one (at most two
 /// voxels long) share its voxel-sized cell with on average (`Σ n² / Σ n`
 /// over the cells, `n` the small primitives whose box centre a cell
@@ -122,7 +128,8 @@ pub struct RasterNeed<'v> {
 /// ([`SurfaceMeasure::voxels`]) do not exceed the rays per image over
 /// [`RAYS_PER_VOXEL`] (more voxels cost more to build and to walk than
 /// they save), but at least the size at which voxels do not crowd
-/// ([`CROWDING`]), and finer where small primitives cluster
+/// ([`CROWDING`]) while that adds at most [`MAX_VOXELS_PER_RAY`]
+/// estimated surface voxels per ray, and finer where small primitives cluster
 /// ([`CLUSTERING`]); a scene without surface primitives (volumes, `.vox`
 /// models, CSG only) starts from [`MIN_DEFAULT_RASTER`]. Where voxels are the picture (the paper's mode;
 /// volumes, `.vox` models and CSG results, which have no exact geometry),
@@ -142,21 +149,28 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
     let [w, h] = need.image.map(f64::from);
     let rays = w * h * f64::from(need.samples).powi(2);
     let (lo, hi) = (MIN_DEFAULT_RASTER, MAX_DEFAULT_RASTER);
-    // The largest size within the ray budget, and the smallest that does
-    // not crowd (both monotone in the size: bisect). Without surface
-    // primitives there is nothing for the raster to accelerate.
+    // The largest size within the ray budget, the smallest that does not
+    // crowd, and the largest within the build budget (all monotone in the
+    // size: bisect). Without surface primitives there is nothing for the
+    // raster to accelerate.
     let within = if surface.objects == 0 {
         lo
     } else {
         last_true(lo, hi, |r| voxels_at(r) * RAYS_PER_VOXEL <= rays.max(1.0))
     };
+    // Voxels beyond those of the smallest raster (the ones every object
+    // takes however coarse the raster), per ray.
+    let least = voxels_at(lo);
+    let built = last_true(lo, hi, |r| {
+        voxels_at(r) - least <= MAX_VOXELS_PER_RAY * rays.max(1.0)
+    });
     let crowd = 8.0 * CROWDING * surface.objects as f64;
     let uncrowded = if voxels_at(lo) < crowd {
         last_true(lo, hi, |r| voxels_at(r) < crowd).saturating_add(1)
     } else {
         lo
     };
-    let mut r = within.max(uncrowded.min(hi));
+    let mut r = within.max(uncrowded.min(hi).min(built));
     r = unclustered(
         scene,
         surface.objects,
@@ -339,6 +353,44 @@ mod tests {
             s.push_str(&format!("s {} {} {} {radius}\n", p[0], p[1], p[2]));
         }
         Scene::parse("cluster.nff", s.as_bytes()).unwrap()
+    }
+
+    /// 27,000 spheres of radius 0.2 one unit apart: the crowding floor
+    /// wants 864,000 estimated surface voxels. A 256² image lets it add at
+    /// most [`MAX_VOXELS_PER_RAY`] per ray to those of the smallest
+    /// raster, so the raster is the largest within that; a 1024² image
+    /// allows more, and the crowding floor decides.
+    #[test]
+    fn the_crowding_floor_stops_at_the_build_budget() {
+        let mut text = String::from(
+            "v\nfrom 15 -80 15\nat 15 15 15\nup 0 0 1\nangle 40\nhither 1\nresolution 64 64\n",
+        );
+        for i in 0..27_000 {
+            let p = [i % 30, i / 30 % 30, i / 900].map(f64::from);
+            text.push_str(&format!("s {} {} {} 0.2\n", p[0], p[1], p[2]));
+        }
+        let scene = Scene::parse("grid.nff", text.as_bytes()).unwrap();
+        let longest = scene.bounds().size().max_element();
+        let surface = SurfaceMeasure::of(&scene);
+        let voxels = |r: u32| surface.voxels(longest / f64::from(r - 2 * DEFAULT_MARGIN));
+        let crowd = 8.0 * CROWDING * surface.objects as f64;
+        let size = |side: u32| {
+            let need = RasterNeed {
+                view: &scene.view,
+                image: [side, side],
+                samples: 1,
+                discrete: false,
+            };
+            (default_raster(&scene, &need), f64::from(side * side))
+        };
+        let added = |r: u32| voxels(r) - voxels(MIN_DEFAULT_RASTER);
+        let (r, rays) = size(256);
+        assert!(added(r) <= MAX_VOXELS_PER_RAY * rays, "{r}");
+        assert!(added(r + 1) > MAX_VOXELS_PER_RAY * rays, "{r}");
+        assert!(voxels(r) < crowd, "{r}");
+        let (r, rays) = size(1024);
+        assert!(voxels(r) >= crowd && voxels(r - 1) < crowd, "{r}");
+        assert!(added(r) <= MAX_VOXELS_PER_RAY * rays, "{r}");
     }
 
     #[test]
