@@ -165,7 +165,7 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
         voxels_at(r) - least <= MAX_VOXELS_PER_RAY * rays.max(1.0)
     });
     let crowd = 8.0 * CROWDING * surface.objects as f64;
-    let uncrowded = if voxels_at(lo) < crowd {
+    let uncrowded = if least < crowd {
         last_true(lo, hi, |r| voxels_at(r) < crowd).saturating_add(1)
     } else {
         lo

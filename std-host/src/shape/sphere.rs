@@ -135,18 +135,35 @@ impl Sphere {
 /// non-finite, nor scales near overflow or underflow.
 #[inline]
 fn clearly_misses(oc: DVec3, dir: DVec3, radius: f64) -> bool {
+    products(oc, dir).is_some_and(|p| {
+        // |oc × dir|² = |oc|²|dir|² − (oc·dir)²: the squared distance times |dir|².
+        let perp = p.scale - p.b * p.b;
+        let r2 = radius * radius * p.dd;
+        perp - r2 > p.scale * (1.0 / 4_294_967_296.0)
+    })
+}
+
+/// The products both early refusals read: `|dir|²`, `oc·dir`, `|oc|²`
+/// and `scale = |oc|²·|dir|²`; `None` unless the scale lies far from
+/// overflow and from subnormals, where their rounding bounds hold.
+struct Products {
+    dd: f64,
+    b: f64,
+    oo: f64,
+    scale: f64,
+}
+
+#[inline]
+fn products(oc: DVec3, dir: DVec3) -> Option<Products> {
     let dd = dir.length_squared();
-    let b = oc.dot(dir);
     let oo = oc.length_squared();
-    // |oc × dir|² = |oc|²|dir|² − (oc·dir)²: the squared distance times |dir|².
     let scale = oo * dd;
-    // Far from overflow and from subnormals, where the rounding bound holds.
-    if !(scale > 1e-200 && scale < 1e200) {
-        return false;
-    }
-    let perp = scale - b * b;
-    let r2 = radius * radius * dd;
-    perp - r2 > scale * (1.0 / 4_294_967_296.0)
+    (scale > 1e-200 && scale < 1e200).then(|| Products {
+        dd,
+        b: oc.dot(dir),
+        oo,
+        scale,
+    })
 }
 
 /// Whether the sphere of `radius` about `centre` lies behind the origin
@@ -162,16 +179,11 @@ fn clearly_misses(oc: DVec3, dir: DVec3, radius: f64) -> bool {
 /// non-finite is refused, nor scales near overflow or underflow.
 #[inline]
 fn clearly_behind(oc: DVec3, dir: DVec3, radius: f64) -> bool {
-    let dd = dir.length_squared();
-    let b = oc.dot(dir);
-    let oo = oc.length_squared();
-    let scale = oo * dd;
-    if !(scale > 1e-200 && scale < 1e200) {
-        return false;
-    }
-    b > 0.0
-        && b * b > scale * (1.0 / 1_208_925_819_614_629_174_706_176.0)
-        && oo > radius * radius * (1.0 + 1.0 / 1_073_741_824.0)
+    products(oc, dir).is_some_and(|p| {
+        p.b > 0.0
+            && p.b * p.b > p.scale * (1.0 / 1_208_925_819_614_629_174_706_176.0)
+            && p.oo > radius * radius * (1.0 + 1.0 / 1_073_741_824.0)
+    })
 }
 
 impl SolidPrimitive for Sphere {
@@ -206,6 +218,14 @@ mod tests {
         fn vec(&mut self, scale: f64) -> DVec3 {
             DVec3::new(self.unit() - 0.5, self.unit() - 0.5, self.unit() - 0.5) * (2.0 * scale)
         }
+        /// A sphere about the origin's neighbourhood at scale 2^-20 to
+        /// 2^20, by `i`.
+        fn sphere(&mut self, i: u32) -> (Sphere, f64) {
+            let scale = 2f64.powi((i % 41) as i32 - 20);
+            let centre = self.vec(scale * 4.0);
+            let radius = scale * (0.01 + self.unit());
+            (Sphere { centre, radius }, scale)
+        }
     }
 
     /// The early refusal changes no answer: on random rays, near-tangent
@@ -217,11 +237,7 @@ mod tests {
         let mut rng = Rng(7);
         let (mut refused, mut misses) = (0u32, 0u32);
         for i in 0..200_000u32 {
-            let scale = 2f64.powi((i % 41) as i32 - 20);
-            let s = Sphere {
-                centre: rng.vec(scale * 4.0),
-                radius: scale * (0.01 + rng.unit()),
-            };
+            let (s, scale) = rng.sphere(i);
             let origin = s.centre + rng.vec(scale * 8.0);
             let dir = if i % 3 == 0 {
                 // Towards a point of the surface, grazing it.
@@ -255,11 +271,7 @@ mod tests {
         let mut rng = Rng(11);
         let (mut refused, mut away) = (0u32, 0u32);
         for i in 0..300_000u32 {
-            let scale = 2f64.powi((i % 41) as i32 - 20);
-            let s = Sphere {
-                centre: rng.vec(scale * 4.0),
-                radius: scale * (0.01 + rng.unit()),
-            };
+            let (s, scale) = rng.sphere(i);
             let normal = rng.vec(1.0).normalize_or(DVec3::Z);
             let lift = match i % 4 {
                 0 => 0.0,
