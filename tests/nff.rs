@@ -253,14 +253,13 @@ fn transmitting_material_and_patch() {
     );
 }
 
-/// The fan of a non-convex polygon folds back where the outline turns
-/// clockwise as seen from vertex 0 (as the teeth of the SPD gears do);
-/// every fan triangle still winds like the polygon, so refraction enters
-/// and leaves the same way on all of it, and the triangles cover the fan's
-/// points (vertex 0, `t + 1`, `t + 2`) with the patch normals swapped
-/// along with their vertices.
+/// A non-convex polygon (as the teeth of the SPD gears make their faces)
+/// is the region its outline bounds: its triangles are that region's ears,
+/// not the fan from vertex 0 (which folds back at the notches and covers
+/// them), each winding like the polygon, so refraction enters and leaves
+/// the same way on all of it, with the patch normals of its vertices.
 #[test]
-fn fan_triangles_wind_like_their_polygon() {
+fn non_convex_polygons_are_their_ears() {
     // A comb in the plane z = 0, counter-clockwise from above (+z): the
     // fan from vertex 0 folds at the notches.
     let outline = [
@@ -293,16 +292,16 @@ fn fan_triangles_wind_like_their_polygon() {
         let v = s.polygon_vertices(p);
         let tris: Vec<_> = s.polygon_triangles(p).collect();
         assert_eq!(tris.len(), outline.len() - 2);
-        let mut swapped = 0;
+        let mut area = 0.0;
         for (t, tri) in tris.iter().enumerate() {
             let [a, b, c] = tri.vertices;
-            assert!((b - a).cross(c - a).z > 0.0, "triangle {t} winds clockwise");
-            assert_eq!(a, v[0]);
-            let fan = [v[t + 1], v[t + 2]];
-            if [b, c] != fan {
-                assert_eq!([c, b], fan, "triangle {t}: not the fan's points");
-                swapped += 1;
-            }
+            let twice = (b - a).cross(c - a).z;
+            assert!(twice > 0.0, "triangle {t} winds clockwise");
+            area += twice / 2.0;
+            // Inside the comb: not in a notch (above y = 1 between its teeth).
+            let m = (a + b + c) / 3.0;
+            let notch = m.y > 1.0 && ((0.5..1.0).contains(&m.x) || (2.0..3.0).contains(&m.x));
+            assert!(!notch, "triangle {t} covers a notch");
             if let Some(n) = tri.normals {
                 for (vertex, normal) in tri.vertices.iter().zip(n) {
                     let k = v.iter().position(|w| w == vertex).unwrap();
@@ -312,11 +311,39 @@ fn fan_triangles_wind_like_their_polygon() {
                 assert!(!patch);
             }
         }
-        assert!(swapped > 0, "the comb's fan folds back somewhere");
+        // The comb's area: 4 × 1 below its teeth, and its teeth 0.5 + 1 + 1 wide and 2 high.
+        assert!(
+            (area - 9.0).abs() < 1e-12,
+            "the triangles cover {area}, not the comb's 9"
+        );
     }
 }
 
 // ------------------------------------------------------------- bad input
+
+/// A non-convex polygon of more than 65536 vertices is refused at its
+/// vertex count (cutting it into ears would cost time and memory that grow
+/// with it); a convex one of that size is its fan.
+#[test]
+fn huge_non_convex_polygons_are_refused_at_their_count() {
+    let n = rrt_host::scene::polygon::MAX_NONCONVEX_VERTICES + 4;
+    let outline = |teeth: bool| {
+        let mut src = format!("f 1 1 1 0.2 0.3 20 0 0\np {n}\n");
+        for k in 0..n {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            let r = if teeth && k % 2 == 0 { 0.8 } else { 1.0 };
+            src += &format!("{} {} 0\n", r * a.cos(), r * a.sin());
+        }
+        src
+    };
+    assert_eq!(
+        err_body(&outline(true)),
+        "scene.nff:9:3: polygon vertex count: non-convex, with more than 65536 vertices (the \
+         most a non-convex polygon may have): split it into smaller polygons"
+    );
+    let s = ok(&format!("{HEAD}{}", outline(false)));
+    assert_eq!(s.polygon_triangles(&s.polygons[0]).count(), n - 2);
+}
 
 #[test]
 fn negative_radius_names_file_line_field() {

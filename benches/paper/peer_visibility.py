@@ -8,8 +8,9 @@ and linear 8-bit output (`rrt render SCENE -o OURS.ppm --linear`,
 `embree_nff -o PEER.ppm SCENE`). For every pixel where the two differ by
 more than `--threshold` levels in some channel and exactly one of them
 shows the background, the pixel's primary ray is cast in double precision
-against every sphere, open cone and polygon (split into fans, as both
-renderers split them), and the render that agrees with it on whether the
+against every sphere, open cone and polygon (the region its outline
+bounds, by the even-odd rule, non-convex ones too), and the render that
+agrees with it on whether the
 ray hits anything is counted right. The PSNR of OURS against PEER is
 printed as is and with those pixels of PEER replaced by OURS where the
 double-precision ray sides with OURS. Needs numpy.
@@ -45,7 +46,7 @@ def read_ppm(path):
 
 
 def read_nff(path):
-    view, spheres, cones, tris, bg = {}, [], [], [], (0.0, 0.0, 0.0)
+    view, spheres, cones, tris, outlines, bg = {}, [], [], [], [], (0.0, 0.0, 0.0)
     lines = open(path).read().split("\n")
     i = 0
     while i < len(lines):
@@ -73,11 +74,48 @@ def read_nff(path):
             n = int(t[1])
             vs = [[float(x) for x in lines[i + j].split()[:3]] for j in range(n)]
             i += n
-            tris += [(vs[0], vs[j], vs[j + 1]) for j in range(1, n - 1)]
-    return view, np.array(spheres).reshape(-1, 4), np.array(cones).reshape(-1, 8), np.array(tris).reshape(-1, 3, 3), bg
+            if n == 3:
+                tris.append(vs)
+            else:
+                outlines.append(np.array(vs))
+    return (
+        view,
+        np.array(spheres).reshape(-1, 4),
+        np.array(cones).reshape(-1, 8),
+        np.array(tris).reshape(-1, 3, 3),
+        outlines,
+        bg,
+    )
 
 
-def hits(o, d, spheres, cones, tris):
+def meets_outline(o, d, v):
+    """Whether the ray o + t d, t > 0, meets the polygon v (its plane by
+    Newell's normal; inside by the even-odd rule in the plane across the
+    normal's largest component)."""
+    w = np.roll(v, -1, axis=0)
+    n = np.array([
+        ((v[:, 1] - w[:, 1]) * (v[:, 2] + w[:, 2])).sum(),
+        ((v[:, 2] - w[:, 2]) * (v[:, 0] + w[:, 0])).sum(),
+        ((v[:, 0] - w[:, 0]) * (v[:, 1] + w[:, 1])).sum(),
+    ])
+    dn = d @ n
+    if dn == 0:
+        return False
+    t = ((v[0] - o) @ n) / dn
+    if t <= 1e-9:
+        return False
+    k = int(np.argmax(np.abs(n)))
+    i, j = [a for a in range(3) if a != k]
+    p = o + t * d
+    x, y = v[:, i], v[:, j]
+    xn, yn = w[:, i], w[:, j]
+    crosses = (y > p[j]) != (yn > p[j])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        at = x + (p[j] - y) * (xn - x) / (yn - y)
+    return bool(np.count_nonzero(crosses & (p[i] < at)) % 2)
+
+
+def hits(o, d, spheres, cones, tris, outlines):
     """Whether the ray o + t d, t > 0, meets any primitive."""
     if len(spheres):
         oc = o - spheres[:, :3]
@@ -121,7 +159,7 @@ def hits(o, d, spheres, cones, tris):
             t = (q * e2).sum(1) * inv
         if np.any((det != 0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-9)):
             return True
-    return False
+    return any(meets_outline(o, d, v) for v in outlines)
 
 
 def psnr(a, b):
@@ -136,7 +174,7 @@ def main():
     ap.add_argument("peer")
     ap.add_argument("--threshold", type=int, default=8)
     args = ap.parse_args()
-    view, spheres, cones, tris, bg = read_nff(args.scene)
+    view, spheres, cones, tris, outlines, bg = read_nff(args.scene)
     ours, peer = read_ppm(args.ours), read_ppm(args.peer)
     if ours.shape != peer.shape:
         sys.exit("the two images differ in size")
@@ -158,7 +196,7 @@ def main():
             counts["both hit"] += not a
             continue
         d = fwd + right * ((x - (w - 1) * 0.5) * pitch) + up * (((h - 1) * 0.5 - y) * pitch)
-        hit = hits(o, d / np.linalg.norm(d), spheres, cones, tris)
+        hit = hits(o, d / np.linalg.norm(d), spheres, cones, tris, outlines)
         if hit != a:
             counts["ours"] += 1
             fixed[y, x] = ours[y, x]

@@ -131,7 +131,7 @@ pub struct SurfaceMeasure {
 }
 
 impl SurfaceMeasure {
-    /// The measure of `scene`'s spheres, cones, polygons (as their fan
+    /// The measure of `scene`'s spheres, cones, polygons (as their
     /// triangles) and tori; volumes, `.vox` models and CSG trees are not
     /// counted.
     #[must_use]

@@ -10,7 +10,7 @@
 //!
 //! [`fit`] then converts every object to the core's fixed-point geometry
 //! ([`rrt_core::geometry`]: positions in 1/65536 voxel, unit normals
-//! scaled by 2^30): spheres, triangles (polygons fan-triangulated, `pp`
+//! scaled by 2^30): spheres, triangles (polygons cut into triangles, `pp`
 //! patches with their vertex normals normalised) and open cones; and
 //! every light to a fixed-point position (lights may lie outside the
 //! raster). [`RasterFrame`] keeps the mapping both ways.

@@ -243,12 +243,12 @@ fn unclustered(
 const CLUSTER_SAMPLE: usize = 1 << 20;
 
 /// The centre and longest side of the box of each of `scene`'s surface
-/// primitives (spheres, cones, the fan triangles of polygons, tori), as
+/// primitives (spheres, cones, the triangles of polygons, tori), as
 /// [`SurfaceMeasure`] counts them, in that order.
 fn primitive_boxes(scene: &Scene) -> impl Iterator<Item = (DVec3, f64)> + '_ {
     use crate::shape::Primitive;
     let of = |b: crate::world::Bounds| (0.5 * (b.min + b.max), (b.max - b.min).max_element());
-    let fans = scene
+    let triangles = scene
         .polygons
         .iter()
         .flat_map(move |p| scene.polygon_triangles(p).map(move |t| of(t.bounds())));
@@ -257,7 +257,7 @@ fn primitive_boxes(scene: &Scene) -> impl Iterator<Item = (DVec3, f64)> + '_ {
         .iter()
         .map(move |o| of(o.shape.bounds()))
         .chain(scene.cones.iter().map(move |o| of(o.shape.bounds())))
-        .chain(fans)
+        .chain(triangles)
         .chain(scene.tori.iter().map(move |o| of(o.shape.bounds())))
 }
 

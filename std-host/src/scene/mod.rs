@@ -31,6 +31,7 @@ pub mod nff;
 pub mod obj;
 pub mod objects;
 pub mod path;
+pub mod polygon;
 pub(crate) mod text;
 pub mod toml;
 
@@ -413,27 +414,18 @@ impl Scene {
         Bounds::around(self.polygon_vertices(polygon).iter().copied())
     }
 
-    /// The triangles of `polygon`'s fan: vertices 0, `t + 1`, `t + 2` for
-    /// each `t`, with the patch's vertex normals (as written) for a `pp`.
-    /// Each triangle winds like the polygon (its normal on the side of the
-    /// polygon's Newell normal): where the fan of a non-convex polygon
-    /// folds back, the triangle's last two vertices are swapped, so every
-    /// triangle of one polygon has the polygon's orientation, which decides
-    /// whether a refracted ray enters or leaves.
+    /// The triangles of `polygon` ([`polygon`]): the fan from
+    /// vertex 0 where it covers the polygon exactly once (every convex
+    /// polygon), else the polygon cut into ears; each triangle winds like
+    /// the polygon (its normal on the side of the polygon's Newell normal),
+    /// which decides whether a refracted ray enters or leaves, with the
+    /// patch's vertex normals (as written) for a `pp`.
     pub fn polygon_triangles(&self, polygon: &Polygon) -> impl Iterator<Item = Triangle> + '_ {
         let v = self.polygon_vertices(polygon);
         let n = self.polygon_normals(polygon);
-        let newell = newell_normal(v);
-        (0..v.len().saturating_sub(2)).map(move |t| {
-            let mut idx = [0, t + 1, t + 2];
-            let [a, b, c] = idx.map(|k| v[k]);
-            if (b - a).cross(c - a).dot(newell) < 0.0 {
-                idx.swap(1, 2);
-            }
-            Triangle {
-                vertices: idx.map(|k| v[k]),
-                normals: n.and_then(|n| Some([*n.get(idx[0])?, *n.get(idx[1])?, *n.get(idx[2])?])),
-            }
+        polygon::triangles(v).map(move |idx| Triangle {
+            vertices: idx.map(|k| v[k]),
+            normals: n.and_then(|n| Some([*n.get(idx[0])?, *n.get(idx[1])?, *n.get(idx[2])?])),
         })
     }
 
@@ -461,7 +453,8 @@ impl Scene {
             && self.csgs.is_empty()
     }
 
-    /// Number of triangles after fan-triangulating every polygon.
+    /// Number of triangles of every polygon: `n − 2` for `n` vertices (ear
+    /// clipping may leave out triangles without area).
     #[must_use]
     pub fn triangle_count(&self) -> usize {
         self.polygons
@@ -502,22 +495,6 @@ impl Scene {
         }
         b
     }
-}
-
-/// The polygon's normal by Newell's method (twice its area vector): the
-/// side its vertices wind counter-clockwise about, for a non-convex
-/// polygon too; zero for a polygon without area.
-fn newell_normal(v: &[DVec3]) -> DVec3 {
-    v.iter()
-        .zip(v.iter().cycle().skip(1))
-        .map(|(a, b)| {
-            DVec3::new(
-                (a.y - b.y) * (a.z + b.z),
-                (a.z - b.z) * (a.x + b.x),
-                (a.x - b.x) * (a.y + b.y),
-            )
-        })
-        .sum()
 }
 
 /// What the file at `path` is, and how a TOML scene draws it (naming it

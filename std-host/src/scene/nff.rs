@@ -734,6 +734,7 @@ impl<'a> Parser<'a> {
             u64::MAX,
         )?;
         self.expect_eol(count_field)?;
+        let count_loc = self.loc_at(count_tok.at);
         // Refuse before allocating: each vertex takes a line.
         let remaining = self.remaining_lines();
         if count > remaining {
@@ -785,6 +786,14 @@ impl<'a> Parser<'a> {
             self.expect_eol(vertex_field)?;
             self.scene.vertices.push(v);
             self.scene.normals.push(normal);
+        }
+        let vertices = self.scene.vertices.get(first..).unwrap_or_default();
+        if let Err(problem) = super::polygon::check(vertices) {
+            return Err(SceneError::Invalid {
+                loc: count_loc,
+                field: count_field,
+                problem,
+            });
         }
         let material = self.current_material();
         self.scene.polygons.push(Polygon {

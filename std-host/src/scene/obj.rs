@@ -1,6 +1,8 @@
 //! Triangle meshes from Wavefront OBJ files, read with the `tobj` crate.
 //!
-//! Faces are triangulated (fans), points and lines are ignored, and
+//! Faces are cut into triangles as NFF polygons are
+//! ([`super::polygon`]: the fan of a convex face, the ears of a non-convex
+//! one), points and lines are ignored, and
 //! per-vertex normals (`vn`) are kept when every face gives them. A UTF-8
 //! byte-order mark at the start of the file is skipped (columns on the
 //! first line count from after it, as editors show them). Groups,
@@ -15,7 +17,8 @@
 //! may name elements defined later, but before the face's object ends at
 //! the next `o` or `g` line, where tobj resolves its faces), which tobj
 //! reports without a location, or at the line that ends the object; that every face (`f`) has at least three
-//! vertices (tobj takes shorter ones for points and lines and drops them);
+//! vertices (tobj takes shorter ones for points and lines and drops them)
+//! and at most [`MAX_FACE_VERTICES`];
 //! and that every vertex (`v`, including `x y z` divided by a weight `w`)
 //! and normal (`vn`) coordinate is finite in single precision, in which
 //! tobj stores them (so `1e308` is out of range, `nan` not finite). tobj
@@ -35,6 +38,9 @@ use glam::DVec3;
 use super::error::SceneError;
 use super::loc::SourceLoc;
 use super::text::{read_text, without_bom};
+
+/// The most vertices a face may have.
+pub const MAX_FACE_VERTICES: usize = super::polygon::MAX_NONCONVEX_VERTICES;
 
 /// Largest OBJ file read, in bytes.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
@@ -223,6 +229,9 @@ fn prescan(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
                     0 => Some("a face needs at least 3 vertices, found none"),
                     1 => Some("a face needs at least 3 vertices, found 1"),
                     2 => Some("a face needs at least 3 vertices, found 2"),
+                    n if n > MAX_FACE_VERTICES => Some(
+                        "more than 65536 vertices (the most a face may have): split it into smaller faces",
+                    ),
                     _ => None,
                 };
                 if let Some(problem) = few {
@@ -324,7 +333,8 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
     };
     let options = tobj::LoadOptions {
         single_index: true,
-        triangulate: true,
+        // Faces are cut into triangles here, as NFF polygons are.
+        triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
@@ -374,7 +384,15 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
         let m = &m.mesh;
         let base = mesh.positions.len();
         let count = m.positions.len() / 3;
-        if mesh.triangles.len() + m.indices.len() / 3 > MAX_TRIANGLES {
+        // Every face has 3 to MAX_FACE_VERTICES vertices (`prescan`); tobj
+        // gives no arities when all are triangles.
+        let arities: Vec<usize> = if m.face_arities.is_empty() {
+            vec![3; m.indices.len() / 3]
+        } else {
+            m.face_arities.iter().map(|&k| k as usize).collect()
+        };
+        let triangles: usize = arities.iter().map(|k| k.saturating_sub(2)).sum();
+        if mesh.triangles.len() + triangles > MAX_TRIANGLES {
             return Err(SceneError::Invalid {
                 loc: SourceLoc::new(Arc::clone(&file), 1, 1),
                 field: "OBJ",
@@ -404,13 +422,27 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
         } else {
             mesh.normals = None;
         }
-        for t in m.indices.chunks_exact(3) {
-            let idx = [t[0], t[1], t[2]];
-            if idx.iter().any(|&i| i as usize >= count) {
+        let mut first = 0usize;
+        let mut face = Vec::new();
+        for k in arities {
+            let idx = m.indices.get(first..first + k).unwrap_or_default();
+            first += k;
+            if idx.len() != k || idx.iter().any(|&i| i as usize >= count) {
                 return Err(invalid(&file, 1, 1, "face", "index out of range"));
             }
-            let off = |i: u32| u32::try_from(base + i as usize).unwrap_or(u32::MAX);
-            mesh.triangles.push(idx.map(off));
+            let global = |i: u32| base + i as usize;
+            face.clear();
+            face.extend(
+                idx.iter()
+                    .filter_map(|&i| mesh.positions.get(global(i)).copied()),
+            );
+            let off = |i: usize| {
+                idx.get(i)
+                    .and_then(|&j| u32::try_from(global(j)).ok())
+                    .unwrap_or(u32::MAX)
+            };
+            mesh.triangles
+                .extend(super::polygon::triangles(&face).map(|t| t.map(off)));
         }
     }
     if mesh.triangles.is_empty() {
@@ -625,15 +657,17 @@ mod tests {
         assert_eq!(w.count(), 2);
     }
 
-    /// A face of 200,000 vertices on one line is read in linear time (the
-    /// columns of its words were counted from the line's start, each, which
-    /// took minutes for a 2 MB line).
+    /// A face of the most vertices a face may have, on one line, is read in
+    /// linear time (the columns of its words were counted from the line's
+    /// start, each, which took minutes for a 2 MB line); one more is
+    /// refused at the face.
     #[test]
     fn one_long_face_is_read_in_linear_time() {
-        let n = 200_000;
+        let n = MAX_FACE_VERTICES;
         let mut text = String::new();
         for i in 0..n {
-            text.push_str(&format!("v {i} {} 0\n", i % 7));
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            text.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
         }
         text.push('f');
         for i in 1..=n {
@@ -653,6 +687,49 @@ mod tests {
             e.starts_with(&format!("fan.obj:{}:{column}: face: vertex index", n + 1)),
             "{e}"
         );
+        let more = format!("v 0 0 1\n{} 1\n", text.trim_end());
+        assert_eq!(
+            parse("fan.obj", &more).unwrap_err().to_string(),
+            format!(
+                "fan.obj:{}:1: face: more than 65536 vertices (the most a face may have): split it \
+                 into smaller faces",
+                n + 2
+            )
+        );
+    }
+
+    /// A non-convex face is cut into its ears, as an NFF polygon is: a comb
+    /// whose fan from vertex 1 would cover its notches.
+    #[test]
+    fn a_non_convex_face_is_its_ears() {
+        let comb = [
+            (0.0, 0.0),
+            (4.0, 0.0),
+            (4.0, 3.0),
+            (3.0, 3.0),
+            (3.0, 1.0),
+            (2.0, 1.0),
+            (2.0, 3.0),
+            (0.0, 3.0),
+        ];
+        let mut text: String = comb.iter().map(|(x, y)| format!("v {x} {y} 0\n")).collect();
+        text += "f 1 2 3 4 5 6 7 8\n";
+        let m = parse("comb.obj", &text).unwrap();
+        assert_eq!(m.triangles.len(), comb.len() - 2);
+        let mut area = 0.0;
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            let twice = (b - a).cross(c - a).z;
+            assert!(twice > 0.0, "{t:?} winds against the face");
+            area += twice / 2.0;
+            let centre = (a + b + c) / 3.0;
+            assert!(
+                !(centre.y > 1.0 && (2.0..3.0).contains(&centre.x)),
+                "{t:?} covers the notch"
+            );
+        }
+        // 4 × 1 below, 1 × 2 and 2 × 2 above.
+        assert!((area - 10.0).abs() < 1e-9, "{area}");
     }
 
     /// A byte-order mark does not hide the first vertex: the triangle is

@@ -170,7 +170,7 @@ pub enum Shape {
     Sphere(Sphere),
     /// An open cone or cylinder.
     Cone(Cone),
-    /// A triangle of a polygon's fan.
+    /// A triangle of a polygon ([`crate::scene::polygon`]).
     Triangle(Triangle),
     /// A torus.
     Torus(Torus),

@@ -1,5 +1,6 @@
-//! Triangles: the fan triangles of NFF polygons (`p`) and polygonal
-//! patches (`pp`), which carry vertex normals.
+//! Triangles: the triangles of NFF polygons (`p`) and polygonal patches
+//! (`pp`, which carry vertex normals), as [`crate::scene::polygon`] cuts
+//! them, and of OBJ faces.
 
 use glam::DVec3;
 use rrt_core::geometry::{self, Point};
@@ -10,7 +11,7 @@ use super::{Primitive, Slots, Surface, Unfit, get, put};
 use crate::frame::{RasterFrame, unit_to_fixed};
 use crate::world::{Bounds, Hit, Ray};
 
-/// A triangle of a polygon's fan (open: seen and lit from both sides),
+/// A triangle of a polygon (open: seen and lit from both sides),
 /// with the patch's vertex normals (as written, not normalised) if it
 /// comes from a `pp`. Saved as kind 3 (v0, v1, v2) or, with normals,
 /// kind 4 (v0, v1, v2, n0, n1, n2).
