@@ -66,6 +66,10 @@ pub fn check_scene(s: &Scene) -> Result<(), String> {
         if p.material >= nm || p.count < 3 || s.vertices.get(p.range()).is_none() {
             return Err(format!("bad polygon {p:?}"));
         }
+        // The cut is the one `polygon::cut` makes of the outline.
+        if super::polygon::cut(s.polygon_vertices(p)).as_ref() != Ok(&p.cut) {
+            return Err(format!("polygon cut not its outline's: {p:?}"));
+        }
         for i in p.range() {
             finite(s.vertices[i], "vertex")?;
             let n = s.normals[i];

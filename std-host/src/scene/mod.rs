@@ -242,6 +242,10 @@ pub struct Polygon {
     pub patch: bool,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// How it is cut into triangles ([`polygon`]): `None` for the fan from
+    /// its first vertex, which covers it exactly once; else its triangles,
+    /// as indices of its vertices.
+    pub cut: Option<Box<[[u32; 3]]>>,
     /// Where the `p` or `pp` is.
     pub loc: SourceLoc,
 }
@@ -420,12 +424,17 @@ impl Scene {
     /// the polygon (its normal on the side of the polygon's Newell normal),
     /// which decides whether a refracted ray enters or leaves, with the
     /// patch's vertex normals (as written) for a `pp`.
-    pub fn polygon_triangles(&self, polygon: &Polygon) -> impl Iterator<Item = Triangle> + '_ {
+    pub fn polygon_triangles<'a>(
+        &'a self,
+        polygon: &'a Polygon,
+    ) -> impl Iterator<Item = Triangle> + 'a {
         let v = self.polygon_vertices(polygon);
         let n = self.polygon_normals(polygon);
-        polygon::triangles(v).map(move |idx| Triangle {
-            vertices: idx.map(|k| v[k]),
-            normals: n.and_then(|n| Some([*n.get(idx[0])?, *n.get(idx[1])?, *n.get(idx[2])?])),
+        polygon::triangles(v, polygon.cut.as_deref()).filter_map(move |[a, b, c]| {
+            Some(Triangle {
+                vertices: [*v.get(a)?, *v.get(b)?, *v.get(c)?],
+                normals: n.and_then(|n| Some([*n.get(a)?, *n.get(b)?, *n.get(c)?])),
+            })
         })
     }
 

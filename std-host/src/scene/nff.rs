@@ -788,19 +788,18 @@ impl<'a> Parser<'a> {
             self.scene.normals.push(normal);
         }
         let vertices = self.scene.vertices.get(first..).unwrap_or_default();
-        if let Err(problem) = super::polygon::check(vertices) {
-            return Err(SceneError::Invalid {
-                loc: count_loc,
-                field: count_field,
-                problem,
-            });
-        }
+        let cut = super::polygon::cut(vertices).map_err(|problem| SceneError::Invalid {
+            loc: count_loc,
+            field: count_field,
+            problem,
+        })?;
         let material = self.current_material();
         self.scene.polygons.push(Polygon {
             first,
             count: n,
             patch,
             material,
+            cut,
             loc,
         });
         Ok(())

@@ -441,8 +441,11 @@ pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
                     .and_then(|&j| u32::try_from(global(j)).ok())
                     .unwrap_or(u32::MAX)
             };
+            // A face has at most MAX_FACE_VERTICES vertices (`prescan`).
+            let cut = super::polygon::cut(&face)
+                .map_err(|problem| invalid(&file, 1, 1, "face", problem))?;
             mesh.triangles
-                .extend(super::polygon::triangles(&face).map(|t| t.map(off)));
+                .extend(super::polygon::triangles(&face, cut.as_deref()).map(|t| t.map(off)));
         }
     }
     if mesh.triangles.is_empty() {

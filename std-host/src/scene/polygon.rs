@@ -20,9 +20,9 @@
 //! outline crosses itself has no inside the NFF format defines; its ears
 //! are what ear clipping makes of it.
 //!
-//! A non-convex polygon is cut with memory and time that grow with its
-//! vertex count, so the scene front-ends refuse one of more than
-//! [`MAX_NONCONVEX_VERTICES`] vertices.
+//! The front-ends cut each polygon once, as they read it, and refuse a
+//! non-convex one of more than [`MAX_NONCONVEX_VERTICES`] vertices (the
+//! cut's memory and time grow with the vertex count).
 //!
 //! [`Scene::polygon_triangles`]: super::Scene::polygon_triangles
 
@@ -60,48 +60,63 @@ fn fan_is_exact(v: &[DVec3], normal: DVec3) -> bool {
     (0..v.len().saturating_sub(2)).all(|t| !folds(v, t, normal))
 }
 
-/// Refuses a polygon [`triangles`] would not cut: a non-convex one of more
-/// than [`MAX_NONCONVEX_VERTICES`] vertices. The error is the problem, for
-/// the front-end's message at the polygon.
-pub(crate) fn check(v: &[DVec3]) -> Result<(), &'static str> {
-    if v.len() > MAX_NONCONVEX_VERTICES && !fan_is_exact(v, newell_normal(v)) {
+/// How polygon `v` is cut (module docs): `None` for the fan from vertex 0,
+/// which covers it exactly once; else its triangles, as vertex indices
+/// winding like the polygon (its ears; for an outline without area, the
+/// fan with each triangle wound so).
+///
+/// # Errors
+/// A non-convex polygon of more than [`MAX_NONCONVEX_VERTICES`]
+/// vertices, with the problem for the front-end's message at it.
+pub(crate) fn cut(v: &[DVec3]) -> Result<Option<Box<[[u32; 3]]>>, &'static str> {
+    let normal = newell_normal(v);
+    if fan_is_exact(v, normal) {
+        return Ok(None);
+    }
+    if v.len() > MAX_NONCONVEX_VERTICES {
         return Err(
             "non-convex, with more than 65536 vertices (the most a non-convex \
                     polygon may have): split it into smaller polygons",
         );
     }
-    Ok(())
+    // Indices fit in u32: at most MAX_NONCONVEX_VERTICES vertices.
+    let index = |k: usize| u32::try_from(k).unwrap_or(u32::MAX);
+    Ok(Some(match ears(v, normal) {
+        Some(ears) if !ears.is_empty() => ears,
+        _ => (0..v.len().saturating_sub(2))
+            .map(|t| {
+                if folds(v, t, normal) {
+                    [0, t + 2, t + 1]
+                } else {
+                    [0, t + 1, t + 2]
+                }
+                .map(index)
+            })
+            .collect(),
+    }))
 }
 
-/// The triangles of polygon `v` (module docs), as vertex indices winding
-/// like the polygon. A polygon without area gives its fan (whose
-/// triangles have none either).
-pub(crate) fn triangles(v: &[DVec3]) -> Triangles {
-    let normal = newell_normal(v);
-    let fan = || Triangles::Fan {
-        t: 0,
-        count: v.len().saturating_sub(2),
-        swap: (0..v.len().saturating_sub(2))
-            .map(|t| folds(v, t, normal))
-            .collect(),
+/// The triangles of polygon `v` as vertex indices, from its [`cut`]: the
+/// fan for `None`.
+pub(crate) fn triangles<'a>(
+    v: &[DVec3],
+    cut: Option<&'a [[u32; 3]]>,
+) -> impl Iterator<Item = [usize; 3]> + 'a {
+    let fan = if cut.is_none() {
+        v.len().saturating_sub(2)
+    } else {
+        0
     };
-    if fan_is_exact(v, normal) || v.len() > MAX_NONCONVEX_VERTICES {
-        return Triangles::Fan {
-            t: 0,
-            count: v.len().saturating_sub(2),
-            swap: Vec::new(),
-        };
-    }
-    match ears(v, normal) {
-        Some(ears) if !ears.is_empty() => Triangles::Ears(ears.into_iter()),
-        _ => fan(),
-    }
+    cut.unwrap_or_default()
+        .iter()
+        .map(|t| t.map(|k| k as usize))
+        .chain((0..fan).map(|t| [0, t + 1, t + 2]))
 }
 
 /// The ear-clipped triangles of `v` (non-convex, at most
 /// [`MAX_NONCONVEX_VERTICES`] vertices), each winding like `normal`;
 /// `None` where the outline cannot be projected (no finite normal).
-fn ears(v: &[DVec3], normal: DVec3) -> Option<Vec<[usize; 3]>> {
+fn ears(v: &[DVec3], normal: DVec3) -> Option<Box<[[u32; 3]]>> {
     let n = normal.abs();
     // The plane across the normal's largest component: the projection keeps
     // the outline simple (it is a shear and scale of the polygon's plane).
@@ -134,8 +149,9 @@ fn ears(v: &[DVec3], normal: DVec3) -> Option<Vec<[usize; 3]>> {
         indices
             .chunks_exact(3)
             .filter_map(|t| {
-                let mut t = [t[0], t[1], t[2]].map(|k| usize::try_from(k).unwrap_or(usize::MAX));
-                let [a, b, c] = [v.get(t[0])?, v.get(t[1])?, v.get(t[2])?];
+                let mut t = [t[0], t[1], t[2]];
+                let [a, b, c] = t.map(|k| v.get(k as usize));
+                let (a, b, c) = (a?, b?, c?);
                 if (*b - *a).cross(*c - *a).dot(normal) < 0.0 {
                     t.swap(1, 2);
                 }
@@ -145,47 +161,15 @@ fn ears(v: &[DVec3], normal: DVec3) -> Option<Vec<[usize; 3]>> {
     )
 }
 
-/// The vertex indices of a polygon's triangles ([`triangles`]).
-pub(crate) enum Triangles {
-    /// The fan: triangle `t` is 0, `t + 1`, `t + 2`, with its last two
-    /// swapped where `swap[t]` (so that it winds like the polygon).
-    Fan {
-        /// The next triangle.
-        t: usize,
-        /// The number of triangles.
-        count: usize,
-        /// Per triangle, whether it is swapped (empty: none is).
-        swap: Vec<bool>,
-    },
-    /// The ears of a non-convex polygon.
-    Ears(std::vec::IntoIter<[usize; 3]>),
-}
-
-impl Iterator for Triangles {
-    type Item = [usize; 3];
-
-    fn next(&mut self) -> Option<[usize; 3]> {
-        match self {
-            Self::Fan { t, count, swap } => {
-                if *t >= *count {
-                    return None;
-                }
-                let k = *t;
-                *t += 1;
-                Some(if swap.get(k).copied().unwrap_or(false) {
-                    [0, k + 2, k + 1]
-                } else {
-                    [0, k + 1, k + 2]
-                })
-            }
-            Self::Ears(ears) => ears.next(),
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The triangles of `v` as the front-ends cut it.
+    fn cut_into(v: &[DVec3]) -> Vec<[usize; 3]> {
+        let c = cut(v).unwrap();
+        triangles(v, c.as_deref()).collect()
+    }
 
     /// Twice the signed area of triangle `t` of `v` in the plane z = 0.
     fn area2(v: &[DVec3], t: [usize; 3]) -> f64 {
@@ -258,7 +242,7 @@ mod tests {
                 DVec3::new(a.cos(), a.sin(), 0.0)
             })
             .collect();
-        let tris: Vec<_> = triangles(&v).collect();
+        let tris = cut_into(&v);
         let fan: Vec<_> = (0..5).map(|t| [0, t + 1, t + 2]).collect();
         assert_eq!(tris, fan);
         assert_tiles(&v, &tris);
@@ -270,7 +254,7 @@ mod tests {
         let normal = newell_normal(&v);
         assert!(normal.z > 0.0);
         assert!(!fan_is_exact(&v, normal), "the gear's fan folds");
-        let tris: Vec<_> = triangles(&v).collect();
+        let tris = cut_into(&v);
         assert_eq!(tris.len(), v.len() - 2);
         for t in &tris {
             assert!(area2(&v, *t) > 0.0, "{t:?} winds against the polygon");
@@ -298,7 +282,7 @@ mod tests {
         .map(|(x, y)| DVec3::new(x, y, 0.0))
         .to_vec();
         v.reverse();
-        let tris: Vec<_> = triangles(&v).collect();
+        let tris = cut_into(&v);
         for t in &tris {
             assert!(area2(&v, *t) < 0.0, "{t:?} winds against the polygon");
         }
@@ -311,7 +295,7 @@ mod tests {
     fn a_polygon_in_any_plane_and_place_is_cut() {
         // The gear tilted, far from the origin and huge: the same ears.
         let flat = gear(9);
-        let flat_tris: Vec<_> = triangles(&flat).collect();
+        let flat_tris = cut_into(&flat);
         let tilt = glam::DQuat::from_rotation_x(1.1) * glam::DQuat::from_rotation_z(0.3);
         for (scale, offset) in [(1.0, 0.0), (1e-9, 1e3), (1e12, -1e14)] {
             let v: Vec<DVec3> = flat
@@ -319,7 +303,7 @@ mod tests {
                 .map(|p| tilt * (*p * scale) + DVec3::splat(offset))
                 .collect();
             let normal = newell_normal(&v);
-            let tris: Vec<_> = triangles(&v).collect();
+            let tris = cut_into(&v);
             assert_eq!(tris.len(), flat_tris.len());
             for t in &tris {
                 let [a, b, c] = t.map(|k| v[k]);
@@ -361,7 +345,7 @@ mod tests {
                 v.push(v[0]);
             }
             let normal = newell_normal(&v);
-            let tris: Vec<_> = triangles(&v).collect();
+            let tris = cut_into(&v);
             for t in &tris {
                 assert!(t.iter().all(|&k| k < v.len()), "case {case}: {t:?}");
                 let [a, b, c] = t.map(|k| v[k]);
@@ -381,14 +365,13 @@ mod tests {
     fn degenerate_and_huge_polygons_are_refused_or_fanned() {
         // Collinear: no area, the fan (whose triangles have none).
         let line: Vec<DVec3> = (0..5).map(|k| DVec3::new(k as f64, 0.0, 0.0)).collect();
-        assert_eq!(triangles(&line).count(), 3);
+        assert_eq!(cut_into(&line).len(), 3);
         // A large gear is cut; one past the limit is refused.
         let big = gear(MAX_NONCONVEX_VERTICES / 4);
-        assert!(check(&big).is_ok());
-        let tris: Vec<_> = triangles(&big).collect();
+        let tris = cut_into(&big);
         assert_eq!(tris.len(), big.len() - 2);
         let bigger = gear(MAX_NONCONVEX_VERTICES / 4 + 1);
-        let e = check(&bigger).unwrap_err();
+        let e = cut(&bigger).unwrap_err();
         assert!(
             e.contains(&format!("more than {MAX_NONCONVEX_VERTICES} vertices")),
             "{e}"
@@ -400,6 +383,6 @@ mod tests {
                 DVec3::new(a.cos(), a.sin(), 0.0)
             })
             .collect();
-        assert!(check(&round).is_ok());
+        assert_eq!(cut(&round), Ok(None));
     }
 }

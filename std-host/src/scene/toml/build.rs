@@ -235,6 +235,8 @@ impl Builder<'_> {
                 format!("more than {} vertices in the scene", self.opts.max_vertices),
             ));
         }
+        let cut = super::super::polygon::cut(vertices)
+            .map_err(|problem| self.err(span.clone(), "object", problem))?;
         let first = scene.vertices.len();
         scene.vertices.extend_from_slice(vertices);
         match normals {
@@ -248,6 +250,7 @@ impl Builder<'_> {
             count: vertices.len(),
             patch: normals.is_some(),
             material,
+            cut,
             loc: loc.clone(),
         });
         Ok(())
