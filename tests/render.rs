@@ -1053,3 +1053,81 @@ fn a_huge_ground_keeps_the_shadows_on_it() {
         .count();
     assert!(differ * 100 <= 64 * 64, "{differ} pixels differ");
 }
+
+/// A non-convex polygon is the region its outline bounds: seen face-on in
+/// the exact mode, every pixel whose primary ray meets the polygon's plane
+/// clearly inside the comb (more than 0.03 from its outline) shows it, and
+/// every one clearly outside (the notches between its teeth among them)
+/// the background. A fan from the first vertex covers the notches.
+#[test]
+fn non_convex_polygons_cover_their_outline_only() {
+    let outline = [
+        (0.0, 0.0),
+        (4.0, 0.0),
+        (4.0, 3.0),
+        (3.0, 3.0),
+        (3.0, 1.0),
+        (2.0, 1.0),
+        (2.0, 3.0),
+        (1.0, 3.0),
+        (1.0, 1.0),
+        (0.5, 1.0),
+        (0.5, 3.0),
+        (0.0, 3.0),
+    ];
+    let mut src = String::from(
+        "v\nfrom 2 1.5 12\nat 2 1.5 0\nup 0 1 0\nangle 25\nhither 0\nresolution 96 80\n\
+         b 0 0 0\nl 2 1.5 20\nf 1 1 1 1 0 1 0 0\n",
+    );
+    src += &format!("p {}\n", outline.len());
+    for (x, y) in outline {
+        src += &format!("{x} {y} 0\n");
+    }
+    let scene = Scene::parse("comb.nff", src.as_bytes()).unwrap();
+    let vs = voxelize_exact(&scene, 128);
+    let (w, h) = (96, 80);
+    let (img, _) = draw(&vs, w, h, TraceOptions::default(), 1, 1);
+    let cam = Camera::new(&scene.view, w, h).unwrap();
+    let inside = |p: DVec3| {
+        let mut inside = false;
+        for (a, b) in outline.iter().zip(outline.iter().cycle().skip(1)) {
+            if (a.1 > p.y) != (b.1 > p.y) && p.x < a.0 + (p.y - a.1) * (b.0 - a.0) / (b.1 - a.1) {
+                inside = !inside;
+            }
+        }
+        inside
+    };
+    let near_edge = |p: DVec3| {
+        outline
+            .iter()
+            .zip(outline.iter().cycle().skip(1))
+            .any(|(a, b)| {
+                let (a, b) = (DVec3::new(a.0, a.1, 0.0), DVec3::new(b.0, b.1, 0.0));
+                let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+                (a + (b - a) * t).distance(p) < 0.03
+            })
+    };
+    let (mut lit, mut dark) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let ray = cam.primary(x, y);
+            let p = ray.origin - ray.dir * (ray.origin.z / ray.dir.z);
+            if near_edge(p) {
+                continue;
+            }
+            let k = 3 * (y * w + x) as usize;
+            let shown = img.rgb[k..k + 3].iter().any(|&c| c > 0);
+            assert_eq!(shown, inside(p), "pixel ({x}, {y}) at {p}");
+            if shown {
+                lit += 1;
+            } else if p.x > 0.0 && p.x < 4.0 && p.y > 1.0 && p.y < 3.0 {
+                dark += 1;
+            }
+        }
+    }
+    assert!(lit > 1000, "{lit} pixels show the comb");
+    assert!(
+        dark > 300,
+        "{dark} pixels of the notches show the background"
+    );
+}

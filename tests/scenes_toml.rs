@@ -1341,3 +1341,55 @@ fn missing_keys_name_their_table() {
         "{msg}"
     );
 }
+
+/// A TOML polygon is cut as an NFF one: a non-convex outline into its
+/// ears (each winding like the polygon, together its area), a convex one
+/// into its fan.
+#[test]
+fn toml_polygons_are_cut_as_nff_polygons() {
+    let d = temp_dir("toml-comb");
+    let p = d.join("s.toml");
+    std::fs::write(
+        &p,
+        r#"
+[camera]
+from = [2, 1.5, 10]
+at = [2, 1.5, 0]
+up = [0, 1, 0]
+angle = 40
+resolution = [16, 16]
+
+[[light]]
+position = [2, 1.5, 20]
+
+[material.grey]
+colour = [0.8, 0.8, 0.8]
+
+[[object]]
+material = "grey"
+polygon = [[0, 0, 0], [4, 0, 0], [4, 3, 0], [3, 3, 0], [3, 1, 0], [2, 1, 0], [2, 3, 0], [0, 3, 0]]
+
+[[object]]
+material = "grey"
+polygon = [[0, 0, 1], [4, 0, 1], [4, 3, 1], [0, 3, 1]]
+"#,
+    )
+    .unwrap();
+    let scene = Scene::load(&p).unwrap();
+    let comb = &scene.polygons[0];
+    assert!(comb.cut.is_some(), "the comb is cut into ears");
+    let tris: Vec<_> = scene.polygon_triangles(comb).collect();
+    assert_eq!(tris.len(), 6);
+    let mut area = 0.0;
+    for t in &tris {
+        let [a, b, c] = t.vertices;
+        let twice = (b - a).cross(c - a).z;
+        assert!(twice > 0.0);
+        area += twice / 2.0;
+    }
+    // 4 × 1 below the notch, 1 × 2 and 2 × 2 beside it.
+    assert!((area - 10.0).abs() < 1e-12, "{area}");
+    let quad = &scene.polygons[1];
+    assert!(quad.cut.is_none(), "a convex polygon is its fan");
+    assert_eq!(scene.polygon_triangles(quad).count(), 2);
+}
