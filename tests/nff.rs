@@ -292,6 +292,7 @@ fn non_convex_polygons_are_their_ears() {
         let v = s.polygon_vertices(p);
         let tris: Vec<_> = s.polygon_triangles(p).collect();
         assert_eq!(tris.len(), outline.len() - 2);
+        assert_eq!(p.triangle_count(), tris.len());
         let mut area = 0.0;
         for (t, tri) in tris.iter().enumerate() {
             let [a, b, c] = tri.vertices;

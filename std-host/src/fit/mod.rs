@@ -241,7 +241,7 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
     table.add_all(&scene.cones)?;
     for p in &scene.polygons {
         if table.outside(scene.polygon_bounds(p)) {
-            table.dropped.outside += p.count.saturating_sub(2);
+            table.dropped.outside += p.triangle_count();
             continue;
         }
         for t in scene.polygon_triangles(p) {

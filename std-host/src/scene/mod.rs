@@ -256,6 +256,14 @@ impl Polygon {
     pub fn range(&self) -> std::ops::Range<usize> {
         self.first..self.first.saturating_add(self.count)
     }
+
+    /// The number of its triangles ([`Scene::polygon_triangles`]).
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.cut
+            .as_ref()
+            .map_or(self.count.saturating_sub(2), |c| c.len())
+    }
 }
 
 /// A scene in world coordinates (see the module docs).
@@ -462,14 +470,10 @@ impl Scene {
             && self.csgs.is_empty()
     }
 
-    /// Number of triangles of every polygon: `n − 2` for `n` vertices (ear
-    /// clipping may leave out triangles without area).
+    /// Number of triangles of every polygon ([`Polygon::triangle_count`]).
     #[must_use]
     pub fn triangle_count(&self) -> usize {
-        self.polygons
-            .iter()
-            .map(|p| p.count.saturating_sub(2))
-            .sum()
+        self.polygons.iter().map(Polygon::triangle_count).sum()
     }
 
     /// The box around all geometry: spheres ± radius, polygon vertices,
