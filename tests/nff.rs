@@ -201,6 +201,21 @@ fn cone_on_one_line_or_two() {
     ok(&format!("{HEAD}c 0 0 0 1 0 0 2 0\n"));
 }
 
+/// NFF's negative radii (an inside-out cone, only its inside visible) are
+/// read as their magnitudes: rrt shades both sides of every surface, as
+/// `embree_nff` does. A zero radius goes with either sign.
+#[test]
+fn inside_out_cones_are_their_magnitudes() {
+    let outside = ok(&format!("{HEAD}c 0 0 0 1 0 0 2 0.5\n"));
+    let inside = ok(&format!("{HEAD}c 0 0 0 -1 0 0 2 -0.5\n"));
+    assert_eq!(outside.cones[0].shape, inside.cones[0].shape);
+    let point = ok(&format!("{HEAD}c 0 0 0 -1 0 0 2 0\n"));
+    assert_eq!(point.cones[0].shape.base_radius, 1.0);
+    assert_eq!(point.cones[0].shape.apex_radius, 0.0);
+    let base_point = ok(&format!("{HEAD}c 0 0 0 0 0 0 2 -0.5\n"));
+    assert_eq!(base_point.cones[0].shape.apex_radius, 0.5);
+}
+
 #[test]
 fn lights_with_and_without_colour() {
     let s = ok(&format!("{HEAD}l 1 2 3\nl 4 5 6 0.5 0.25 2\ns 0 0 0 1\n"));
@@ -693,7 +708,11 @@ fn out_of_range_values() {
     );
     assert_eq!(
         err_body("c 0 0 0 -1 0 0 1 1\n"),
-        r#"scene.nff:8:9: cone base radius: expected a number ≥ 0, found "-1""#
+        r#"scene.nff:8:18: cone apex radius: expected a number ≤ 0 (the base radius is negative: an inside-out cone), found "1""#
+    );
+    assert_eq!(
+        err_body("c 0 0 0 1 0 0 1 -0.5\n"),
+        r#"scene.nff:8:17: cone apex radius: expected a number ≥ 0 (the base radius is positive), found "-0.5""#
     );
     assert_eq!(
         err_body("c 0 0 0 1 0 0 0 1\n"),

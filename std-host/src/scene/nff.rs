@@ -41,9 +41,10 @@
 //! pixel sizes must be whole numbers. Ranges: colours of `b` and `f` in
 //! `[0, 1]`; light colours ≥ 0; `Kd`, `Ks`, `Shine` and the index of
 //! refraction ≥ 0, `T` in `[0, 1]`, and an index of refraction > 0 when
-//! `T > 0`; sphere radii > 0 and cone radii ≥ 0
-//! (NFF's negative radii, "only the inside is visible", are refused: rrt
-//! shades both sides, as `embree_nff`); `0 < angle < 180`; resolutions
+//! `T > 0`; sphere radii > 0; a cone's two radii of one sign (NFF's
+//! negative radii, "only the inside is visible", are read as their
+//! magnitudes: rrt shades both sides of every surface, as `embree_nff`
+//! does); `0 < angle < 180`; resolutions
 //! from 1 to [`MAX_RESOLUTION`]. `v` and `b` may appear once. A view whose
 //! `from` equals `at`, or whose `up` is parallel to the view direction, is
 //! refused, as are cones whose base and apex coincide or whose radii are
@@ -675,14 +676,30 @@ impl<'a> Parser<'a> {
         if self.at_eol() {
             self.record_line("cone base", BASE)?;
         }
-        let radius = |p: &mut Self, field| p.number_where(field, "a number ≥ 0", |r| r >= 0.0);
         let base = self.vec3("cone base")?;
-        let base_radius = radius(self, "cone base radius")?;
+        let base_radius = self.number("cone base radius")?;
         if self.at_eol() {
             self.record_line("cone apex", APEX)?;
         }
         let apex = self.vec3("cone apex")?;
-        let apex_radius = radius(self, "cone apex radius")?;
+        // NFF's negative radii (an inside-out cone: only its inside
+        // visible) come in pairs; rrt shades both sides of every surface.
+        let apex_radius = if base_radius < 0.0 {
+            self.number_where(
+                "cone apex radius",
+                "a number ≤ 0 (the base radius is negative: an inside-out cone)",
+                |r| r <= 0.0,
+            )?
+        } else if base_radius > 0.0 {
+            self.number_where(
+                "cone apex radius",
+                "a number ≥ 0 (the base radius is positive)",
+                |r| r >= 0.0,
+            )?
+        } else {
+            self.number("cone apex radius")?
+        };
+        let (base_radius, apex_radius) = (base_radius.abs(), apex_radius.abs());
         self.expect_eol("cone")?;
         if base == apex {
             return Err(SceneError::Invalid {
