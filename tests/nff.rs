@@ -275,22 +275,7 @@ fn transmitting_material_and_patch() {
 /// the same way on all of it, with the patch normals of its vertices.
 #[test]
 fn non_convex_polygons_are_their_ears() {
-    // A comb in the plane z = 0, counter-clockwise from above (+z): the
-    // fan from vertex 0 folds at the notches.
-    let outline = [
-        (0.0, 0.0),
-        (4.0, 0.0),
-        (4.0, 3.0),
-        (3.0, 3.0),
-        (3.0, 1.0),
-        (2.0, 1.0),
-        (2.0, 3.0),
-        (1.0, 3.0),
-        (1.0, 1.0),
-        (0.5, 1.0),
-        (0.5, 3.0),
-        (0.0, 3.0),
-    ];
+    let outline = rrt_tests::COMB;
     for patch in [false, true] {
         let mut src = format!("{HEAD}f 1 1 1 0.2 0.3 20 0.7 1.5\n");
         src += &format!("{} {}\n", if patch { "pp" } else { "p" }, outline.len());

@@ -1061,20 +1061,7 @@ fn a_huge_ground_keeps_the_shadows_on_it() {
 /// the background. A fan from the first vertex covers the notches.
 #[test]
 fn non_convex_polygons_cover_their_outline_only() {
-    let outline = [
-        (0.0, 0.0),
-        (4.0, 0.0),
-        (4.0, 3.0),
-        (3.0, 3.0),
-        (3.0, 1.0),
-        (2.0, 1.0),
-        (2.0, 3.0),
-        (1.0, 3.0),
-        (1.0, 1.0),
-        (0.5, 1.0),
-        (0.5, 3.0),
-        (0.0, 3.0),
-    ];
+    let outline = rrt_tests::COMB;
     let mut src = String::from(
         "v\nfrom 2 1.5 12\nat 2 1.5 0\nup 0 1 0\nangle 25\nhither 0\nresolution 96 80\n\
          b 0 0 0\nl 2 1.5 20\nf 1 1 1 1 0 1 0 0\n",

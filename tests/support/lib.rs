@@ -24,6 +24,26 @@ use std::path::PathBuf;
 /// printed with it.
 pub use rrt_core::rng::Rng;
 
+/// A comb in the plane z = 0, counter-clockwise seen from +z: three teeth
+/// (x in [0, 0.5], [1, 2], [3, 4]) rising from y = 1 to 3 over a base
+/// from y = 0 to 1, with notches between them (x in (0.5, 1) and (2, 3)
+/// above y = 1). Area 9. The fan from its first vertex folds back at the
+/// notches and covers them.
+pub const COMB: [(f64, f64); 12] = [
+    (0.0, 0.0),
+    (4.0, 0.0),
+    (4.0, 3.0),
+    (3.0, 3.0),
+    (3.0, 1.0),
+    (2.0, 1.0),
+    (2.0, 3.0),
+    (1.0, 3.0),
+    (1.0, 1.0),
+    (0.5, 1.0),
+    (0.5, 3.0),
+    (0.0, 3.0),
+];
+
 /// The number the environment variable `var` holds, if it is set to one
 /// (the case counts of the soak tests).
 #[must_use]
