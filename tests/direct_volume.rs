@@ -241,6 +241,96 @@ fn the_step_correction_adds_up_over_any_split() {
     assert!((a.colour.x - want).abs() < 1e-12);
 }
 
+/// The raster holds exactly the voxels whose sample (the one the tracer
+/// composites) has an opacity above 0, each recorded with the transfer
+/// function's colour of that sample, for a volume whose cells do not line
+/// up with the voxels (values varying along every axis, half of them
+/// clear), on one thread and on three (the passes in pieces).
+#[test]
+fn the_raster_holds_the_visible_samples_with_their_colours() {
+    let d = rrt_tests::fresh_dir("rrt-test", "dvr-visible");
+    let (nx, ny, nz) = (9usize, 7usize, 5usize);
+    let raw: Vec<u8> = (0..nx * ny * nz)
+        .map(|i| {
+            let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
+            ((x * 29 + y * 13 + z * 41) % 256) as u8
+        })
+        .collect();
+    std::fs::write(d.join("v.raw"), raw).unwrap();
+    let p = d.join("v.toml");
+    std::fs::write(
+        &p,
+        r#"[camera]
+from = [4, 3, 20]
+at = [4, 3, 2]
+up = [0, 1, 0]
+angle = 30
+resolution = [4, 4]
+
+[volume.v]
+raw = { file = "v.raw", dims = [9, 7, 5], type = "u8" }
+scale = 0.83
+translate = [0.37, 0.21, 0.55]
+render = "direct"
+opacity = [[0, 0], [120, 0], [255, 0.6]]
+colours = [[0, 0, 0, 1], [128, 1, 0.5, 0], [255, 1, 1, 1]]
+
+[material.m]
+kd = 1
+
+[[object]]
+material = "m"
+volume = "v"
+"#,
+    )
+    .unwrap();
+    let scene = Scene::load(&p).unwrap();
+    let mut first = None;
+    for threads in [1, 3] {
+        let mut o = BuildOptions::new(12);
+        o.threads = threads;
+        o.fit.max_memory = 1 << 28;
+        let vs = build(&scene, &o, &ProgressBar::hidden()).unwrap().0;
+        let store = vs.store().unwrap();
+        let [dv] = vs.direct.as_slice() else {
+            panic!("one volume rendered directly: {}", vs.direct.len());
+        };
+        let dims = vs.extent().dims();
+        let (mut visible, mut clear) = (0, 0);
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let v = [x, y, z];
+                    let value = dv.value(v).map(f64::from);
+                    let alpha = value.map_or(0.0, |s| dv.classifier.sample_opacity(s));
+                    match store.get_voxel(v) {
+                        Some(rec) => {
+                            assert!(alpha > 0.0, "{v:?}: {value:?} recorded with opacity 0");
+                            assert_eq!(store.objects(rec), &[dv.object], "{v:?}");
+                            let want = dv.classifier.color(value.unwrap(), dv.base);
+                            assert_eq!(rec.color, want, "{v:?}: {value:?}");
+                            visible += 1;
+                        }
+                        None => {
+                            assert!(alpha <= 0.0, "{v:?}: {value:?} missing");
+                            clear += value.is_some() as u32;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            visible > 50 && clear > 50,
+            "{visible} visible, {clear} clear"
+        );
+        let records: Vec<_> = store.records().to_vec();
+        match &first {
+            None => first = Some(records),
+            Some(r) => assert!(r == &records, "records differ on {threads} threads"),
+        }
+    }
+}
+
 /// A raster with a volume rendered directly cannot be saved: `rrt
 /// voxelize` says so before voxelizing, and the library's writer refuses
 /// it.

@@ -184,9 +184,12 @@ impl Tracer<'_> {
         } else {
             1.0
         };
-        let Some(n) = (-g).try_normalize().filter(|_| w > 0.0) else {
+        // `(-g).try_normalize()`, from the length at hand.
+        let rcp = m.recip();
+        if !(w > 0.0 && rcp.is_finite() && rcp > 0.0) {
             return c;
-        };
+        }
+        let n = -g * rcp;
         let n = face_forward(n, ray.dir);
         let m = usize::try_from(d.object)
             .ok()

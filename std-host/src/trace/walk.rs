@@ -313,12 +313,20 @@ impl Tracer<'_> {
             match self.store.get_hinted(h.voxel, c) {
                 None => stats.missing += 1,
                 Some(rec) => {
-                    self.test_voxel(
-                        ray, o_r, h.voxel, h.index, rec, tmin, leave, &mut mail, &mut best,
-                    );
-                    let reach = (exit_param(o_r, ray.dir, h.voxel) + REACH_MARGIN) * vs;
-                    let here = best.as_ref().filter(|b| b.t <= reach).map(|b| b.t);
                     let direct = self.direct_of(rec);
+                    // A voxel of a volume rendered directly and nothing
+                    // else has nothing to test.
+                    if direct.is_none() || self.store.objects(rec).len() > 1 {
+                        self.test_voxel(
+                            ray, o_r, h.voxel, h.index, rec, tmin, leave, &mut mail, &mut best,
+                        );
+                    }
+                    // The candidate's t when it lies within the part of
+                    // the ray the walk has reached.
+                    let here = best
+                        .as_ref()
+                        .map(|b| b.t)
+                        .filter(|&t| t <= (exit_param(o_r, ray.dir, h.voxel) + REACH_MARGIN) * vs);
                     if let Some(d) = direct
                         && self.composite_voxel(
                             ray,
@@ -336,7 +344,7 @@ impl Tracer<'_> {
                         }
                     }
                     match &best {
-                        Some(b) if b.t <= reach => return Some(self.accept(ray, b, stats)),
+                        Some(b) if here.is_some() => return Some(self.accept(ray, b, stats)),
                         Some(_) => stats.deferred += 1,
                         None if direct.is_some() => {}
                         None => stats.false_hits += 1,

@@ -7,11 +7,13 @@
 //! ([`DirectVolume`]).
 //!
 //! A voxel's sample is the placed volume's trilinear value at the voxel's
-//! centre, rounded to `f32` ([`voxel_sample`]); the voxelization and the
-//! tracer read the same numbers, so the voxels in the raster are exactly
-//! those of opacity above 0. Their records carry the object (and, where
-//! geometry shares the voxel, are listed with it; the geometry owns the
-//! voxel: the volume offers its voxels at the largest distance).
+//! centre, rounded to `f32` ([`voxel_sample`]), computed once per voxel
+//! ([`DirectVolume::new`], before the voxelization's passes); both passes
+//! and the tracer read those samples, so the voxels in the raster are
+//! exactly those of opacity above 0. Their records carry the object (and,
+//! where geometry shares the voxel, are listed with it; the geometry owns
+//! the voxel: the volume offers its voxels at the largest distance) and
+//! the transfer function's colour of the sample.
 //!
 //! ```
 //! use glam::DVec3;
@@ -36,14 +38,16 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
+use rrt_core::fixed::FRAC_BITS;
+use rrt_core::store::Texture;
 use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
 
 use super::BuildError;
 use super::pass::Pass;
-use super::volume::{VolumeColors, sample_grid};
+use super::volume::sample_grid;
 use crate::assets::volume::{Classifier, PlacedVolume, SampleType, VolumeError};
 use crate::frame::RasterFrame;
-use crate::scene::{SceneVolume, VolumeObject};
+use crate::scene::SceneVolume;
 
 /// The sample of raster voxel `v` of a placed volume: its trilinear value
 /// at the voxel's centre, rounded to `f32`; NaN outside the volume (clear
@@ -194,53 +198,67 @@ impl DirectVolume {
     }
 }
 
-/// Offers every voxel of opacity above 0 of a directly rendered volume to
-/// `sink`, over the layers it keeps, in z, y, x order, at the largest
-/// distance (so that geometry sharing a voxel owns it).
-fn offer_visible<S: VoxelSink + ?Sized>(
-    placed: &PlacedVolume<'_>,
-    frame: &RasterFrame,
-    classifier: &Classifier,
-    sink: &mut S,
-) {
-    let Some((first, n)) = placed.raster_box(frame) else {
-        return;
-    };
+/// Offers every voxel of opacity above 0 of a directly rendered volume,
+/// as its samples `d` give them, to `sink`, over the layers it keeps, in
+/// z, y, x order, at the largest distance (so that geometry sharing a
+/// voxel owns it).
+fn offer_visible<S: VoxelSink + ?Sized>(d: &DirectVolume, sink: &mut S) {
     let layers = sink.layers();
-    let z0 = first[2].max(layers.start);
-    let z1 = (first[2] + n[2]).min(layers.end);
+    let z0 = d.first[2].max(layers.start);
+    let z1 = d.first[2].saturating_add(d.dims[2]).min(layers.end);
     let surfel = Surfel {
         normal: [0, 0, NORMAL_ONE],
         distance: u32::MAX,
     };
+    let [nx, ny, _] = d.dims.map(|n| n as usize);
     for z in z0..z1 {
-        for y in first[1]..first[1] + n[1] {
-            for x in first[0]..first[0] + n[0] {
-                let v = [x, y, z];
-                let s = voxel_sample(placed, frame, v);
-                if classifier.sample_opacity(f64::from(s)) > 0.0 {
-                    sink.offer(v, surfel);
+        // z − first ≥ 0 and below the box's depth: in the samples.
+        let layer = (z - d.first[2]) as usize * nx * ny;
+        for (j, row) in d
+            .values
+            .get(layer..layer + nx * ny)
+            .unwrap_or(&[])
+            .chunks(nx.max(1))
+            .enumerate()
+        {
+            let y = d.first[1] + j as u32;
+            for (i, &s) in row.iter().enumerate() {
+                if d.classifier.sample_opacity(f64::from(s)) > 0.0 {
+                    sink.offer([d.first[0] + i as u32, y, z], surfel);
                 }
             }
         }
     }
 }
 
-/// Voxelizes a directly rendered volume object into `pass`: every voxel
-/// of opacity above 0, coloured by the transfer function (or the
-/// material's texture).
+/// The colours of a directly rendered volume's voxels: the transfer
+/// function's colour of each voxel's sample, as the tracer composites it
+/// (the base colour where there is no colour ramp, or outside the box).
+struct SampleColors<'a>(&'a DirectVolume);
+
+impl Texture for SampleColors<'_> {
+    fn color(&self, centre: [i64; 3], _normal: [i32; 3], base: [u8; 3]) -> [u8; 3] {
+        // A voxel's centre is (v + ½) voxels in fixed point: v is its floor.
+        let v = centre.map(|c| u32::try_from(c >> FRAC_BITS).unwrap_or(u32::MAX));
+        self.0
+            .value(v)
+            .map_or(base, |x| self.0.classifier.color(f64::from(x), base))
+    }
+}
+
+/// Voxelizes a directly rendered volume object into `pass` from its
+/// samples over the raster `d` ([`DirectVolume::new`]): every voxel of
+/// opacity above 0, coloured by the transfer function (or the material's
+/// texture). Both passes read the same samples, which the tracer reads.
 ///
 /// # Errors
 /// The store's.
 pub(super) fn voxelize_object(
-    v: &VolumeObject,
-    frame: &RasterFrame,
+    d: &DirectVolume,
     pass: Pass<'_, '_, '_, '_>,
 ) -> Result<(), BuildError> {
-    let placed = v.data.placed();
-    let classifier = &v.data.classifier;
     match pass {
-        Pass::Count(c) => offer_visible(&placed, frame, classifier, c),
+        Pass::Count(c) => offer_visible(d, c),
         Pass::Fill {
             filler,
             attrs,
@@ -249,10 +267,9 @@ pub(super) fn voxelize_object(
         } => {
             filler.begin_object(attrs)?;
             if let Some(t) = texture {
-                offer_visible(&placed, frame, classifier, &mut filler.textured(t));
+                offer_visible(d, &mut filler.textured(t));
             } else {
-                let colors = VolumeColors::new(placed, *frame, classifier);
-                offer_visible(&placed, frame, classifier, &mut filler.textured(&colors));
+                offer_visible(d, &mut filler.textured(&SampleColors(d)));
             }
         }
     }

@@ -328,6 +328,9 @@ pub fn build(
 
     let mut plane = Plane::zeroed(extent.len()).map_err(alloc_err("raster plane", extent.len()))?;
     let textures = MaterialTextures::new(scene, frame);
+    // Sampled once: the passes offer their voxels from these samples, and
+    // the tracer composites them.
+    let direct = pool.install(|| direct_volumes(&objects, &frame, scene, opts.fit.max_memory))?;
     let passes = Passes {
         objects: &objects,
         frame: &frame,
@@ -335,6 +338,7 @@ pub fn build(
         materials: &materials,
         textures: &textures,
         exact: opts.exact,
+        direct: &direct,
     };
     let pieces = slabs::pieces(extent.dims(), pool.current_num_threads());
     // Refused after the count pass, before the records are allocated: an
@@ -425,7 +429,6 @@ pub fn build(
             material: materials.of(o.material()),
         })
         .collect();
-    let direct = direct_volumes(&objects, &frame, scene, opts.fit.max_memory)?;
     let world_lights = scene
         .lights
         .iter()

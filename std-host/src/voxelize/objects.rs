@@ -123,7 +123,10 @@ impl TableObject<'_> {
         }))
     }
 
-    /// Voxelizes the object into `pass`.
+    /// Voxelizes the object into `pass`. A volume rendered directly is
+    /// voxelized from `samples`, its samples over the raster
+    /// ([`direct::DirectVolume::new`]; `None` where it misses the raster:
+    /// no voxels); other objects ignore `samples`.
     ///
     /// # Errors
     /// A voxelizer's refusal with the object's location, the store's.
@@ -131,12 +134,13 @@ impl TableObject<'_> {
         &self,
         frame: &RasterFrame,
         separation: Separation,
+        samples: Option<&direct::DirectVolume>,
         pass: Pass<'_, '_, '_, '_>,
     ) -> Result<(), BuildError> {
         match *self {
             Self::Primitive(o) => primitive(o, frame, separation, pass),
             Self::Volume(v) if v.data.classifier.is_direct() => {
-                direct::voxelize_object(v, frame, pass)
+                samples.map_or(Ok(()), |d| direct::voxelize_object(d, pass))
             }
             Self::Volume(v) => volume::voxelize_object(v, frame, separation, None, pass),
             Self::Vox(v) => vox::voxelize_object(v, frame, pass),

@@ -42,6 +42,7 @@ use rrt_core::store::{BRICK, Counter, Limits, Sizing, brick_count, directory_len
 use rrt_core::voxel::VoxelRecord;
 use rrt_core::voxelize::Separation;
 
+use super::direct::DirectVolume;
 use super::materials::MaterialTable;
 use super::objects::TableObject;
 use super::pass::Pass;
@@ -123,6 +124,9 @@ pub(super) struct Passes<'a> {
     pub textures: &'a MaterialTextures<'a>,
     /// Object lists for the voxels several objects share.
     pub exact: bool,
+    /// The samples of the volumes rendered directly, in object-id order
+    /// (their voxels are read from them).
+    pub direct: &'a [DirectVolume],
 }
 
 /// What the count pass found, for the caller's checks before the records
@@ -481,8 +485,13 @@ impl Passes<'_> {
         let mut counter = counter.map_err(|e| (0, e.into()))?;
         for &id in part.members {
             let o = &self.objects[id];
-            o.voxelize(self.frame, self.separation, Pass::Count(&mut counter))
-                .map_err(|e| (id, e))?;
+            o.voxelize(
+                self.frame,
+                self.separation,
+                self.samples(id),
+                Pass::Count(&mut counter),
+            )
+            .map_err(|e| (id, e))?;
             progress.inc(1);
         }
         let r = counter.report();
@@ -490,6 +499,15 @@ impl Passes<'_> {
             .finish()
             .map_err(|e| (self.objects.len(), e.into()))?;
         Ok((sizing, r.offers.saturating_sub(r.outside)))
+    }
+
+    /// The samples of object `id` if it is a volume rendered directly.
+    fn samples(&self, id: usize) -> Option<&DirectVolume> {
+        let i = self
+            .direct
+            .binary_search_by_key(&id, |d| usize::try_from(d.object).unwrap_or(usize::MAX))
+            .ok()?;
+        self.direct.get(i)
     }
 
     /// The fill pass of one piece into its records and list storage:
@@ -524,7 +542,7 @@ impl Passes<'_> {
                     .collect(),
                 texture: self.textures.of(m),
             };
-            o.voxelize(self.frame, self.separation, pass)
+            o.voxelize(self.frame, self.separation, self.samples(id), pass)
                 .map_err(|e| (id, e))?;
             progress.inc(1);
         }
