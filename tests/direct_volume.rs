@@ -241,11 +241,16 @@ fn the_step_correction_adds_up_over_any_split() {
     assert!((a.colour.x - want).abs() < 1e-12);
 }
 
-/// The raster holds exactly the voxels whose sample (the one the tracer
-/// composites) has an opacity above 0, each recorded with the transfer
-/// function's colour of that sample, for a volume whose cells do not line
-/// up with the voxels (values varying along every axis, half of them
-/// clear), on one thread and on three (the passes in pieces).
+/// The raster lists a volume rendered directly in exactly the voxels
+/// whose sample (the one the tracer composites) has an opacity above 0,
+/// the voxels it owns with the transfer function's colour of that sample,
+/// and marks alone ([`DirectVolume::alone`]) exactly those whose record
+/// lists it and nothing else: a volume whose cells do not line up with
+/// the voxels (values varying along every axis, half of them clear), with
+/// a sphere inside that shares some of its voxels, on one thread and on
+/// three (the passes in pieces).
+///
+/// [`DirectVolume::alone`]: rrt_host::voxelize::direct::DirectVolume::alone
 #[test]
 fn the_raster_holds_the_visible_samples_with_their_colours() {
     let d = rrt_tests::fresh_dir("rrt-test", "dvr-visible");
@@ -281,6 +286,10 @@ kd = 1
 [[object]]
 material = "m"
 volume = "v"
+
+[[object]]
+material = "m"
+sphere = { centre = [4.1, 3.2, 2.3], radius = 1.3 }
 "#,
     )
     .unwrap();
@@ -296,32 +305,33 @@ volume = "v"
             panic!("one volume rendered directly: {}", vs.direct.len());
         };
         let dims = vs.extent().dims();
-        let (mut visible, mut clear) = (0, 0);
+        let (mut visible, mut clear, mut shared) = (0, 0, 0);
         for z in 0..dims[2] {
             for y in 0..dims[1] {
                 for x in 0..dims[0] {
                     let v = [x, y, z];
                     let value = dv.value(v).map(f64::from);
                     let alpha = value.map_or(0.0, |s| dv.classifier.sample_opacity(s));
-                    match store.get_voxel(v) {
-                        Some(rec) => {
-                            assert!(alpha > 0.0, "{v:?}: {value:?} recorded with opacity 0");
-                            assert_eq!(store.objects(rec), &[dv.object], "{v:?}");
-                            let want = dv.classifier.color(value.unwrap(), dv.base);
-                            assert_eq!(rec.color, want, "{v:?}: {value:?}");
-                            visible += 1;
-                        }
-                        None => {
-                            assert!(alpha <= 0.0, "{v:?}: {value:?} missing");
-                            clear += value.is_some() as u32;
-                        }
+                    let rec = store.get_voxel(v);
+                    let objects = rec.map_or(&[][..], |r| store.objects(r));
+                    let listed = objects.contains(&dv.object);
+                    assert_eq!(listed, alpha > 0.0, "{v:?}: {value:?}, {objects:?}");
+                    assert_eq!(dv.alone(v), objects == [dv.object], "{v:?}: {objects:?}");
+                    if let Some(r) = rec
+                        && store.owner(r) == dv.object
+                    {
+                        let want = dv.classifier.color(value.unwrap(), dv.base);
+                        assert_eq!(r.color, want, "{v:?}: {value:?}");
                     }
+                    visible += u32::from(listed);
+                    shared += u32::from(listed && objects.len() > 1);
+                    clear += u32::from(value.is_some() && !listed);
                 }
             }
         }
         assert!(
-            visible > 50 && clear > 50,
-            "{visible} visible, {clear} clear"
+            visible > 50 && clear > 50 && shared > 5,
+            "{visible} visible, {clear} clear, {shared} shared"
         );
         let records: Vec<_> = store.records().to_vec();
         match &first {

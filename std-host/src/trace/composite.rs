@@ -97,6 +97,12 @@ impl Tracer<'_> {
             .find_map(|&id| self.direct_volume(id))
     }
 
+    /// The volume rendered directly whose voxel `v` is, with no other
+    /// object ([`DirectVolume::alone`]).
+    pub(super) fn direct_alone(&self, v: [u32; 3]) -> Option<&DirectVolume> {
+        self.direct.iter().find(|d| d.alone(v))
+    }
+
     /// The volume rendered directly with object id `id`.
     pub(super) fn direct_volume(&self, id: u32) -> Option<&DirectVolume> {
         let i = self.direct.binary_search_by_key(&id, |d| d.object).ok()?;

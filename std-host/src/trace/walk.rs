@@ -309,14 +309,25 @@ impl Tracer<'_> {
                 return best.map(|c| self.accept(ray, &c, stats));
             }
             let h = dray.hit();
-            let c = self.raster.plane().get(h.index).copied().unwrap_or(0);
-            match self.store.get_hinted(h.voxel, c) {
-                None => stats.missing += 1,
-                Some(rec) => {
-                    let direct = self.direct_of(rec);
-                    // A voxel of a volume rendered directly and nothing
-                    // else has nothing to test.
-                    if direct.is_none() || self.store.objects(rec).len() > 1 {
+            // The volume rendered directly and the record, if one is
+            // needed: a voxel of a volume alone has nothing to test.
+            let looked = match self.direct_alone(h.voxel) {
+                Some(d) => Some((Some(d), None)),
+                None => {
+                    let c = self.raster.plane().get(h.index).copied().unwrap_or(0);
+                    let rec = self.store.get_hinted(h.voxel, c);
+                    if rec.is_none() {
+                        stats.missing += 1;
+                    }
+                    rec.map(|r| (self.direct_of(r), Some(r)))
+                }
+            };
+            match looked {
+                None => {}
+                Some((direct, rec)) => {
+                    if let Some(rec) = rec
+                        && (direct.is_none() || self.store.objects(rec).len() > 1)
+                    {
                         self.test_voxel(
                             ray, o_r, h.voxel, h.index, rec, tmin, leave, &mut mail, &mut best,
                         );

@@ -39,7 +39,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 use rrt_core::fixed::FRAC_BITS;
-use rrt_core::store::Texture;
+use rrt_core::store::{RecordStore, Texture};
 use rrt_core::voxelize::{NORMAL_ONE, Surfel, VoxelSink};
 
 use super::BuildError;
@@ -62,8 +62,9 @@ pub fn voxel_sample(placed: &PlacedVolume<'_>, frame: &RasterFrame, v: [u32; 3])
 }
 
 /// A volume rendered directly, as the tracer reads it: the samples at
-/// the centres of the raster voxels its cells cover, and its transfer
-/// function.
+/// the centres of the raster voxels its cells cover, its transfer
+/// function, and which of those voxels it holds alone (no record lookup
+/// needed there).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DirectVolume {
     /// Its id in the object table.
@@ -81,6 +82,10 @@ pub struct DirectVolume {
     /// The world length the ramp's opacities are for: the placed
     /// volume's smallest sample spacing.
     pub spacing: f64,
+    /// One bit per voxel of the box (x fastest, 64 to a word): whether
+    /// the voxel's record lists this volume and no other object
+    /// ([`DirectVolume::mark_alone`]; all clear before).
+    alone: Vec<u64>,
 }
 
 impl DirectVolume {
@@ -141,13 +146,13 @@ impl DirectVolume {
             classifier: classifier.clone(),
             base,
             spacing,
+            alone: Vec::new(),
         }))
     }
 
-    /// The sample of raster voxel `v` (`None` outside the box; NaN where
-    /// the volume has no value).
-    #[must_use]
-    pub fn value(&self, v: [u32; 3]) -> Option<f32> {
+    /// The position of raster voxel `v` among the samples (`None`
+    /// outside the box).
+    fn local(&self, v: [u32; 3]) -> Option<usize> {
         let mut l = [0u64; 3];
         for axis in 0..3 {
             let d = v[axis].checked_sub(self.first[axis])?;
@@ -157,8 +162,39 @@ impl DirectVolume {
             l[axis] = u64::from(d);
         }
         let [nx, ny, _] = self.dims.map(u64::from);
-        let i = l[0] + nx * (l[1] + ny * l[2]);
-        self.values.get(usize::try_from(i).ok()?).copied()
+        usize::try_from(l[0] + nx * (l[1] + ny * l[2])).ok()
+    }
+
+    /// Marks the voxels whose record in `store` lists this volume and
+    /// nothing else ([`DirectVolume::alone`]).
+    pub fn mark_alone(&mut self, store: &RecordStore<'_>) {
+        let mut alone = vec![0u64; self.values.len().div_ceil(64)];
+        for (v, rec) in store.iter() {
+            if store.objects(rec) == [self.object]
+                && let Some(i) = self.local(v)
+                && let Some(w) = alone.get_mut(i / 64)
+            {
+                *w |= 1 << (i % 64);
+            }
+        }
+        self.alone = alone;
+    }
+
+    /// Whether raster voxel `v`'s record lists this volume and no other
+    /// object (after [`DirectVolume::mark_alone`]; false before, and
+    /// outside the box): then the tracer needs no record to composite it.
+    #[must_use]
+    pub fn alone(&self, v: [u32; 3]) -> bool {
+        self.local(v)
+            .and_then(|i| self.alone.get(i / 64).map(|w| w >> (i % 64) & 1 != 0))
+            .unwrap_or(false)
+    }
+
+    /// The sample of raster voxel `v` (`None` outside the box; NaN where
+    /// the volume has no value).
+    #[must_use]
+    pub fn value(&self, v: [u32; 3]) -> Option<f32> {
+        self.values.get(self.local(v)?).copied()
     }
 
     /// The transfer function's opacity of raster voxel `v` (0 outside).

@@ -330,7 +330,8 @@ pub fn build(
     let textures = MaterialTextures::new(scene, frame);
     // Sampled once: the passes offer their voxels from these samples, and
     // the tracer composites them.
-    let direct = pool.install(|| direct_volumes(&objects, &frame, scene, opts.fit.max_memory))?;
+    let mut direct =
+        pool.install(|| direct_volumes(&objects, &frame, scene, opts.fit.max_memory))?;
     let passes = Passes {
         objects: &objects,
         frame: &frame,
@@ -390,6 +391,9 @@ pub fn build(
     // the rank hints.
     let store = rrt_core::store::RecordStore::with_lists(extent, &directory, &records, &lists)
         .map_err(|e| BuildError::Raster(e.to_string()))?;
+    for d in &mut direct {
+        d.mark_alone(&store);
+    }
     let lines = pool.install(|| finish_plane(&mut plane, &store));
     let voxelize = t0.elapsed();
 
