@@ -162,8 +162,29 @@ fn ears(v: &[DVec3], normal: DVec3) -> Option<Box<[[u32; 3]]>> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// A comb in the plane z = 0, counter-clockwise seen from +z: three
+    /// teeth (x in [0, 0.5], [1, 2], [3, 4]) rising from y = 1 to 3 over a
+    /// base from y = 0 to 1, with notches between them (x in (0.5, 1) and
+    /// (2, 3) above y = 1). Area 9. The fan from its first vertex folds
+    /// back at the notches and covers them. (The integration tests' copy:
+    /// `rrt_tests::COMB`.)
+    pub(crate) const COMB: [(f64, f64); 12] = [
+        (0.0, 0.0),
+        (4.0, 0.0),
+        (4.0, 3.0),
+        (3.0, 3.0),
+        (3.0, 1.0),
+        (2.0, 1.0),
+        (2.0, 3.0),
+        (1.0, 3.0),
+        (1.0, 1.0),
+        (0.5, 1.0),
+        (0.5, 3.0),
+        (0.0, 3.0),
+    ];
 
     /// The triangles of `v` as the front-ends cut it.
     fn cut_into(v: &[DVec3]) -> Vec<[usize; 3]> {
@@ -265,22 +286,7 @@ mod tests {
     #[test]
     fn a_clockwise_comb_winds_its_ears_like_itself() {
         // Seen from +z the comb runs clockwise: its normal is −z.
-        let mut v: Vec<DVec3> = [
-            (0.0, 0.0),
-            (4.0, 0.0),
-            (4.0, 3.0),
-            (3.0, 3.0),
-            (3.0, 1.0),
-            (2.0, 1.0),
-            (2.0, 3.0),
-            (1.0, 3.0),
-            (1.0, 1.0),
-            (0.5, 1.0),
-            (0.5, 3.0),
-            (0.0, 3.0),
-        ]
-        .map(|(x, y)| DVec3::new(x, y, 0.0))
-        .to_vec();
+        let mut v: Vec<DVec3> = COMB.map(|(x, y)| DVec3::new(x, y, 0.0)).to_vec();
         v.reverse();
         let tris = cut_into(&v);
         for t in &tris {
