@@ -283,30 +283,32 @@ pub fn relax_rows(rows: &mut [u8], neighbour: &[u8], nx: usize, y0: usize, area:
     let at = |yy: usize| neighbour.get(yy.checked_mul(nx)?..)?.get(..nx);
     let stop = area.x[1].min(nx);
     let mut start = area.x[0];
+    // Buffers shared by the chunks; each use writes (or reads) only the
+    // chunk's first `len` cells, so a narrow area costs what it covers.
+    let mut ring = [[FAR; CHUNK]; 3];
+    let mut offer = [FAR; CHUNK];
+    let mut t = [FAR; CHUNK + 2];
+    let slot = |yy: usize| yy.wrapping_add(1) % 3;
     // Column chunks; within one, the rows in order, each relaxed from the
     // neighbour rows around it, each of those reduced once ([`beyond`]) and
     // kept for the three rows it borders.
     while start < stop {
         let chunk_end = start.saturating_add(CHUNK).min(stop);
         let len = chunk_end.wrapping_sub(start);
-        let mut ring = [[FAR; CHUNK]; 3];
-        let slot = |yy: usize| yy.wrapping_add(1) % 3;
-        if let (Some(above), Some(r)) = (
-            first.checked_sub(1).and_then(at),
-            ring.get_mut(slot(first.wrapping_sub(1))),
-        ) {
-            beyond(above, start, chunk_end, r);
+        let mut reduce = |row: Option<&[u8]>, r: &mut [u8; CHUNK]| match row {
+            Some(row) => beyond(row, start, chunk_end, r, &mut t),
+            None => r.get_mut(..len).unwrap_or(&mut []).fill(FAR),
+        };
+        if let Some(r) = ring.get_mut(slot(first.wrapping_sub(1))) {
+            reduce(first.checked_sub(1).and_then(at), r);
         }
-        if let (Some(row), Some(r)) = (at(first), ring.get_mut(slot(first))) {
-            beyond(row, start, chunk_end, r);
+        if let Some(r) = ring.get_mut(slot(first)) {
+            reduce(at(first), r);
         }
         for y in first..end {
             let next = y.saturating_add(1);
             if let Some(r) = ring.get_mut(slot(next)) {
-                match at(next) {
-                    Some(row) => beyond(row, start, chunk_end, r),
-                    None => r.fill(FAR),
-                }
+                reduce(at(next), r);
             }
             let base = y.wrapping_sub(y0).wrapping_mul(nx);
             let Some(seg) = rows.get_mut(base.wrapping_add(start)..base.wrapping_add(chunk_end))
@@ -319,7 +321,6 @@ pub fn relax_rows(rows: &mut [u8], neighbour: &[u8], nx: usize, y0: usize, area:
                 r1.get(..len).unwrap_or(&[]),
                 r2.get(..len).unwrap_or(&[]),
             );
-            let mut offer = [FAR; CHUNK];
             for (((o, &a), &b), &c) in offer.iter_mut().zip(r0).zip(r1).zip(r2) {
                 *o = nearer(a, nearer(b, c));
             }
@@ -334,20 +335,26 @@ pub fn relax_rows(rows: &mut [u8], neighbour: &[u8], nx: usize, y0: usize, area:
 /// what the row offers each cell of the rows beside it. Since
 /// [`one_beyond`] is increasing, the least of three such values is one
 /// beyond the least of the nine cells, so each neighbour row is reduced
-/// once for the three rows it borders.
-fn beyond(row: &[u8], start: usize, end: usize, out: &mut [u8; CHUNK]) {
+/// once for the three rows it borders. Writes `out[..end − start]`; `t`
+/// is scratch.
+fn beyond(row: &[u8], start: usize, end: usize, out: &mut [u8; CHUNK], t: &mut [u8; CHUNK + 2]) {
     let n = row.len();
+    let len = end.wrapping_sub(start).min(CHUNK);
     // t[j] = the row's cell at x = start − 1 + j (FAR beyond the row).
-    let mut t = [FAR; CHUNK + 2];
     let lo = start.saturating_sub(1);
     let hi = end.saturating_add(1).min(n);
     // 0 when start > 0, 1 at the row's start.
     let off = lo.wrapping_add(1).wrapping_sub(start);
     let width = hi.wrapping_sub(lo);
+    if off != 0 || width < len.wrapping_add(2) {
+        // A neighbour beyond the row's ends: FAR.
+        t.get_mut(..len.wrapping_add(2))
+            .unwrap_or(&mut [])
+            .fill(FAR);
+    }
     if let (Some(src), Some(dst)) = (row.get(lo..hi), t.get_mut(off..off.wrapping_add(width))) {
         dst.copy_from_slice(src);
     }
-    let len = end.wrapping_sub(start).min(CHUNK);
     let (a, b, c) = (
         t.get(..len).unwrap_or(&[]),
         t.get(1..len.wrapping_add(1)).unwrap_or(&[]),
@@ -374,11 +381,12 @@ fn relax_row(row: &mut [u8], neighbour: &[u8], [x0, x1]: [usize; 2]) {
     let stop = x1.min(row.len());
     let mut start = x0;
     let mut offered = [FAR; CHUNK];
+    let mut t = [FAR; CHUNK + 2];
     while start < stop {
         let end = start.saturating_add(CHUNK).min(stop);
-        beyond(neighbour, start, end, &mut offered);
+        beyond(neighbour, start, end, &mut offered, &mut t);
         if let Some(seg) = row.get_mut(start..end) {
-            lower(seg, &offered);
+            lower(seg, offered.get(..end.wrapping_sub(start)).unwrap_or(&[]));
         }
         start = end;
     }

@@ -393,6 +393,43 @@ pub fn line_distances(
     line_stand_ins(raster, bricks, 0, lines)
 }
 
+/// Lines in a row of the longest raster axis ([`MAX_AXIS`](crate::raster::MAX_AXIS)).
+const MAX_LINES_PER_ROW: usize = crate::raster::MAX_AXIS as usize / LINE_CELLS;
+
+/// The stand-in of the line of plane cells `cells` whose bricks' coarse
+/// level is at least `bound`: that bound where it is [`NEAR_LIMIT`] or
+/// more (the plane is not read), else the least distance of the cells
+/// (an empty cell counting as `NEAR_LIMIT`) or `bound` if larger, and
+/// [`cell::EMPTY`] (read the plane) where a cell is opaque or flagged or
+/// the distance is below 2.
+#[inline]
+fn stand_in(cells: &[u8], bound: u8) -> u8 {
+    if bound >= NEAR_LIMIT {
+        return bound << cell::DISTANCE_SHIFT;
+    }
+    // Without OPAQUE or PROXIMITY in any cell, every cell is its distance
+    // bits alone (EMPTY the farthest), and the nearest cell holds the least
+    // distance.
+    let any = cells.iter().fold(0u8, |a, &c| a | c);
+    // `nearer` over the line, as a plain minimum of `c − 1` (wrapping:
+    // EMPTY last), which vectorizes.
+    let least = cells
+        .iter()
+        .fold(u8::MAX, |a, &c| a.min(c.wrapping_sub(1)))
+        .wrapping_add(1);
+    let d = if least == cell::EMPTY {
+        NEAR_LIMIT
+    } else {
+        distance(least)
+    };
+    let d = d.max(bound);
+    if any & (cell::OPAQUE | cell::PROXIMITY) != 0 || d < 2 {
+        cell::EMPTY
+    } else {
+        d << cell::DISTANCE_SHIFT
+    }
+}
+
 /// The stand-ins of the lines `first..first + lines.len()` of the line
 /// level ([`line_distances`]) from the raster's coarse level `bricks`
 /// ([`coarse_level`], or [`coarse_field`] of the occupied bricks), into
@@ -426,6 +463,39 @@ pub fn line_stand_ins(
     // per line).
     let (mut x, row) = (start.checked_rem(nx).unwrap_or(0), div(start, nx));
     let (mut y, mut z) = (row.checked_rem(ny).unwrap_or(0), div(row, ny));
+    if nx.is_multiple_of(LINE_CELLS) && LINE_CELLS.is_multiple_of(edge) {
+        // Every line lies in one row and covers whole bricks: the rows of
+        // a brick row share their lines' coarse bounds, made once.
+        let per_row = div(nx, LINE_CELLS);
+        let span = div(LINE_CELLS, edge);
+        let mut shared = [DISTANCE_LIMIT; MAX_LINES_PER_ROW];
+        let mut made: Option<usize> = None;
+        let mut j = div(x, LINE_CELLS);
+        for out in lines.iter_mut() {
+            if start >= len {
+                break;
+            }
+            let brick_row = div(z, edge).wrapping_mul(cy).wrapping_add(div(y, edge));
+            if made != Some(brick_row) {
+                let base = brick_row.wrapping_mul(cx);
+                let row = bricks.get(base..base.wrapping_add(cx)).unwrap_or(&[]);
+                for (b, piece) in shared.iter_mut().zip(row.chunks(span)) {
+                    *b = piece.iter().fold(DISTANCE_LIMIT, |a, &c| a.min(c));
+                }
+                made = Some(brick_row);
+            }
+            let bound = shared.get(j).copied().unwrap_or(0);
+            let end = start.saturating_add(LINE_CELLS);
+            *out = stand_in(plane.get(start..end).unwrap_or(&[]), bound);
+            start = end;
+            j = j.wrapping_add(1);
+            if j == per_row {
+                j = 0;
+                (y, z) = next_row(y, z, ny);
+            }
+        }
+        return Ok(());
+    }
     for out in lines.iter_mut() {
         if start >= len {
             break;
@@ -448,32 +518,7 @@ pub fn line_stand_ins(
             px = 0;
             (py, pz) = next_row(py, pz, ny);
         }
-        *out = if bound >= NEAR_LIMIT {
-            bound << cell::DISTANCE_SHIFT
-        } else {
-            let cells = plane.get(start..end).unwrap_or(&[]);
-            // Without OPAQUE or PROXIMITY in any cell, every cell is its
-            // distance bits alone (EMPTY the farthest), and the nearest cell
-            // holds the least distance.
-            let any = cells.iter().fold(0u8, |a, &c| a | c);
-            // `nearer` over the line, as a plain minimum of `c − 1`
-            // (wrapping: EMPTY last), which vectorizes.
-            let least = cells
-                .iter()
-                .fold(u8::MAX, |a, &c| a.min(c.wrapping_sub(1)))
-                .wrapping_add(1);
-            let d = if least == cell::EMPTY {
-                NEAR_LIMIT
-            } else {
-                distance(least)
-            };
-            let d = d.max(bound);
-            if any & (cell::OPAQUE | cell::PROXIMITY) != 0 || d < 2 {
-                cell::EMPTY
-            } else {
-                d << cell::DISTANCE_SHIFT
-            }
-        };
+        *out = stand_in(plane.get(start..end).unwrap_or(&[]), bound);
         start = end;
         x = x.wrapping_add(LINE_CELLS);
         while x >= nx {

@@ -147,7 +147,13 @@ fn distances_stop_at_the_near_limit() {
 /// including rasters whose rows are not whole lines.
 #[test]
 fn far_lines_are_bounded_by_the_coarse_level() {
-    for dims in [[64, 64, 64], [200, 30, 20], [37, 90, 41], [5, 7, 300]] {
+    for dims in [
+        [64, 64, 64],
+        [192, 40, 30],
+        [200, 30, 20],
+        [37, 90, 41],
+        [5, 7, 300],
+    ] {
         let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
         let at = [[3, 5, 6], [150, 2, 19], [36, 0, 20], [4, 6, 150]];
         for v in at.into_iter().filter(|&v| e.contains(v)) {
@@ -161,6 +167,33 @@ fn far_lines_are_bounded_by_the_coarse_level() {
                 }
             }
             check_line_level(e, &plane, &want, &std::format!("{dims:?} {v:?}"));
+        }
+    }
+}
+
+/// The line level made in parts from any first line (as threads share it
+/// out) is the line level made at once, for rows of whole lines and not.
+#[test]
+fn line_level_in_parts_is_the_whole() {
+    for dims in [[192, 40, 30], [128, 17, 9], [200, 30, 20]] {
+        let e = Extent::new(dims[0], dims[1], dims[2]).unwrap();
+        let mut plane = vec![cell::EMPTY; e.len()];
+        for v in [[3, 5, 6], [150, 2, 19], [100, 16, 8]] {
+            if let Some(i) = e.index(v) {
+                plane[i] = cell::OPAQUE;
+            }
+        }
+        distance_field(&mut RasterMut::new(e, &mut plane).unwrap());
+        let raster = Raster::new(e, &plane).unwrap();
+        let mut bricks = vec![0u8; coarse_extent(e).unwrap().len()];
+        let mut whole = vec![0u8; line_count(e.len())];
+        line_distances(&raster, &mut bricks, &mut whole).unwrap();
+        for part in [1, 5, 7, 64] {
+            let mut lines = vec![0xffu8; whole.len()];
+            for (k, l) in lines.chunks_mut(part).enumerate() {
+                line_stand_ins(&raster, &bricks, k * part, l).unwrap();
+            }
+            assert_eq!(lines, whole, "{dims:?} in parts of {part}");
         }
     }
 }

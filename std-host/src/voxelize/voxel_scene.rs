@@ -305,37 +305,25 @@ fn back_field_rows(plane: &Plane, store: &RecordStore<'_>, z0: u32, slices: [u32
 /// side along one axis, whose elements lie `stride` apart, `n` of them
 /// (the array holds whole groups of `n · stride`).
 fn dilate(flags: &[bool], n: usize, stride: usize, reach: usize) -> Vec<bool> {
-    let mut out = vec![false; flags.len()];
+    let mut out = flags.to_vec();
     let block = n * stride;
     if block == 0 {
         return out;
     }
+    // Each shift by `d` elements along the axis, as one run of the group:
+    // element k takes element k + d, for the k where both lie in it.
     for (src, dst) in flags.chunks(block).zip(out.chunks_mut(block)) {
-        for i in 0..stride {
-            // The nearest flagged element before, then after, each one.
-            let mut last: Option<usize> = None;
-            for k in 0..n {
-                let j = k * stride + i;
-                if src.get(j) == Some(&true) {
-                    last = Some(k);
-                }
-                if last.is_some_and(|l| k - l <= reach)
-                    && let Some(d) = dst.get_mut(j)
-                {
-                    *d = true;
-                }
+        let len = src.len();
+        for d in 1..=reach.min(n.saturating_sub(1)) {
+            let shift = d * stride;
+            if shift >= len {
+                break;
             }
-            let mut next: Option<usize> = None;
-            for k in (0..n).rev() {
-                let j = k * stride + i;
-                if src.get(j) == Some(&true) {
-                    next = Some(k);
-                }
-                if next.is_some_and(|m| m - k <= reach)
-                    && let Some(d) = dst.get_mut(j)
-                {
-                    *d = true;
-                }
+            for (o, &f) in dst[..len - shift].iter_mut().zip(&src[shift..]) {
+                *o |= f;
+            }
+            for (o, &f) in dst[shift..].iter_mut().zip(&src[..len - shift]) {
+                *o |= f;
             }
         }
     }
@@ -491,6 +479,14 @@ struct BrickRows {
     /// Per brick row, `bz · by + by_row`: whether a brick of it, or of a
     /// brick row beside it (±1 in y and z), holds a record.
     held: Vec<bool>,
+    /// Per brick, `(bz · by + by_row) · bx + bx_col`: whether a brick
+    /// within [`NEAR_BRICKS`] bricks of it on every axis holds a record.
+    /// Only cells of such bricks lie within
+    /// [`FIELD_REACH`](field::FIELD_REACH) of an opaque voxel, so only
+    /// they can change when a slice is relaxed from its neighbour.
+    near: Vec<bool>,
+    /// Bricks per brick row.
+    bx: usize,
     /// Brick rows per brick layer.
     by: usize,
     /// The first slice of the plane the field is computed over (a
@@ -508,6 +504,9 @@ impl BrickRows {
         }
         let bricks: Vec<bool> = holds_records(directory).collect();
         let own: Vec<bool> = bricks.chunks(bx).map(|row| row.contains(&true)).collect();
+        let near = dilate(&bricks, bx, 1, NEAR_BRICKS);
+        let near = dilate(&near, by, bx, NEAR_BRICKS);
+        let near = dilate(&near, bz, bx * by, NEAR_BRICKS);
         let at = |y: usize, z: usize| own.get(z * by + y).copied().unwrap_or(false);
         let held = (0..bz * by)
             .map(|b| {
@@ -518,8 +517,29 @@ impl BrickRows {
             .collect();
         Some(Self {
             held,
+            near,
+            bx,
             by,
             z0: z0 as usize,
+        })
+    }
+
+    /// The runs of columns `[x0, x1)` of the brick row holding row `y` of
+    /// slice `z` (of the plane) whose bricks are near a record: outside
+    /// them no cell of the row lies within reach of an opaque voxel.
+    fn near_columns(&self, z: usize, y: usize) -> impl Iterator<Item = [usize; 2]> + '_ {
+        let b = ((self.z0 + z) / BRICK as usize * self.by + y / BRICK as usize) * self.bx;
+        let row = self.near.get(b..b + self.bx).unwrap_or(&[]);
+        let edge = BRICK as usize;
+        let mut at = 0;
+        std::iter::from_fn(move || {
+            let start = at + row.get(at..)?.iter().position(|&n| n)?;
+            let len = row[start..]
+                .iter()
+                .position(|&n| !n)
+                .unwrap_or(row.len() - start);
+            at = start + len;
+            Some([start * edge, at * edge])
         })
     }
 
@@ -529,6 +549,11 @@ impl BrickRows {
         self.held.get(b).copied().unwrap_or(true)
     }
 }
+
+/// Bricks on either side of a brick holding a record whose cells may lie
+/// within [`FIELD_REACH`](field::FIELD_REACH) of its voxels: the reach
+/// spans at most this many brick edges.
+const NEAR_BRICKS: usize = (field::FIELD_REACH as usize).div_ceil(BRICK as usize);
 
 /// The distance field of `plane` (as long as `extent`) on the current
 /// rayon pool: the core's steps ([`field`]) with the slices of step 1
@@ -556,18 +581,26 @@ fn distance_field(extent: Extent, plane: &mut [u8], rows: Option<&BrickRows>) {
     };
     for z in 1..nz {
         let area = reached(z.saturating_sub(reach)..z);
-        relax_slice(plane, [nx, ny], z, z - 1, area);
+        relax_slice(plane, [nx, ny], z, z - 1, area, rows);
     }
     for z in (0..nz.saturating_sub(1)).rev() {
         let area = reached(z + 1..(z + 1 + reach).min(nz));
-        relax_slice(plane, [nx, ny], z, z + 1, area);
+        relax_slice(plane, [nx, ny], z, z + 1, area, rows);
     }
 }
 
 /// Relaxes the box `area` of slice `z` of `plane` from its neighbour
 /// `from` ([`field::relax_rows`]), its rows shared out among the pool's
-/// threads.
-fn relax_slice(plane: &mut [u8], [nx, ny]: [usize; 2], z: usize, from: usize, area: Area) {
+/// threads; with `rows`, only the columns of each brick row that lie near
+/// a record ([`BrickRows::near_columns`]), the only ones that can change.
+fn relax_slice(
+    plane: &mut [u8],
+    [nx, ny]: [usize; 2],
+    z: usize,
+    from: usize,
+    area: Area,
+    rows: Option<&BrickRows>,
+) {
     if area.is_empty() {
         return;
     }
@@ -580,16 +613,41 @@ fn relax_slice(plane: &mut [u8], [nx, ny]: [usize; 2], z: usize, from: usize, ar
         (&mut lo[z * slice..][..slice], &hi[..slice])
     };
     let [y0, y1] = area.y;
-    let rows = &mut cur[y0 * nx..y1 * nx];
-    if (y1 - y0) * (area.x[1] - area.x[0]) < PARALLEL_CELLS {
-        field::relax_rows(rows, src, nx, y0, area);
+    let parallel = (y1 - y0) * (area.x[1] - area.x[0]) >= PARALLEL_CELLS;
+    let Some(near) = rows else {
+        let rows = &mut cur[y0 * nx..y1 * nx];
+        if !parallel {
+            field::relax_rows(rows, src, nx, y0, area);
+            return;
+        }
+        // A few bands of rows per thread.
+        let band = (y1 - y0).div_ceil(4 * rayon::current_num_threads()).max(1);
+        rows.par_chunks_mut(band * nx)
+            .enumerate()
+            .for_each(|(i, rows)| field::relax_rows(rows, src, nx, y0 + i * band, area));
         return;
+    };
+    // Brick rows: each relaxed over its near runs of columns.
+    let edge = BRICK as usize;
+    let first = y0 / edge * edge;
+    let brick_row = |(i, rows): (usize, &mut [u8])| {
+        let r0 = first + i * edge;
+        for [x0, x1] in near.near_columns(z, r0) {
+            let part = Area {
+                x: [x0.max(area.x[0]), x1.min(area.x[1])],
+                y: area.y,
+            };
+            field::relax_rows(rows, src, nx, r0, part);
+        }
+    };
+    let rows = &mut cur[first * nx..y1 * nx];
+    if parallel {
+        rows.par_chunks_mut(edge * nx)
+            .enumerate()
+            .for_each(brick_row);
+    } else {
+        rows.chunks_mut(edge * nx).enumerate().for_each(brick_row);
     }
-    // A few bands of rows per thread.
-    let band = (y1 - y0).div_ceil(4 * rayon::current_num_threads()).max(1);
-    rows.par_chunks_mut(band * nx)
-        .enumerate()
-        .for_each(|(i, rows)| field::relax_rows(rows, src, nx, y0 + i * band, area));
 }
 
 /// The line level of a plane over `extent` with its distance field
@@ -664,4 +722,47 @@ pub struct WorldLight {
     pub position: DVec3,
     /// Colour (white unless the file gives one).
     pub colour: DVec3,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The dilation along each axis of a 3D box of flags is the brute
+    /// force's: a flag is set where one lies within `reach` along the
+    /// axis, in the same column.
+    #[test]
+    fn dilate_spreads_along_one_axis() {
+        let dims = [7usize, 5, 9];
+        let len = dims.iter().product::<usize>();
+        let mut state = 0x9e37_79b9u64;
+        let flags: Vec<bool> = (0..len)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1);
+                state >> 61 == 0
+            })
+            .collect();
+        let at = |x: usize, y: usize, z: usize| (z * dims[1] + y) * dims[0] + x;
+        for axis in 0..3 {
+            let stride = dims[..axis].iter().product::<usize>();
+            for reach in [0, 1, 2, 4, 14] {
+                let got = dilate(&flags, dims[axis], stride, reach);
+                for z in 0..dims[2] {
+                    for y in 0..dims[1] {
+                        for x in 0..dims[0] {
+                            let p = [x, y, z];
+                            let want = (0..dims[axis]).any(|k| {
+                                let mut q = p;
+                                q[axis] = k;
+                                k.abs_diff(p[axis]) <= reach && flags[at(q[0], q[1], q[2])]
+                            });
+                            assert_eq!(got[at(x, y, z)], want, "axis {axis} reach {reach} {p:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
