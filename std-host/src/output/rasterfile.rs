@@ -745,7 +745,9 @@ fn differences<const W: usize>(raw: &[u8], len: usize, at: usize, planes: &mut [
     }
 }
 
-/// The entries [`transposed`] made `t` from, into `raw` (as long).
+/// The entries [`transposed`] made `t` from, into `raw` (as long): field
+/// by field, each gathered from its byte planes and added to the field
+/// before it, modulo its width, in one pass over the entries.
 fn untransposed(t: &[u8], fields: &[usize], raw: &mut [u8]) {
     let len: usize = fields.iter().sum();
     if len == 0 {
@@ -755,26 +757,21 @@ fn untransposed(t: &[u8], fields: &[usize], raw: &mut [u8]) {
     let raw = &mut raw[..m * len];
     let mut at = 0;
     for &w in fields {
-        // The field's byte planes back into the entries: its differences.
-        for (i, plane) in t.chunks_exact(m.max(1)).skip(at).take(w).enumerate() {
-            for (entry, &b) in raw.chunks_exact_mut(len).zip(plane) {
-                entry[at + i] = b;
-            }
-        }
-        // The differences summed, modulo the field's width.
+        let planes = &t[at * m..(at + w) * m];
         match w {
-            1 => running_sum::<1>(raw, len, at),
-            2 => running_sum::<2>(raw, len, at),
-            4 => running_sum::<4>(raw, len, at),
-            8 => running_sum::<8>(raw, len, at),
+            1 => sums::<1>(planes, raw, len, at),
+            2 => sums::<2>(planes, raw, len, at),
+            4 => sums::<4>(planes, raw, len, at),
+            8 => sums::<8>(planes, raw, len, at),
             _ => {
                 let mask = width_mask(w);
                 let mut prev = 0u64;
-                for entry in raw.chunks_exact_mut(len) {
-                    let f = &mut entry[at..at + w];
-                    let v = prev.wrapping_add(le_value(f)) & mask;
-                    prev = v;
-                    f.copy_from_slice(&v.to_le_bytes()[..w]);
+                for (e, entry) in raw.chunks_exact_mut(len).enumerate() {
+                    let d = (0..w)
+                        .rev()
+                        .fold(0u64, |d, i| (d << 8) | u64::from(planes[i * m + e]));
+                    prev = prev.wrapping_add(d) & mask;
+                    entry[at..at + w].copy_from_slice(&prev.to_le_bytes()[..w]);
                 }
             }
         }
@@ -782,18 +779,22 @@ fn untransposed(t: &[u8], fields: &[usize], raw: &mut [u8]) {
     }
 }
 
-/// Replaces the `W`-byte field at `at` of each entry (`len` bytes) of
-/// `raw` by the running sum of the fields so far, modulo `2^(8W)`.
-fn running_sum<const W: usize>(raw: &mut [u8], len: usize, at: usize) {
+/// The `W`-byte field at `at` of each entry (`len` bytes) of `raw`: the
+/// running sum, modulo `2^(8W)`, of the differences whose byte `i` for
+/// entry `e` is `planes[i·m + e]` (`m` entries): [`untransposed`]'s work
+/// for one field.
+fn sums<const W: usize>(planes: &[u8], raw: &mut [u8], len: usize, at: usize) {
+    let m = planes.len() / W;
+    let bytes: [&[u8]; W] = std::array::from_fn(|i| &planes[i * m..(i + 1) * m]);
     let mask = width_mask(W);
     let mut prev = 0u64;
-    for entry in raw.chunks_exact_mut(len) {
-        let f = &mut entry[at..at + W];
+    for (e, entry) in raw.chunks_exact_mut(len).enumerate().take(m) {
         let mut b = [0u8; 8];
-        b[..W].copy_from_slice(f);
-        let v = prev.wrapping_add(u64::from_le_bytes(b)) & mask;
-        prev = v;
-        f.copy_from_slice(&v.to_le_bytes()[..W]);
+        for (x, plane) in b.iter_mut().zip(&bytes) {
+            *x = plane[e];
+        }
+        prev = prev.wrapping_add(u64::from_le_bytes(b)) & mask;
+        entry[at..at + W].copy_from_slice(&prev.to_le_bytes()[..W]);
     }
 }
 
@@ -2326,8 +2327,8 @@ mod tests {
 
     #[test]
     fn transposed_entries_come_back() {
-        let fields = [4, 2, 1, 8, 1];
-        let raw: Vec<u8> = (0..16u32 * 37)
+        let fields = [4, 2, 1, 8, 1, 3];
+        let raw: Vec<u8> = (0..19u32 * 37)
             .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
             .collect();
         let t = transposed(&raw, &fields);
