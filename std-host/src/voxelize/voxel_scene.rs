@@ -560,7 +560,8 @@ const NEAR_BRICKS: usize = (field::FIELD_REACH as usize).div_ceil(BRICK as usize
 /// shared out, then the rows of each slice in steps 2 and 3, each slice
 /// relaxed only over the box its neighbours' opaque voxels reach. With
 /// `rows`, a fresh plane whose opaque voxels lie in those brick rows: the
-/// other rows are not read where no opaque voxel is near.
+/// other rows are not read where no opaque voxel is near, and steps 2 and
+/// 3 relax only the bricks near one holding a record.
 fn distance_field(extent: Extent, plane: &mut [u8], rows: Option<&BrickRows>) {
     let [nx, ny, nz] = extent.dims().map(|d| d as usize);
     let slice = nx * ny;
