@@ -1556,28 +1556,32 @@ fn decode_entries<T: Clone + Default + Send>(
         return Err(format!("{} bytes after the last block", b.len() - at));
     }
     let mut out = vec![T::default(); n];
+    // Each job's blocks share two buffers: a fresh block-sized allocation
+    // per block would be mapped, faulted in and unmapped every time.
     out.par_chunks_mut(per)
         .zip(ranges.par_iter())
-        .try_for_each(|(dst, r)| {
-            let fail = || {
-                format!(
-                    "the block at byte {} does not decompress",
-                    off + r.start as u64
-                )
-            };
-            let mut t = vec![0u8; dst.len() * len];
-            let got =
-                lz4_flex::block::decompress_into(&b[r.clone()], &mut t).map_err(|_| fail())?;
-            if got != t.len() {
-                return Err(fail());
-            }
-            let mut raw = vec![0u8; t.len()];
-            untransposed(&t, fields, &mut raw);
-            for (d, e) in dst.iter_mut().zip(raw.chunks_exact(len)) {
-                *d = parse(e);
-            }
-            Ok(())
-        })?;
+        .try_for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(t, raw): &mut (Vec<u8>, Vec<u8>), (dst, r)| {
+                let fail = || {
+                    format!(
+                        "the block at byte {} does not decompress",
+                        off + r.start as u64
+                    )
+                };
+                t.resize(dst.len() * len, 0);
+                let got = lz4_flex::block::decompress_into(&b[r.clone()], t).map_err(|_| fail())?;
+                if got != t.len() {
+                    return Err(fail());
+                }
+                raw.resize(t.len(), 0);
+                untransposed(t, fields, raw);
+                for (d, e) in dst.iter_mut().zip(raw.chunks_exact(len)) {
+                    *d = parse(e);
+                }
+                Ok(())
+            },
+        )?;
     Ok(out)
 }
 
