@@ -379,8 +379,9 @@ pub enum Loaded {
 
 /// Loads `path` as a saved raster when it starts with the raster magic,
 /// else parses and voxelizes it as an NFF or TOML scene (the built-in
-/// scene for `None`). `check_view` sees the scene's view before any
-/// voxelizing (a bad view is refused before the long work).
+/// scene for `None`), either on `threads` threads (0: one per core).
+/// `check_view` sees the scene's view before any voxelizing (a bad view
+/// is refused before the long work).
 ///
 /// # Errors
 /// The parser's, builder's or raster file's error; `--raster` or
@@ -416,7 +417,12 @@ pub fn load_or_build(
         let bar = progress(show_progress);
         crate::progress::phase(&bar, "loading", crate::progress::Unit::Bytes, 0);
         let limit = raster.max_memory.unwrap_or_else(default_max_memory);
-        let scene = rasterfile::load_within(p, &bar, limit);
+        // On `threads` threads, as a build would be.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|source| CliError::Threads { threads, source })?;
+        let scene = pool.install(|| rasterfile::load_within(p, &bar, limit));
         bar.finish_and_clear();
         let scene = scene?;
         check_view(&scene.view)?;

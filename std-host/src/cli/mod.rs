@@ -102,6 +102,15 @@ pub enum CliError {
     /// Joining bands.
     #[error(transparent)]
     Stitch(#[from] crate::output::stitch::StitchError),
+    /// The thread pool could not be started.
+    #[error("cannot start {threads} threads")]
+    Threads {
+        /// How many (0: one per core).
+        threads: usize,
+        /// Why.
+        #[source]
+        source: rayon::ThreadPoolBuildError,
+    },
 }
 
 /// Runs a parsed command line, writing reports to `out`.

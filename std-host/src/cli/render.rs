@@ -67,8 +67,9 @@ pub struct RenderArgs {
     /// 2^32 rays in all).
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = parse_positive, allow_hyphen_values = true)]
     pub supersample: u32,
-    /// Threads for the voxelization, the light pass and the render, 0
-    /// (one per core) to 1024; the image does not depend on it.
+    /// Threads for loading a saved raster or for the voxelization and the
+    /// light pass, and for the render, 0 (one per core) to 1024; the image
+    /// does not depend on it.
     #[arg(long, value_name = "T", default_value_t = 0, value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: usize,
     /// Walk primary rays in 8-ray packets (4×2 pixel blocks) instead of

@@ -23,8 +23,9 @@ pub struct VoxelizeArgs {
     /// Voxelization.
     #[command(flatten)]
     pub raster: RasterArgs,
-    /// Threads for the voxelization and the light pass, 0 (one per core)
-    /// to 1024; the saved raster does not depend on it.
+    /// Threads for the voxelization and the light pass (or for loading a
+    /// saved raster), 0 (one per core) to 1024; the saved raster does not
+    /// depend on it.
     #[arg(long, value_name = "T", default_value_t = 0, value_parser = parse_threads, allow_hyphen_values = true)]
     pub threads: usize,
     /// No progress bar and no summary line.
