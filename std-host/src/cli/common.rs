@@ -379,9 +379,9 @@ pub enum Loaded {
 
 /// Loads `path` as a saved raster when it starts with the raster magic,
 /// else parses and voxelizes it as an NFF or TOML scene (the built-in
-/// scene for `None`), either on `threads` threads (0: one per core).
-/// `check_view` sees the scene's view before any voxelizing (a bad view
-/// is refused before the long work).
+/// scene for `None`); the loading or the voxelizing runs on `threads`
+/// threads (0: one per core). `check_view` sees the scene's view before
+/// any voxelizing (a bad view is refused before the long work).
 ///
 /// # Errors
 /// The parser's, builder's or raster file's error; `--raster` or
