@@ -145,6 +145,12 @@ pub trait Surface: Primitive + Copy + Into<Shape> {
     /// The exact intersection of `ray` in `(tmin, tmax)` (module docs).
     fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit>;
 
+    /// The parameter of [`Surface::intersect`]'s hit, bit for bit, without
+    /// its normal: what a shadow ray or a farther candidate needs.
+    fn first_t(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
+        self.intersect(ray, tmin, tmax).map(|h| h.t)
+    }
+
     /// Writes its saved form into `slots` (all 0 on entry) and returns its
     /// saved kind.
     fn save(&self, slots: &mut Slots) -> u32;
@@ -230,6 +236,13 @@ impl Shape {
     #[must_use]
     pub fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
         each_surface!(self, s => s.intersect(ray, tmin, tmax), voxels => None)
+    }
+
+    /// [`Shape::intersect`]'s `t`, bit for bit, without computing the
+    /// normal ([`Surface::first_t`]); `None` for [`Shape::Voxels`].
+    #[must_use]
+    pub fn first_t(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
+        each_surface!(self, s => s.first_t(ray, tmin, tmax), voxels => None)
     }
 
     /// The radius of a ball that holds the shape, half the diagonal of its

@@ -73,10 +73,15 @@ impl Surface for Sphere {
     /// clearly behind an origin clearly outside it (`clearly_behind`);
     /// every other ray gets the same answer as from the full form.
     fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
-        let Self { centre, radius } = *self;
-        let oc = ray.origin - centre;
-        if clearly_misses(oc, ray.dir, radius)
-            || (tmin >= 0.0 && clearly_behind(oc, ray.dir, radius))
+        let t = self.first_t(ray, tmin, tmax)?;
+        let normal = (ray.at(t) - self.centre) / self.radius;
+        Some(Hit::new(t, normal.normalize_or(DVec3::Z)))
+    }
+
+    fn first_t(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
+        let oc = ray.origin - self.centre;
+        if clearly_misses(oc, ray.dir, self.radius)
+            || (tmin >= 0.0 && clearly_behind(oc, ray.dir, self.radius))
         {
             return None;
         }
@@ -98,8 +103,8 @@ impl Surface for Sphere {
 }
 
 impl Sphere {
-    /// [`Surface::intersect`] without the early refusal.
-    fn stable(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
+    /// [`Surface::first_t`] without the early refusal.
+    fn stable(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
         let Self { centre, radius } = *self;
         let len = ray.dir.length();
         if !(len > 0.0 && len.is_finite() && radius > 0.0) {
@@ -119,9 +124,7 @@ impl Sphere {
         let c = (dist - radius) * (dist + radius);
         let q = -b - sq.copysign(b);
         let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (q, c / q) };
-        let t = nearest([t0 / len, t1 / len], tmin, tmax)?;
-        let normal = (ray.at(t) - centre) / radius;
-        Some(Hit::new(t, normal.normalize_or(DVec3::Z)))
+        nearest([t0 / len, t1 / len], tmin, tmax)
     }
 }
 
@@ -255,7 +258,7 @@ mod tests {
                 assert_eq!(full, None, "{s:?} {ray:?}");
             }
             misses += u32::from(full.is_none());
-            assert_eq!(s.intersect(&ray, 0.0, f64::INFINITY), full);
+            assert_eq!(s.first_t(&ray, 0.0, f64::INFINITY), full);
         }
         assert!(refused > misses / 2, "{refused} of {misses} misses refused");
     }
@@ -300,11 +303,7 @@ mod tests {
                 assert_eq!(full, None, "{s:?} {ray:?} {tmin}");
             }
             away += u32::from(lift > 1e-3 && (origin - s.centre).dot(dir) > 0.0);
-            assert_eq!(
-                s.intersect(&ray, tmin, f64::INFINITY),
-                full,
-                "{s:?} {ray:?}"
-            );
+            assert_eq!(s.first_t(&ray, tmin, f64::INFINITY), full, "{s:?} {ray:?}");
         }
         assert!(refused > away / 2, "{refused} of {away} refused");
     }

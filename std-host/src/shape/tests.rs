@@ -9,8 +9,15 @@ use glam::DVec3;
 use super::{Cone, Sphere, Surface, Torus, Triangle};
 use crate::world::{Hit, Ray};
 
+/// `s`'s hit, after checking that [`Surface::first_t`] gives its `t`.
+fn hit_of(s: &impl Surface, r: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
+    let hit = s.intersect(r, tmin, tmax);
+    assert_eq!(s.first_t(r, tmin, tmax), hit.map(|h| h.t), "{r:?}");
+    hit
+}
+
 fn sphere(r: &Ray, centre: DVec3, radius: f64, tmin: f64, tmax: f64) -> Option<Hit> {
-    Sphere { centre, radius }.intersect(r, tmin, tmax)
+    hit_of(&Sphere { centre, radius }, r, tmin, tmax)
 }
 
 fn triangle(
@@ -20,7 +27,7 @@ fn triangle(
     tmin: f64,
     tmax: f64,
 ) -> Option<Hit> {
-    Triangle { vertices, normals }.intersect(r, tmin, tmax)
+    hit_of(&Triangle { vertices, normals }, r, tmin, tmax)
 }
 
 fn cone(
@@ -32,13 +39,13 @@ fn cone(
     tmin: f64,
     tmax: f64,
 ) -> Option<Hit> {
-    Cone {
+    let c = Cone {
         base,
         base_radius,
         apex,
         apex_radius,
-    }
-    .intersect(r, tmin, tmax)
+    };
+    hit_of(&c, r, tmin, tmax)
 }
 
 fn torus(
@@ -50,13 +57,13 @@ fn torus(
     tmin: f64,
     tmax: f64,
 ) -> Option<Hit> {
-    Torus {
+    let t = Torus {
         centre,
         axis,
         major,
         minor,
-    }
-    .intersect(r, tmin, tmax)
+    };
+    hit_of(&t, r, tmin, tmax)
 }
 
 const INF: f64 = f64::INFINITY;

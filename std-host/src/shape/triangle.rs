@@ -28,6 +28,42 @@ const FLAT: u32 = 3;
 /// The saved kind of a triangle with vertex normals.
 const SMOOTH: u32 = 4;
 
+impl Triangle {
+    /// Where `ray` crosses the triangle in `(tmin, tmax)`: `(t, u, v)`, the
+    /// parameter and the barycentrics of vertices 1 and 2 of
+    /// [`Surface::intersect`]'s hit.
+    fn crossing(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<(f64, f64, f64)> {
+        let [v0, v1, v2] = self.vertices;
+        let e1 = v1 - v0;
+        let e2 = v2 - v0;
+        let p = ray.dir.cross(e2);
+        let det = e1.dot(p);
+        // A ray in the plane (|det| ≤ 1e-14·|e1|·|e2|·|dir|) misses; that
+        // test's square roots are taken last, for rays that pass the others
+        // (with det = 0 the barycentric tests below fail on NaN or ∞).
+        let inv = 1.0 / det;
+        let s = ray.origin - v0;
+        let u = s.dot(p) * inv;
+        if !(0.0..=1.0).contains(&u) {
+            return None;
+        }
+        let q = s.cross(e1);
+        let v = ray.dir.dot(q) * inv;
+        if !(v >= 0.0 && u + v <= 1.0) {
+            return None;
+        }
+        let t = e2.dot(q) * inv;
+        if !(t > tmin && t < tmax) {
+            return None;
+        }
+        let scale = e1.length() * e2.length() * ray.dir.length();
+        if !(det.abs() > 1e-14 * scale) {
+            return None;
+        }
+        Some((t, u, v))
+    }
+}
+
 impl Primitive for Triangle {
     const KIND: &'static str = "triangle";
 
@@ -83,39 +119,18 @@ impl Surface for Triangle {
     /// if that interpolation vanishes, the face normal `(v1−v0) × (v2−v0)`.
     /// A ray in the triangle's plane and a zero-area triangle miss.
     fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
-        let Self { vertices, normals } = *self;
-        let [v0, v1, v2] = vertices;
-        let e1 = v1 - v0;
-        let e2 = v2 - v0;
-        let p = ray.dir.cross(e2);
-        let det = e1.dot(p);
-        // A ray in the plane (|det| ≤ 1e-14·|e1|·|e2|·|dir|) misses; that
-        // test's square roots are taken last, for rays that pass the others
-        // (with det = 0 the barycentric tests below fail on NaN or ∞).
-        let inv = 1.0 / det;
-        let s = ray.origin - v0;
-        let u = s.dot(p) * inv;
-        if !(0.0..=1.0).contains(&u) {
-            return None;
-        }
-        let q = s.cross(e1);
-        let v = ray.dir.dot(q) * inv;
-        if !(v >= 0.0 && u + v <= 1.0) {
-            return None;
-        }
-        let t = e2.dot(q) * inv;
-        if !(t > tmin && t < tmax) {
-            return None;
-        }
-        let scale = e1.length() * e2.length() * ray.dir.length();
-        if !(det.abs() > 1e-14 * scale) {
-            return None;
-        }
-        let face = e1.cross(e2).normalize_or(DVec3::Z);
-        let normal = normals
+        let (t, u, v) = self.crossing(ray, tmin, tmax)?;
+        let [v0, v1, v2] = self.vertices;
+        let face = (v1 - v0).cross(v2 - v0).normalize_or(DVec3::Z);
+        let normal = self
+            .normals
             .and_then(|[n0, n1, n2]| (n0 * (1.0 - u - v) + n1 * u + n2 * v).try_normalize())
             .unwrap_or(face);
         Some(Hit { t, normal, u, v })
+    }
+
+    fn first_t(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
+        self.crossing(ray, tmin, tmax).map(|(t, _, _)| t)
     }
 
     fn save(&self, slots: &mut Slots) -> u32 {

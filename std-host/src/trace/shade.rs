@@ -276,7 +276,7 @@ impl Tracer<'_> {
                 let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) else {
                     continue;
                 };
-                if obj.shape.intersect(&segment, 0.0, tmax).is_some() {
+                if obj.shape.first_t(&segment, 0.0, tmax).is_some() {
                     att *= self.transmittance(obj.material);
                 }
             }
@@ -499,7 +499,7 @@ impl Tracer<'_> {
                         let blocks = if obj.shape.is_exact() {
                             Some(id) != skip
                                 && !mail.tested(id)
-                                && obj.shape.intersect(segment, tmin, tmax).is_some()
+                                && obj.shape.first_t(segment, tmin, tmax).is_some()
                         } else {
                             !rule.ignores(&store, index, b)
                         };
@@ -542,10 +542,10 @@ impl Tracer<'_> {
         if !obj.shape.is_exact() || self.transmittance(obj.material) > 0.0 {
             return false;
         }
-        let Some(hit) = obj.shape.intersect(segment, 0.0, tmax) else {
+        let Some(t) = obj.shape.first_t(segment, 0.0, tmax) else {
             return false;
         };
-        let r = self.frame.world_to_raster(segment.at(hit.t));
+        let r = self.frame.world_to_raster(segment.at(t));
         let dims = self.extent.dims();
         (0..3).all(|a| r[a] > 0.0 && r[a] < f64::from(dims[a]))
     }

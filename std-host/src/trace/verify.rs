@@ -270,8 +270,12 @@ impl Tracer<'_> {
                 if mail.tested(id) {
                     continue;
                 }
+                // Only a nearer hit can replace the candidate: the
+                // intersection is sought before it (the same nearest root
+                // when there is one there), so farther hits cost no normal.
+                let tmax = best.as_ref().map_or(f64::INFINITY, |b| b.t);
                 obj.shape
-                    .intersect(ray, tmin, f64::INFINITY)
+                    .intersect(ray, tmin, tmax)
                     .filter(|h| h.normal.is_finite() && h.t.is_finite())
                     .map(|h| (h.t, h.normal, true))
             } else if leave.is_some_and(|l| l.ignores(&self.store, index, rec)) {
