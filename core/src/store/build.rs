@@ -782,7 +782,8 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
             });
         }
         let cap = self.lists.len();
-        let nodes = cap.saturating_sub(self.node_top);
+        // Two entries per node.
+        let node_entries = cap.saturating_sub(self.node_top);
         if self.unlisted > 0 {
             return Err(BuildError::ListStorage {
                 needed: cap.saturating_add(
@@ -810,7 +811,7 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
         let mut report = self.report;
         let used = lay_out_lists(self.records, self.lists, self.node_top, &mut report).ok_or(
             BuildError::ListStorage {
-                needed: list_space(self.records, self.lists).saturating_add(nodes),
+                needed: list_space(self.records, node_entries / 2).saturating_add(node_entries),
                 found: cap,
             },
         )?;
@@ -848,15 +849,18 @@ impl<'p, 'd, 'r> Filler<'p, 'd, 'r> {
 }
 
 /// Entries the finished lists of `records` take: `1 + n` per voxel of `n`
-/// objects (its chain's length plus the owner).
-fn list_space(records: &[VoxelRecord], lists: &[u32]) -> usize {
+/// objects (its chain's length plus the owner), from the `nodes` the
+/// chains hold between them: every node the fill pass adds becomes the
+/// head of its voxel's chain, so each lies on exactly one chain, and
+/// `2` per listed voxel (its length and owner) plus `nodes` is the sum
+/// without walking a chain.
+fn list_space(records: &[VoxelRecord], nodes: usize) -> usize {
     records
         .iter()
-        .map(|r| match chain_head(r) {
-            0 => 0,
-            h => chain(lists, h).count().saturating_add(2),
-        })
-        .fold(0usize, usize::saturating_add)
+        .filter(|r| chain_head(r) != 0)
+        .count()
+        .saturating_mul(2)
+        .saturating_add(nodes)
 }
 
 /// Writes the finished object lists to the front of `lists`, in the
@@ -869,7 +873,8 @@ fn lay_out_lists(
     node_top: usize,
     report: &mut FillReport,
 ) -> Option<usize> {
-    if list_space(records, lists) > node_top {
+    let nodes = lists.len().saturating_sub(node_top) / 2;
+    if list_space(records, nodes) > node_top {
         return None;
     }
     let mut w = 0usize;
@@ -881,8 +886,9 @@ fn lay_out_lists(
         }
         // The lists written so far end below every node (checked above).
         let start = w;
+        // Never onto a node (the count above makes that impossible).
         let mut put = |lists: &mut [u32], x: u32| {
-            if let Some(slot) = lists.get_mut(w) {
+            if let Some(slot) = lists.get_mut(w).filter(|_| w < node_top) {
                 *slot = x;
             }
             w = w.saturating_add(1);
