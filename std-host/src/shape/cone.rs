@@ -114,11 +114,13 @@ impl Surface for Cone {
     /// first with products and sums only (`clearly_misses`); every other
     /// ray gets the answer of the full form.
     fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
-        let rmax = self.base_radius.abs().max(self.apex_radius.abs());
-        if clearly_misses(ray.origin - self.base, ray.dir, self.apex - self.base, rmax) {
-            return None;
-        }
-        self.full(ray, tmin, tmax)
+        let (t, ax, k) = self.refused_or_full(ray, tmin, tmax)?;
+        let normal = cone_normal(self.base, ax, self.base_radius.abs(), k, ray.at(t));
+        Some(Hit::new(t, normal))
+    }
+
+    fn first_t(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
+        self.refused_or_full(ray, tmin, tmax).map(|(t, _, _)| t)
     }
 
     fn save(&self, slots: &mut Slots) -> u32 {
@@ -160,8 +162,18 @@ fn clearly_misses(co: DVec3, dir: DVec3, axis: DVec3, rmax: f64) -> bool {
 }
 
 impl Cone {
-    /// [`Surface::intersect`] without the early refusal.
-    fn full(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
+    /// [`Cone::full`] after the early refusal ([`Surface::intersect`]).
+    fn refused_or_full(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<(f64, DVec3, f64)> {
+        let rmax = self.base_radius.abs().max(self.apex_radius.abs());
+        if clearly_misses(ray.origin - self.base, ray.dir, self.apex - self.base, rmax) {
+            return None;
+        }
+        self.full(ray, tmin, tmax)
+    }
+
+    /// [`Surface::intersect`] without the early refusal and the normal: the
+    /// hit's `t`, with the unit axis and the slope its normal needs.
+    fn full(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<(f64, DVec3, f64)> {
         let Self {
             base,
             base_radius,
@@ -213,7 +225,7 @@ impl Cone {
             let y = oy + t * dy;
             t > tmin && t < tmax && (0.0..=h).contains(&y) && rr + k * dy * t >= 0.0
         })?;
-        Some(Hit::new(t, cone_normal(base, ax, r0, k, ray.at(t))))
+        Some((t, ax, k))
     }
 }
 
@@ -301,13 +313,14 @@ mod tests {
                 _ => rng.vec(1.0) * 2f64.powi((i % 7) as i32 - 3),
             };
             let ray = Ray::new(origin, dir);
-            let full = c.full(&ray, 0.0, f64::INFINITY);
+            let full = c.full(&ray, 0.0, f64::INFINITY).map(|(t, _, _)| t);
             if clearly_misses(origin - base, dir, apex - base, r0.max(r1)) {
                 refused += 1;
                 assert_eq!(full, None, "{c:?} {ray:?}");
             }
             misses += u32::from(full.is_none());
-            assert_eq!(c.intersect(&ray, 0.0, f64::INFINITY), full);
+            assert_eq!(c.first_t(&ray, 0.0, f64::INFINITY), full);
+            assert_eq!(c.intersect(&ray, 0.0, f64::INFINITY).map(|h| h.t), full);
         }
         assert!(refused > misses / 2, "{refused} of {misses} misses refused");
     }
