@@ -234,6 +234,7 @@ impl Shape {
     /// with the true normal there (module docs); `None` for
     /// [`Shape::Voxels`].
     #[must_use]
+    #[inline]
     pub fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
         each_surface!(self, s => s.intersect(ray, tmin, tmax), voxels => None)
     }
@@ -241,6 +242,7 @@ impl Shape {
     /// [`Shape::intersect`]'s `t`, bit for bit, without computing the
     /// normal ([`Surface::first_t`]); `None` for [`Shape::Voxels`].
     #[must_use]
+    #[inline]
     pub fn first_t(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
         each_surface!(self, s => s.first_t(ray, tmin, tmax), voxels => None)
     }

@@ -72,6 +72,7 @@ impl Surface for Sphere {
     /// only (`clearly_misses`), and so is, for `tmin ≥ 0`, a sphere
     /// clearly behind an origin clearly outside it (`clearly_behind`);
     /// every other ray gets the same answer as from the full form.
+    #[inline]
     fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
         let t = self.first_t(ray, tmin, tmax)?;
         let normal = (ray.at(t) - self.centre) / self.radius;
