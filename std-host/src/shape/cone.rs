@@ -163,6 +163,7 @@ fn clearly_misses(co: DVec3, dir: DVec3, axis: DVec3, rmax: f64) -> bool {
 
 impl Cone {
     /// [`Cone::full`] after the early refusal ([`Surface::intersect`]).
+    #[inline(always)]
     fn refused_or_full(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<(f64, DVec3, f64)> {
         let rmax = self.base_radius.abs().max(self.apex_radius.abs());
         if clearly_misses(ray.origin - self.base, ray.dir, self.apex - self.base, rmax) {

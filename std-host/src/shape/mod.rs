@@ -234,7 +234,7 @@ impl Shape {
     /// with the true normal there (module docs); `None` for
     /// [`Shape::Voxels`].
     #[must_use]
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
         each_surface!(self, s => s.intersect(ray, tmin, tmax), voxels => None)
     }
