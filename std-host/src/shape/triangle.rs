@@ -32,6 +32,7 @@ impl Triangle {
     /// Where `ray` crosses the triangle in `(tmin, tmax)`: `(t, u, v)`, the
     /// parameter and the barycentrics of vertices 1 and 2 of
     /// [`Surface::intersect`]'s hit.
+    #[inline(always)]
     fn crossing(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<(f64, f64, f64)> {
         let [v0, v1, v2] = self.vertices;
         let e1 = v1 - v0;
