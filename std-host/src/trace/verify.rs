@@ -239,9 +239,11 @@ impl Tracer<'_> {
     /// Verification at one opaque voxel `v` (plane index `index`, record
     /// `rec`) of the walk of `ray`: every object of the voxel not yet in
     /// `mail` is tested; an exact object by its first intersection with
-    /// `t > tmin` anywhere on the ray, an object without exact geometry by
-    /// the point where the ray enters this voxel (unless the acne rule
-    /// `leave` ignores the voxel). The nearest is kept in `best`.
+    /// `t > tmin` anywhere on the ray before `best`'s (only such a one can
+    /// replace it, and it is the object's first intersection past `tmin`
+    /// when there is one), an object without exact geometry by the point
+    /// where the ray enters this voxel (unless the acne rule `leave`
+    /// ignores the voxel). The nearest is kept in `best`.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn test_voxel(
         &self,
