@@ -736,15 +736,9 @@ mod tests {
     fn dilate_spreads_along_one_axis() {
         let dims = [7usize, 5, 9];
         let len = dims.iter().product::<usize>();
-        let mut state = 0x9e37_79b9u64;
-        let flags: Vec<bool> = (0..len)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1);
-                state >> 61 == 0
-            })
-            .collect();
+        let mut rng = rrt_core::rng::Rng::new(0x9e37_79b9);
+        // About one in eight set.
+        let flags: Vec<bool> = (0..len).map(|_| rng.chance(1, 8)).collect();
         let at = |x: usize, y: usize, z: usize| (z * dims[1] + y) * dims[0] + x;
         for axis in 0..3 {
             let stride = dims[..axis].iter().product::<usize>();
