@@ -267,7 +267,7 @@ pub(crate) fn scale(ctx: &mut Ctx) -> Res<()> {
              (profiled at 4096; it varies between runs with the kernel's state). The light visibility phase walks the tube of every surface \
              voxel towards every light: the surface voxels grow with the square of the raster's \
              side and the walks with the side. The render takes more steps per ray as the \
-             voxels shrink (jumps through empty space are bounded by the line level's 63 \
+             voxels shrink (jumps through empty space are bounded by the line level's bound of 120 \
              voxels) and its plane reads miss the caches more often.",
             f(cells / f64::from(1u32 << 30), 1),
             largest.raster

@@ -25,8 +25,9 @@ pub const MAX_AXIS: u32 = 1 << 16;
 ///   bit 0      OPAQUE     the voxel is non-transparent (holds an object)
 ///   bit 1      PROXIMITY  the voxel is near a non-transparent voxel: adaptive
 ///                         rays take 6-connected steps here
-///   bits 2..8  DISTANCE   in a transparent voxel: a lower bound on the
-///                         proximity distance (empty-space skipping), 0
+///   bits 2..8  DISTANCE   in a transparent voxel: the code of a lower
+///                         bound on the proximity distance (empty-space
+///                         skipping; proximity::distance decodes it), 0
 ///                         meaning "unknown / none" (the distance field
 ///                         stores distances below proximity::NEAR_LIMIT
 ///                         and leaves farther cells EMPTY); in an OPAQUE

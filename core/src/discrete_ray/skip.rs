@@ -126,7 +126,8 @@ pub(crate) fn jump(f: [i64; 2], k: u32, by_a: Reciprocal, inc: [i64; 3]) -> Jump
 /// `f ∈ (−inc_a, inc_a]`; so after `i ≥ 1` steps the count is the unique
 /// `n_i` putting `f + i·inc_m − n_i·inc_a` in that interval:
 /// `n_i = ⌈(f + (i − 1)·inc_m) / inc_a⌉`, which is 0 when the numerator is
-/// not positive. The values are below 2^55 (k ≤ 62).
+/// not positive. The values are below 2^58 (k < 2^8: a jump is at most
+/// [`DISTANCE_LIMIT`](crate::proximity::DISTANCE_LIMIT) − 1 steps).
 ///
 /// The last step (from a term `f'` already in that interval, as `k ≥ 2`)
 /// took a crossing iff `f' > 0`, which leaves the new term in
@@ -192,11 +193,11 @@ mod tests {
         let mut next = |m: u64| rng.below(m);
         for case in 0..200_000u32 {
             let big = case % 2 == 0;
-            let inc_a = i64::try_from(if big { 2 + next(1 << 40) } else { 2 + next(12) }).unwrap();
+            let inc_a = i64::try_from(if big { 2 + next(1 << 48) } else { 2 + next(12) }).unwrap();
             let inc_m = i64::try_from(next(u64::try_from(inc_a).unwrap() + 1)).unwrap();
             // Any reachable term: (−inc_a, inc_a].
             let f0 = i64::try_from(next(u64::try_from(2 * inc_a).unwrap())).unwrap() - inc_a + 1;
-            let k = 2 + u32::try_from(next(61)).unwrap();
+            let k = 2 + u32::try_from(next(154)).unwrap();
             let (mut f, mut n, mut took) = (f0, 0i64, false);
             for _ in 0..k {
                 took = f > 0;

@@ -116,9 +116,44 @@ fn or_proximity(dst: &mut [u8], src: &[u8]) {
     }
 }
 
-/// Largest proximity distance a cell can hold (6 bits): line stand-ins
-/// saturate to it.
-pub const DISTANCE_LIMIT: u8 = cell::DISTANCE_MASK;
+/// Distance codes below this are the distance itself; from it on, a code
+/// `k` stands for `EXACT_CODES + CODE_STEP·(k − EXACT_CODES)` ([`distance`]).
+const EXACT_CODES: u8 = 32;
+
+/// Voxels between the distances of consecutive codes from [`EXACT_CODES`] on.
+const CODE_STEP: u8 = 4;
+
+/// Largest proximity distance a cell can hold: that of the largest code of
+/// its 6 distance bits ([`distance`]). Line stand-ins saturate to it.
+pub const DISTANCE_LIMIT: u8 = EXACT_CODES + CODE_STEP * (cell::DISTANCE_MASK - EXACT_CODES);
+
+/// The transparent, unflagged cell holding the largest distance a cell
+/// can hold that is at most `d` ([`distance`] reads it back): `d` itself
+/// below 32, every fourth distance from there up to [`DISTANCE_LIMIT`].
+/// The distances the distance field stores ([`NEAR_LIMIT`] and below) are
+/// all exact.
+///
+/// ```
+/// use rrt_core::proximity::{distance, distance_cell, DISTANCE_LIMIT};
+/// assert_eq!(distance(distance_cell(9)), 9);
+/// assert_eq!(distance(distance_cell(35)), 32);
+/// assert_eq!(distance(distance_cell(36)), 36);
+/// assert_eq!(distance(distance_cell(255)), DISTANCE_LIMIT);
+/// ```
+#[must_use]
+pub const fn distance_cell(d: u8) -> u8 {
+    let code = if d < EXACT_CODES {
+        d
+    } else {
+        let k = EXACT_CODES + (d - EXACT_CODES) / CODE_STEP;
+        if k > cell::DISTANCE_MASK {
+            cell::DISTANCE_MASK
+        } else {
+            k
+        }
+    };
+    code << cell::DISTANCE_SHIFT
+}
 
 /// The distance field ([`distance_field`]) stores the distances below
 /// this in the plane; a transparent cell at this distance or more from
@@ -134,18 +169,29 @@ pub const NEAR_LIMIT: u8 = 16;
 /// distance bits hold its record's rank hint instead
 /// ([`crate::store::rank_hint`]).
 ///
+/// The 6 distance bits hold a code: codes below 32 are the distance
+/// itself, a larger code `k` stands for `32 + 4·(k − 32)`, up to
+/// [`DISTANCE_LIMIT`] (156), so that a line stand-in far from every
+/// surface allows jumps past the 63 voxels 6 bits could count
+/// ([`distance_cell`] writes a distance).
+///
 /// ```
 /// use rrt_core::proximity::distance;
 /// use rrt_core::raster::cell;
 /// assert_eq!(distance(5 << 2), 5);
+/// assert_eq!(distance(33 << 2), 36);
 /// assert_eq!(distance((5 << 2) | cell::OPAQUE), 0);
 /// ```
 #[must_use]
 pub const fn distance(c: u8) -> u8 {
     if c & cell::OPAQUE != 0 {
-        0
+        return 0;
+    }
+    let code = (c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK;
+    if code < EXACT_CODES {
+        code
     } else {
-        (c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK
+        EXACT_CODES + CODE_STEP * (code - EXACT_CODES)
     }
 }
 
@@ -175,11 +221,11 @@ pub const fn dilated(c: u8) -> u8 {
     if c & (cell::OPAQUE | cell::PROXIMITY) != 0 {
         return cell::OPAQUE | cell::PROXIMITY;
     }
-    let d = (c >> cell::DISTANCE_SHIFT) & cell::DISTANCE_MASK;
+    let d = distance(c);
     if d <= 2 {
         cell::PROXIMITY | (d.saturating_sub(1) << cell::DISTANCE_SHIFT)
     } else {
-        d.wrapping_sub(1) << cell::DISTANCE_SHIFT
+        distance_cell(d.wrapping_sub(1))
     }
 }
 
@@ -373,8 +419,8 @@ fn brick_bound(c: u8) -> u8 {
 /// // x = 128..192 of row (y, z) = (0, 3): 9 to 72 voxels from the opaque one.
 /// assert_eq!(distance(line([128, 0, 3])), 9);
 /// // x = 0..64 of that row: 137 voxels and more; the coarse level bounds
-/// // it by the most a cell can hold.
-/// assert_eq!(distance(line([0, 0, 3])), 63);
+/// // it by 121 (16 bricks or more away), which a cell holds as 120.
+/// assert_eq!(distance(line([0, 0, 3])), 120);
 /// // The opaque voxel's own line: read the plane.
 /// assert_eq!(line([192, 0, 0]), cell::EMPTY);
 /// ```
@@ -405,7 +451,7 @@ const MAX_LINES_PER_ROW: usize = crate::raster::MAX_AXIS as usize / LINE_CELLS;
 #[inline]
 fn stand_in(cells: &[u8], bound: u8) -> u8 {
     if bound >= NEAR_LIMIT {
-        return bound << cell::DISTANCE_SHIFT;
+        return distance_cell(bound);
     }
     // Without OPAQUE or PROXIMITY in any cell, every cell is its distance
     // bits alone (EMPTY the farthest), and the nearest cell holds the least
@@ -426,7 +472,7 @@ fn stand_in(cells: &[u8], bound: u8) -> u8 {
     if any & (cell::OPAQUE | cell::PROXIMITY) != 0 || d < 2 {
         cell::EMPTY
     } else {
-        d << cell::DISTANCE_SHIFT
+        distance_cell(d)
     }
 }
 

@@ -92,7 +92,12 @@ fn check_line_level(e: Extent, plane: &[u8], want: &[u8], what: &str) {
     let brick_want = brute(ce, &occupied);
     let brick_bound = |k: u8| {
         let k = u32::from(k.min(NEAR_LIMIT));
-        u8::try_from(if k == 0 { 0 } else { (8 * (k - 1) + 1).min(63) }).unwrap()
+        u8::try_from(if k == 0 {
+            0
+        } else {
+            (8 * (k - 1) + 1).min(u32::from(DISTANCE_LIMIT))
+        })
+        .unwrap()
     };
     for (b, (&got, &w)) in bricks.iter().zip(&brick_want).enumerate() {
         assert_eq!(got, brick_bound(w), "{what}: brick {b}");
@@ -113,12 +118,12 @@ fn check_line_level(e: Extent, plane: &[u8], want: &[u8], what: &str) {
             .min()
             .unwrap();
         let expect = if bound >= NEAR_LIMIT {
-            bound << cell::DISTANCE_SHIFT
+            distance_cell(bound)
         } else if exact <= 1 {
             cell::EMPTY
         } else {
             let d = exact.min(NEAR_LIMIT).max(bound);
-            d << cell::DISTANCE_SHIFT
+            distance_cell(d)
         };
         assert_eq!(got, expect, "{what}: line {l}");
         assert!(distance(got) <= exact, "{what}: line {l} above its cells");
