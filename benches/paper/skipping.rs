@@ -77,7 +77,7 @@ pub(crate) fn skipping(ctx: &mut Ctx) -> Res<()> {
         "Camera rays ({0}×{0}, SPD view) walked adaptively to their first non-transparent voxel, \
          one thread, setup excluded (medians of three times the repetitions, interleaved): \
          without skipping (`walk`), with skipping by the proximity distance field of the plane \
-         alone (`walk_skipping`: a 26-run at distance d ≥ 5 jumps d − 1 steps at once; the plane \
+         alone (`walk_skipping`: a 26-run at distance d ≥ 4 jumps d − 1 steps at once; the plane \
          stores distances only within 15 voxels of a surface, so it jumps only there), and with \
          skipping through the plane's **line level** as the renderer walks (one stand-in cell per \
          64 plane cells, a lower bound on their distances from the coarse level over 8³ bricks and \
@@ -142,7 +142,7 @@ pub(crate) fn skipping(ctx: &mut Ctx) -> Res<()> {
              jumps are shorter than an exact distance's would be; the plane stores distances only \
              within 15 voxels of a surface so that its memory far from surfaces is never written \
              (Rasters at scale). The other steps left are single steps near surfaces (distance \
-             below 5, no jump) and the ever shorter jumps on the approach to a surface, such as \
+             below 4, no jump) and the ever shorter jumps on the approach to a surface, such as \
              the floor under a grazing camera ray.",
             f(5.0 / min_line_saving_large, 2),
             per.join("; ")

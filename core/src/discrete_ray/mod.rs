@@ -358,7 +358,7 @@ impl DiscreteRay {
     /// As [`DiscreteRay::walk`], with **empty-space skipping**: where the
     /// raster's proximity distance (see
     /// [`crate::proximity::distance_field`]) at the current voxel is large
-    /// enough (`d ≥ 5`), a run of 26-steps (TwentySix, and Adaptive away from
+    /// enough (`d ≥ 4`), a run of 26-steps (TwentySix, and Adaptive away from
     /// surfaces) advances `d − 1` steps at once, exactly: it lands on the
     /// voxel, with the state, that `d − 1` single steps reach. Six walks do
     /// not skip.

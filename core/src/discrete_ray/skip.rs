@@ -12,7 +12,7 @@
 /// value of at least 1 gives the same hits, faces and resume states (see
 /// [`skip_count`]); it changes only the speed and the `steps` count of a
 /// skipping walk.
-pub(crate) const MIN_JUMP: u8 = 4;
+pub(crate) const MIN_JUMP: u8 = 3;
 
 /// The smallest line stand-in ([`crate::raster::Raster::with_lines`]) a
 /// skipping walk reads instead of the plane: one at distance 8 or more.

@@ -145,7 +145,7 @@
 //! # Empty-space skipping
 //! The scalar walks use the plane's proximity distances
 //! ([`rrt_core::proximity::distance_field`], computed by the builder):
-//! where the nearest non-transparent voxel is `d ≥ 5` voxels away, a
+//! where the nearest non-transparent voxel is `d ≥ 4` voxels away, a
 //! 26-run takes `d − 1` steps at once, landing exactly where single steps
 //! would. Far from surfaces they read the scene's line level instead of the
 //! plane ([`rrt_core::raster::Raster::with_lines`]: one stand-in cell per
