@@ -145,7 +145,8 @@ pub const fn distance_cell(d: u8) -> u8 {
     let code = if d < EXACT_CODES {
         d
     } else {
-        let k = EXACT_CODES + (d - EXACT_CODES) / CODE_STEP;
+        // d − 32 ≤ 223: the sum stays below 256.
+        let k = (d.wrapping_sub(EXACT_CODES) / CODE_STEP).wrapping_add(EXACT_CODES);
         if k > cell::DISTANCE_MASK {
             cell::DISTANCE_MASK
         } else {
@@ -191,7 +192,10 @@ pub const fn distance(c: u8) -> u8 {
     if code < EXACT_CODES {
         code
     } else {
-        EXACT_CODES + CODE_STEP * (code - EXACT_CODES)
+        // code ≤ 63: at most 156.
+        CODE_STEP
+            .wrapping_mul(code.wrapping_sub(EXACT_CODES))
+            .wrapping_add(EXACT_CODES)
     }
 }
 
