@@ -511,3 +511,28 @@ fn field_steps_shared_out_by_rows_give_the_whole_field() {
         assert_eq!(got, want, "case {case} dims {dims:?} band {band}");
     }
 }
+
+/// The distance codes: every distance is written as the largest distance
+/// a cell holds that is not above it, every code reads back as itself,
+/// and the distances the field stores are exact.
+#[test]
+fn distance_codes_round_down_and_read_back() {
+    let held: Vec<u8> = (0..=cell::DISTANCE_MASK)
+        .map(|k| distance(k << cell::DISTANCE_SHIFT))
+        .collect();
+    assert!(held.windows(2).all(|w| w[0] < w[1]), "{held:?}");
+    assert_eq!(held.last(), Some(&DISTANCE_LIMIT));
+    for d in 0..=u8::MAX {
+        let c = distance_cell(d);
+        assert_eq!(c & (cell::OPAQUE | cell::PROXIMITY), 0, "{d}");
+        let want = held.iter().copied().filter(|&h| h <= d).max().unwrap();
+        assert_eq!(distance(c), want, "{d}");
+        if d <= NEAR_LIMIT {
+            assert_eq!(distance(c), d);
+        }
+    }
+    for k in 0..=cell::DISTANCE_MASK {
+        let c = k << cell::DISTANCE_SHIFT;
+        assert_eq!(distance_cell(distance(c)), c, "code {k}");
+    }
+}
