@@ -10,13 +10,14 @@
 
 use glam::DVec3;
 use indicatif::ProgressBar;
+use rrt_core::discrete_ray::Connectivity;
 use rrt_core::light::{ExactRecords, classify_voxel};
 use rrt_core::voxel::LightVisibility;
 use rrt_host::render::camera::Camera;
 use rrt_host::render::{Image, RenderOptions, render};
 use rrt_host::scene::Scene;
 use rrt_host::shape::{Shape, Surface};
-use rrt_host::trace::{RayStats, TraceOptions, Tracer};
+use rrt_host::trace::{Mode, RayStats, TraceOptions, Tracer};
 use rrt_host::voxelize::light::ShadowLevel;
 use rrt_host::voxelize::{BuildOptions, VoxelScene, build};
 use rrt_host::world::Ray;
@@ -285,6 +286,37 @@ fn classified_shadows_render_as_exact_shadow_rays() {
     }
     // Some lights of hits were proven occluded, without a shadow ray.
     assert!(occluded > 0);
+}
+
+/// The render-time shadow rays of the paper's and the verified modes (the
+/// classification's uncertain voxels, translucent occluders) walk
+/// adaptively by default, skipping empty space: the images are those of
+/// 6-connected shadow rays, in fewer steps.
+#[test]
+fn adaptive_shadow_rays_render_as_six_connected_ones() {
+    let mut walked = 0;
+    for seed in 60..66u64 {
+        let nff = random_scene(seed, 40, if seed % 2 == 0 { 0.05 } else { 0.3 });
+        let vs = exact(&nff, 48, ExactRecords::Classify);
+        for mode in [Mode::Paper, Mode::Verified] {
+            let adaptive = TraceOptions {
+                mode,
+                ..TraceOptions::default()
+            };
+            assert_eq!(adaptive.light.mode, Connectivity::Adaptive);
+            let mut six = adaptive;
+            six.light.mode = Connectivity::Six;
+            let (a, sa) = draw(&vs, adaptive, 48);
+            let (b, sb) = draw(&vs, six, 48);
+            assert_eq!(a.rgb, b.rgb, "seed {seed}, {mode:?}");
+            assert_eq!(a.linear, b.linear, "seed {seed}, {mode:?}");
+            assert_eq!(sa.shadow, sb.shadow, "seed {seed}, {mode:?}");
+            assert!(sa.shadow_steps <= sb.shadow_steps, "seed {seed}, {mode:?}");
+            walked += sa.shadow;
+        }
+    }
+    // Shadow rays were fired at render time.
+    assert!(walked > 1000, "{walked} shadow rays");
 }
 
 /// The classification computed on demand is the pass's: for every record

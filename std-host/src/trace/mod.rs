@@ -260,7 +260,10 @@ pub struct TraceOptions {
     /// 0 traces the whole tree to `depth`.
     pub min_weight: f64,
     /// The acne rule's slab and angle, and the connectivity of render-time
-    /// shadow rays (those of the light pass by default).
+    /// shadow rays: by default those of the light pass, adaptive rays that
+    /// meet the opaque voxels of the 6-connected line in its order (the
+    /// plane's proximity flags are set around every opaque voxel), so
+    /// they give the 6-connected rays' answers.
     pub light: LightParams,
     /// Walk primary rays eight at a time in a
     /// [`RayPacket8`](rrt_core::packet::RayPacket8) instead of one by one.
@@ -291,7 +294,7 @@ impl Default for TraceOptions {
             connectivity: Connectivity::Adaptive,
             depth: 3,
             min_weight: DEFAULT_MIN_WEIGHT,
-            light: LightParams::default(),
+            light: crate::voxelize::pass_light_params(),
             packets: false,
             last_blocker: true,
             classify_on_demand: true,

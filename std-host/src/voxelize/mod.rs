@@ -99,12 +99,13 @@ pub struct BuildOptions {
     pub exact: bool,
 }
 
-/// The light pass's shadow rays: the core's defaults (the 6-connected
-/// line) walked adaptively, skipping empty space. The pass runs on the
-/// finished plane ([`finish_plane`]), whose proximity flags make an
-/// adaptive walk meet the opaque voxels of the 6-connected one
-/// ([`LightParams::mode`]): the same light bits, in less time.
-fn pass_light_params() -> LightParams {
+/// The shadow rays of the light pass and of the renderer: the core's
+/// defaults (the 6-connected line) walked adaptively, skipping empty
+/// space. Both run on a finished plane ([`finish_plane`], or the plane a
+/// saved raster makes on load), whose proximity flags make an adaptive
+/// walk meet the opaque voxels of the 6-connected one, in the same order
+/// ([`LightParams::mode`]): the same answers, in less time.
+pub(crate) fn pass_light_params() -> LightParams {
     LightParams {
         mode: Connectivity::Adaptive,
         ..LightParams::default()
