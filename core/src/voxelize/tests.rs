@@ -5,6 +5,7 @@
 //! ([`VoxelSink::reads_surfels`]) the same voxels in the same order.
 
 use core::ops::Range;
+use std::format;
 use std::vec::Vec;
 
 use super::volume::Block;
@@ -97,6 +98,49 @@ fn assert_layers_kept(what: &str, keep: [Range<u32>; 2], run: impl Fn(&mut Seque
 /// A point near the raster of `n` voxels per axis, in fixed units.
 fn point(rng: &mut Rng, n: i64) -> Point {
     [0; 3].map(|_| rng.range(-2 * VOXEL, (n + 2) * VOXEL))
+}
+
+/// Spheres in many windows: the offers of a window are checked over
+/// centres on lattice points, voxel centres and faces, radii of whole and
+/// half voxels (crossings exactly on faces) and windows of one layer or
+/// row up to the whole raster.
+#[test]
+fn spheres_offer_the_same_voxels_in_every_window() {
+    let mut rng = Rng(0x0b5e_55ed_u64);
+    let extent = Extent::new(18, 20, 22).unwrap();
+    for case in 0..300u32 {
+        let snap = case % 4;
+        let centre = [0; 3].map(|_| {
+            let base = rng.range(-3 * VOXEL, 24 * VOXEL);
+            match snap {
+                0 => base & !(VOXEL - 1),
+                1 => (base & !(VOXEL - 1)) | (VOXEL / 2),
+                _ => base,
+            }
+        });
+        let radius = match case % 3 {
+            0 => (1 + rng.range(0, 9)) * VOXEL,
+            1 => (1 + rng.range(0, 18)) * (VOXEL / 2),
+            _ => rng.range(VOXEL / 4, 10 * VOXEL),
+        };
+        let ball = Sphere { centre, radius };
+        let z0 = rng.below_u32(24);
+        let y0 = rng.below_u32(22);
+        let layers = z0..z0 + 1 + rng.below_u32(if case % 2 == 0 { 2 } else { 12 });
+        let rows = match case % 5 {
+            0 | 1 => 0..u32::MAX,
+            _ => y0..y0 + 1 + rng.below_u32(8),
+        };
+        for sep in [Separation::Six, Separation::TwentySix] {
+            assert_layers_kept(
+                &format!("sphere {case} {ball:?} {sep:?}"),
+                [rows.clone(), layers.clone()],
+                |s| {
+                    sphere::surface(&ball, sep, extent, s).unwrap();
+                },
+            );
+        }
+    }
 }
 
 #[test]
