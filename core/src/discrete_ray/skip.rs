@@ -54,6 +54,10 @@ const NEAR_CELL: u8 = crate::proximity::NEAR_LIMIT << crate::raster::cell::DISTA
 /// [`NEAR_LIMIT`](crate::proximity::NEAR_LIMIT) when there is a line
 /// level (whose contract is a plane with its distance field); `None`
 /// outside the plane.
+///
+/// The line level is read first, so that a walk far from surfaces reads
+/// no plane cell there: a host may leave the plane's far pages unbacked
+/// (the distance field never writes them), and reading one would map it.
 #[inline(always)]
 pub(crate) fn skip_cell(plane: &[u8], lines: &[u8], index: usize) -> Option<u8> {
     match lines.get(index >> crate::raster::LINE_BITS) {
