@@ -158,22 +158,25 @@ pub fn contains(
 }
 
 /// Whether the centre segment along `k` of the voxel at offset `w` from the
-/// sphere's centre meets the sphere of squared radius `r2`.
+/// sphere's centre meets the sphere of squared radius `r2`. Every caller's
+/// `w` is a voxel centre (below 2^49) less a checked centre (at most
+/// [`COORD_LIMIT`](super::error::COORD_LIMIT) = 2^40), so `|w_j| < 2^50`:
+/// squares and their sums stay below 2^102 and the arithmetic is exact
+/// without saturating.
 #[inline]
 fn segment_meets(w: [i128; 3], k: usize, r2: i128) -> bool {
     let mut lat = 0i128;
     let mut wk = 0i128;
     for (j, c) in w.iter().enumerate() {
         if j == k {
-            wk = c.saturating_abs();
+            wk = c.wrapping_abs();
         } else {
-            lat = lat.saturating_add(c.saturating_mul(*c));
+            lat = lat.wrapping_add(c.wrapping_mul(*c));
         }
     }
-    let near = wk.saturating_sub(H).max(0);
-    let far = wk.saturating_add(H);
-    lat.saturating_add(near.saturating_mul(near)) <= r2
-        && r2 <= lat.saturating_add(far.saturating_mul(far))
+    let near = wk.wrapping_sub(H).max(0);
+    let far = wk.wrapping_add(H);
+    lat.wrapping_add(near.wrapping_mul(near)) <= r2 && r2 <= lat.wrapping_add(far.wrapping_mul(far))
 }
 
 fn radius(r: i64) -> Result<i128, VoxelizeError> {
@@ -257,9 +260,12 @@ impl Ball {
         let Some((b0, b1)) = clip(bl, bh, nb) else {
             return;
         };
+        // Below, the distances from near_far are below 2^50 (a voxel face
+        // less a checked centre) and r2 ≤ 2^80: their squares and the
+        // differences are exact without saturating.
         for bi in b0..=b1 {
             let (ab_min, ab_max) = near_far(cb, bi);
-            let eb = self.r2.saturating_sub(ab_min.saturating_mul(ab_min));
+            let eb = self.r2.wrapping_sub(ab_min.wrapping_mul(ab_min));
             if eb < 0 {
                 continue;
             }
@@ -270,7 +276,7 @@ impl Ball {
             };
             for ai in a0..=a1 {
                 let (aa_min, aa_max) = near_far(ca, ai);
-                let d_in = eb.saturating_sub(aa_min.saturating_mul(aa_min));
+                let d_in = eb.wrapping_sub(aa_min.wrapping_mul(aa_min));
                 if d_in < 0 {
                     continue;
                 }
@@ -278,8 +284,8 @@ impl Ball {
                 let (kl, kh) = cells_overlapping(ck.saturating_sub(h_in), ck.saturating_add(h_in));
                 let d_out = self
                     .r2
-                    .saturating_sub(aa_max.saturating_mul(aa_max))
-                    .saturating_sub(ab_max.saturating_mul(ab_max));
+                    .wrapping_sub(aa_max.wrapping_mul(aa_max))
+                    .wrapping_sub(ab_max.wrapping_mul(ab_max));
                 // Cells strictly inside the open ball: el ..= eh (empty when
                 // the column's far corner is outside the sphere).
                 let (el, eh) = if d_out > 0 {
@@ -327,9 +333,11 @@ impl Ball {
         let Some((b0, b1)) = clip(bl, bh, nb) else {
             return;
         };
+        // Below, |db|, |da| < 2^50 (a voxel centre less a checked centre)
+        // and r2 ≤ 2^80: exact without saturating.
         for bi in b0..=b1 {
             let db = centre(bi).wrapping_sub(cb);
-            let eb = self.r2.saturating_sub(db.saturating_mul(db));
+            let eb = self.r2.wrapping_sub(db.wrapping_mul(db));
             if eb < 0 {
                 continue;
             }
@@ -340,7 +348,7 @@ impl Ball {
             };
             for ai in a0..=a1 {
                 let da = centre(ai).wrapping_sub(ca);
-                let d = eb.saturating_sub(da.saturating_mul(da));
+                let d = eb.wrapping_sub(da.wrapping_mul(da));
                 if d >= 0 {
                     f(ai, bi, da, db, d);
                 }
@@ -353,8 +361,9 @@ impl Ball {
         let (_, _, ck) = pick(k, self.c);
         let (_, _, nk) = pick(k, self.win);
         self.centre_columns(k, |ai, bi, _, _, d| {
+            // d ≤ r2 ≤ 2^80: s ≤ 2^40 and s² is exact.
             let s = isqrt(d);
-            let exact = s.saturating_mul(s) == d;
+            let exact = s.wrapping_mul(s) == d;
             // Up to four cells: each crossing's cell, and the cell below
             // when the crossing lies exactly on a face.
             let hi = ck.saturating_add(s);
@@ -363,7 +372,8 @@ impl Ball {
             } else {
                 ck.saturating_sub(s).saturating_sub(1)
             };
-            let on_face = |p: i128| exact && p.rem_euclid(V) == 0;
+            // V is a power of two: `p & (V − 1)` is `p mod V`.
+            let on_face = |p: i128| exact && p & V.wrapping_sub(1) == 0;
             let cells = [
                 Some(cell_floor(hi)),
                 on_face(hi).then(|| cell_floor(hi).saturating_sub(1)),
@@ -404,15 +414,16 @@ impl Ball {
                 return;
             };
             for ki in k0..=k1 {
+                // |da|, |db|, |dk| < 2^50: every term below 2^100, exact.
                 let dk = centre(ki).wrapping_sub(ck);
                 let m = da.abs().max(db.abs()).max(dk.abs());
                 let w2 = da
-                    .saturating_mul(da)
-                    .saturating_add(db.saturating_mul(db))
-                    .saturating_add(dk.saturating_mul(dk));
+                    .wrapping_mul(da)
+                    .wrapping_add(db.wrapping_mul(db))
+                    .wrapping_add(dk.wrapping_mul(dk));
                 let reach = w2
-                    .saturating_add(m.saturating_mul(V))
-                    .saturating_add(H.saturating_mul(H));
+                    .wrapping_add(m.wrapping_mul(V))
+                    .wrapping_add(H.wrapping_mul(H));
                 if reach < self.r2 {
                     let v = place(K, ai, bi, ki);
                     let s = self.surfel_for(v, sink);
@@ -549,6 +560,56 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// The shell's arithmetic wraps instead of saturating because nothing
+    /// accepted can overflow: at the extremes of the accepted range (centre
+    /// and radius up to `COORD_LIMIT`, any voxel of a 2^32 axis) the
+    /// membership test equals one in checked arithmetic, which would panic
+    /// on an overflow.
+    #[test]
+    fn membership_arithmetic_never_overflows() {
+        let limit = crate::voxelize::error::COORD_LIMIT;
+        let mut rng = Rng(0x5e6_3e75);
+        let checked = |w: [i128; 3], k: usize, r2: i128| -> bool {
+            let mut lat = 0i128;
+            for (j, c) in w.iter().enumerate() {
+                if j != k {
+                    lat = lat.checked_add(c.checked_mul(*c).unwrap()).unwrap();
+                }
+            }
+            let wk = w[k].checked_abs().unwrap();
+            let near = wk.checked_sub(H).unwrap().max(0);
+            let far = wk.checked_add(H).unwrap();
+            lat.checked_add(near.checked_mul(near).unwrap()).unwrap() <= r2
+                && r2 <= lat.checked_add(far.checked_mul(far).unwrap()).unwrap()
+        };
+        let extremes = [-limit, -limit + 1, -1, 0, 1, limit - 1, limit];
+        for case in 0..4000 {
+            let pick = |rng: &mut Rng| {
+                if case % 2 == 0 {
+                    extremes[rng.range(0, 6) as usize]
+                } else {
+                    rng.range(-limit, limit)
+                }
+            };
+            let c = [pick(&mut rng), pick(&mut rng), pick(&mut rng)];
+            let r = pick(&mut rng).unsigned_abs().max(1) as i64;
+            let v = [0, 1, 2].map(|_| match rng.range(0, 3) {
+                0 => 0,
+                1 => u32::MAX,
+                _ => rng.range(0, i64::from(u32::MAX)) as u32,
+            });
+            let w = [0, 1, 2].map(|k| centre(v[k]) - i128::from(c[k]));
+            let r2 = i128::from(r) * i128::from(r);
+            for k in 0..3 {
+                assert_eq!(
+                    segment_meets(w, k, r2),
+                    checked(w, k, r2),
+                    "{c:?} {r} {v:?}"
+                );
             }
         }
     }
