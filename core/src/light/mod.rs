@@ -276,6 +276,7 @@ pub fn illuminate<const N: usize>(
             lights,
             params,
             &mut proofs,
+            None,
             v,
             rec,
             &mut report,
@@ -296,6 +297,12 @@ pub fn illuminate<const N: usize>(
 /// shadow classification walks a brick's tube once per light and spares
 /// the walks of the voxels it proves lit: the same records, faster on
 /// surfaces of one object.
+///
+/// Stack: a run keeps a table of the records its shadow classifications
+/// looked up (neighbouring records' tubes cross the same voxels), 2^10
+/// pairs of `usize` (16 KiB on 64-bit targets, 8 KiB on 32-bit ones);
+/// [`illuminate`] keeps none and its stack small. The records are the same
+/// either way.
 ///
 /// # Errors
 /// [`LightError::ExtentMismatch`] if `raster`, `store` and `bricks` differ
@@ -318,6 +325,7 @@ pub fn illuminate_run<const N: usize>(
     }
     let mut report = LightReport::default();
     let mut proofs = BrickProofs::new(bricks);
+    let mut found = FoundRecords::new();
     for (slot, (v, rec)) in out.iter_mut().zip(store.iter_from(first)) {
         *slot = shade_record(
             raster,
@@ -328,6 +336,7 @@ pub fn illuminate_run<const N: usize>(
             lights,
             params,
             &mut proofs,
+            Some(&mut found),
             v,
             *rec,
             &mut report,
@@ -376,6 +385,59 @@ impl<'l, 'b> BrickProofs<'l, 'b> {
     }
 }
 
+/// The records of the voxels the shadow classifications of one run
+/// ([`illuminate_run`]) looked up, by linear index: neighbouring records' tubes cross the same voxels
+/// (their own surface first), and a lookup found here spares the brick
+/// directory's. A direct-mapped table of [`FOUND_SLOTS`] entries; an
+/// entry is a pure function of the read-only store, so the answers are
+/// the store's whatever the table holds.
+struct FoundRecords {
+    /// `(index, position)`: voxel `index` has the record at `position`
+    /// ([`NO_RECORD`] for none); [`EMPTY_SLOT`] as the index marks an
+    /// unused entry.
+    slots: [(usize, usize); FOUND_SLOTS],
+}
+
+/// Entries of [`FoundRecords`]: `2^FOUND_BITS`.
+const FOUND_SLOTS: usize = 1 << FOUND_BITS;
+/// See [`FOUND_SLOTS`].
+const FOUND_BITS: u32 = 10;
+/// An index no raster holds (a raster's cells are fewer than `usize::MAX`).
+const EMPTY_SLOT: usize = usize::MAX;
+/// The position stored for a voxel without a record.
+const NO_RECORD: usize = usize::MAX;
+
+impl FoundRecords {
+    const fn new() -> Self {
+        Self {
+            slots: [(EMPTY_SLOT, NO_RECORD); FOUND_SLOTS],
+        }
+    }
+
+    /// The record of the opaque voxel `w` (linear index `index`, cell
+    /// `c`) in `view`, as [`RecordStore::get_hinted`] finds it.
+    fn get<'a>(
+        &mut self,
+        view: &RecordStore<'a>,
+        index: usize,
+        w: [u32; 3],
+        c: u8,
+    ) -> Option<&'a VoxelRecord> {
+        // Fibonacci hashing: the top bits of the index times 2^64/φ.
+        let h = u64::try_from(index)
+            .unwrap_or(u64::MAX)
+            .wrapping_mul(0x9e37_79b9_7f4a_7c15)
+            >> u64::BITS.wrapping_sub(FOUND_BITS);
+        let Some(slot) = self.slots.get_mut(usize::try_from(h).unwrap_or(0)) else {
+            return view.get_hinted(w, c);
+        };
+        if slot.0 != index {
+            *slot = (index, view.index_hinted(w, c).unwrap_or(NO_RECORD));
+        }
+        view.records().get(slot.1)
+    }
+}
+
 impl LightReport {
     /// Adds the counts of `other` (another run of the same pass).
     pub fn add(&mut self, other: &Self) {
@@ -401,6 +463,7 @@ fn shade_record<const N: usize>(
     lights: &Lights,
     params: &LightParams,
     proofs: &mut BrickProofs<'_, '_>,
+    mut found: Option<&mut FoundRecords>,
     v: [u32; 3],
     mut rec: VoxelRecord,
     report: &mut LightReport,
@@ -473,6 +536,7 @@ fn shade_record<const N: usize>(
                     sphere_of(objects),
                     opaque_sphere_of(objects, materials),
                     light.position,
+                    found.as_deref_mut(),
                 )?
             }
             (false, _) => {
@@ -982,7 +1046,7 @@ pub fn classify_voxel(
     {
         return Ok(LightVisibility::Visible);
     }
-    classify(raster, store, v, own, sphere, blocker, light)
+    classify(raster, store, v, own, sphere, blocker, light, None)
 }
 
 /// The shadow classification of voxel `v` (objects `own`) for a light at
@@ -996,6 +1060,7 @@ pub fn classify_voxel(
 /// every such segment ([`sphere_blocks`]); else
 /// [`LightVisibility::Translucent`] (undecided: a render-time shadow ray
 /// decides). A voxel without a record undecides too.
+#[allow(clippy::too_many_arguments)] // the voxel, its light, and what the walk reads
 fn classify(
     raster: &Raster<'_>,
     view: &RecordStore<'_>,
@@ -1004,6 +1069,7 @@ fn classify(
     sphere: impl Fn(u32) -> Option<Sphere>,
     blocker: impl Fn(u32) -> Option<Sphere>,
     light: [i64; 3],
+    mut found: Option<&mut FoundRecords>,
 ) -> Result<LightVisibility, LightError> {
     let c0 = v.map(voxel_centre);
     let extent = raster.extent();
@@ -1034,16 +1100,20 @@ fn classify(
     // The objects of the voxel where the walk found a foreign object,
     // asked after the walk whether one blocks every segment from the cube
     // to the light ([`sphere_blocks`]).
-    let found: core::cell::Cell<&[u32]> = core::cell::Cell::new(&[]);
+    let foreign_objects: core::cell::Cell<&[u32]> = core::cell::Cell::new(&[]);
     // Whether the opaque voxel `w` (cell `c`) has no record or holds an
     // object not in `own` that may meet a segment from the cube to the
     // light.
-    let holds_foreign = |w: [u32; 3], c: u8| -> bool {
-        view.get_hinted(w, c).is_none_or(|rec| {
+    let mut holds_foreign = |wi: usize, w: [u32; 3], c: u8| -> bool {
+        let rec = match found.as_deref_mut() {
+            Some(memo) => memo.get(view, wi, w, c),
+            None => view.get_hinted(w, c),
+        };
+        rec.is_none_or(|rec| {
             let objects = view.objects(rec);
             let foreign = !objects.iter().all(|&o| own.contains(&o) || clear(o));
             if foreign {
-                found.set(objects);
+                foreign_objects.set(objects);
             }
             foreign
         })
@@ -1063,7 +1133,7 @@ fn classify(
             // the offsets, no clipping.
             // The neighbours at offsets `lo..hi` on axis `k` and −1..2 on
             // the other two.
-            let scan = |k: usize, lo: i8, hi: i8| -> bool {
+            let mut scan = |k: usize, lo: i8, hi: i8| -> bool {
                 let k = k.min(2);
                 let (j1, j2) = match k {
                     0 => (1, 2),
@@ -1086,7 +1156,7 @@ fn classify(
                             w[k] = w[k].wrapping_add_signed(i32::from(a));
                             w[j1] = w[j1].wrapping_add_signed(i32::from(b));
                             w[j2] = w[j2].wrapping_add_signed(i32::from(d));
-                            if holds_foreign(w, c) {
+                            if holds_foreign(wi, w, c) {
                                 return true;
                             }
                         }
@@ -1118,7 +1188,7 @@ fn classify(
                         u[1].wrapping_add_signed(i32::from(dy)),
                         u[2].wrapping_add_signed(i32::from(dz)),
                     ];
-                    if holds_foreign(w, c) {
+                    if holds_foreign(wi, w, c) {
                         return true;
                     }
                 }
@@ -1137,7 +1207,7 @@ fn classify(
     })?;
     Ok(match outcome {
         Piece::Clear => LightVisibility::Visible,
-        Piece::Blocked if blocks_all(found.get(), own, &blocker, v, light, dims) => {
+        Piece::Blocked if blocks_all(foreign_objects.get(), own, &blocker, v, light, dims) => {
             LightVisibility::Occluded
         }
         Piece::Blocked => LightVisibility::Translucent,

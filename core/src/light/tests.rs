@@ -1327,3 +1327,49 @@ fn a_clear_sphere_in_the_tube_leaves_the_voxel_lit() {
         "no voxel lit thanks to the small ball's geometry"
     );
 }
+
+/// The table of looked-up records answers as the store does, for far more
+/// voxels than it has entries (so entries are replaced), in an order that
+/// repeats voxels: every opaque voxel of a few balls, then random ones,
+/// opaque or not, among them again.
+#[test]
+fn found_records_answer_as_the_store() {
+    let e = Extent::cube(48).unwrap();
+    let balls: Vec<_> = [([14, 20, 18], 9), ([30, 28, 24], 11), ([24, 12, 36], 7)]
+        .into_iter()
+        .map(|(c, r)| {
+            move |s: &mut dyn VoxelSink| {
+                testkit::sphere(e, vox(c), r * VOXEL, Separation::TwentySix, s)
+            }
+        })
+        .collect();
+    let objects: Vec<Voxelize<'_>> = balls
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (attrs(i as u32, 0), f as &dyn Fn(&mut dyn VoxelSink)))
+        .collect();
+    let scene = testkit::build(e, &objects, LIM);
+    let store = RecordStore::with_lists(e, &scene.dir, &scene.records, &scene.lists).unwrap();
+    let opaque: Vec<usize> = (0..e.len())
+        .filter(|&i| scene.plane[i] & cell::OPAQUE != 0)
+        .collect();
+    assert!(opaque.len() > 4 * FOUND_SLOTS, "{}", opaque.len());
+    let mut rng = testkit::Rng(0xf0_0d);
+    let mut order = opaque.clone();
+    for _ in 0..20_000 {
+        let i = if rng.range(0, 1) == 0 {
+            opaque[rng.range(0, opaque.len() as i64 - 1) as usize]
+        } else {
+            rng.range(0, e.len() as i64 - 1) as usize
+        };
+        order.push(i);
+    }
+    let mut found = FoundRecords::new();
+    for i in order {
+        let w = e.coord(i).unwrap();
+        let c = scene.plane[i];
+        let want = store.get_hinted(w, c);
+        assert_eq!(found.get(&store, i, w, c), want, "voxel {w:?}");
+        assert_eq!(found.get(&store, i, w, c), want, "voxel {w:?}, again");
+    }
+}
