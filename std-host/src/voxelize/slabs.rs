@@ -314,11 +314,12 @@ impl Passes<'_> {
             Unit::SlabObjects,
             visits,
         );
-        // Slabs in order: nothing says yet which hold more.
+        // The pieces with the most objects to voxelize first (ties in
+        // raster order): the records are not counted yet.
         let counted = heaviest_first(
             pool,
             parts,
-            |_, i| u64::MAX - i as u64,
+            |p, _| p.members.len() as u64,
             |p| self.count(p, progress),
         );
         let sizings = first_error(counted)?;
