@@ -386,11 +386,11 @@ impl<'l, 'b> BrickProofs<'l, 'b> {
 }
 
 /// The records of the voxels the shadow classifications of one run
-/// ([`illuminate_run`]) looked up, by linear index: neighbouring records' tubes cross the same voxels
-/// (their own surface first), and a lookup found here spares the brick
-/// directory's. A direct-mapped table of [`FOUND_SLOTS`] entries; an
-/// entry is a pure function of the read-only store, so the answers are
-/// the store's whatever the table holds.
+/// ([`illuminate_run`]) looked up, by linear index: neighbouring records'
+/// tubes cross the same voxels (their own surface first), and a lookup
+/// found here spares the brick directory's. A direct-mapped table of
+/// [`FOUND_SLOTS`] entries; an entry is a pure function of the read-only
+/// store, so the answers are the store's whatever the table holds.
 struct FoundRecords {
     /// `(index, position)`: voxel `index` has the record at `position`
     /// ([`NO_RECORD`] for none); [`EMPTY_SLOT`] as the index marks an
