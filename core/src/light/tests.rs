@@ -1335,20 +1335,8 @@ fn a_clear_sphere_in_the_tube_leaves_the_voxel_lit() {
 #[test]
 fn found_records_answer_as_the_store() {
     let e = Extent::cube(48).unwrap();
-    let balls: Vec<_> = [([14, 20, 18], 9), ([30, 28, 24], 11), ([24, 12, 36], 7)]
-        .into_iter()
-        .map(|(c, r)| {
-            move |s: &mut dyn VoxelSink| {
-                testkit::sphere(e, vox(c), r * VOXEL, Separation::TwentySix, s)
-            }
-        })
-        .collect();
-    let objects: Vec<Voxelize<'_>> = balls
-        .iter()
-        .enumerate()
-        .map(|(i, f)| (attrs(i as u32, 0), f as &dyn Fn(&mut dyn VoxelSink)))
-        .collect();
-    let scene = testkit::build(e, &objects, LIM);
+    let balls = [([14, 20, 18], 9), ([30, 28, 24], 11), ([24, 12, 36], 7)];
+    let scene = balls_scene(e, &balls.map(|(c, r)| (vox(c), r * VOXEL)));
     let store = RecordStore::with_lists(e, &scene.dir, &scene.records, &scene.lists).unwrap();
     let opaque: Vec<usize> = (0..e.len())
         .filter(|&i| scene.plane[i] & cell::OPAQUE != 0)
