@@ -80,10 +80,7 @@ impl Surface for Sphere {
     }
 
     fn first_t(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
-        let oc = ray.origin - self.centre;
-        if clearly_misses(oc, ray.dir, self.radius)
-            || (tmin >= 0.0 && clearly_behind(oc, ray.dir, self.radius))
-        {
+        if self.refuses(ray, tmin) {
             return None;
         }
         self.stable(ray, tmin, tmax)
@@ -104,6 +101,19 @@ impl Surface for Sphere {
 }
 
 impl Sphere {
+    /// The early refusal of [`Surface::first_t`] and
+    /// [`Surface::intersect`]: `true` when `ray`'s line passes the sphere
+    /// by a clear margin, or, for `tmin ≥ 0`, the sphere lies clearly
+    /// behind an origin clearly outside it; then both answer `None` for
+    /// every `tmax`. A sphere with a NaN centre or radius refuses nothing.
+    #[inline]
+    #[must_use]
+    pub fn refuses(&self, ray: &Ray, tmin: f64) -> bool {
+        let oc = ray.origin - self.centre;
+        clearly_misses(oc, ray.dir, self.radius)
+            || (tmin >= 0.0 && clearly_behind(oc, ray.dir, self.radius))
+    }
+
     /// [`Surface::first_t`] without the early refusal.
     fn stable(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<f64> {
         let Self { centre, radius } = *self;

@@ -213,6 +213,44 @@ fn sphere_random_rays_land_on_surface() {
     }
 }
 
+#[test]
+fn sphere_refusal_only_where_there_is_no_hit() {
+    // Rays aimed at points around the sphere, many of them clear misses,
+    // some from inside, some pointing away: a refused ray has no hit for
+    // any tmax; a NaN sphere (the tracer's table for other objects)
+    // refuses nothing.
+    let nan = Sphere {
+        centre: DVec3::NAN,
+        radius: f64::NAN,
+    };
+    let mut refused = 0;
+    for seed in 0..4000 {
+        let mut g = Uniform(rrt_core::rng::Rng::new(seed));
+        let s = Sphere {
+            centre: g.vec(-5.0, 5.0),
+            radius: g.range(0.01, 3.0),
+        };
+        let o = g.vec(-10.0, 10.0);
+        let target = s.centre + g.vec(-3.0, 3.0) * s.radius;
+        let ry = Ray::new(o, (target - o) * g.range(0.1, 3.0));
+        for tmin in [-1.0, 0.0, 1e-3] {
+            assert!(!nan.refuses(&ry, tmin));
+            if s.refuses(&ry, tmin) {
+                refused += 1;
+                assert_eq!(s.first_t(&ry, tmin, INF), None, "seed {seed}");
+                assert!(s.intersect(&ry, tmin, INF).is_none(), "seed {seed}");
+            } else if s.first_t(&ry, tmin, INF).is_none() {
+                // Not refused: the full form decides.
+                assert!(s.intersect(&ry, tmin, INF).is_none(), "seed {seed}");
+            }
+        }
+    }
+    assert!(
+        refused > 1000,
+        "only {refused} refusals: the test lost its misses"
+    );
+}
+
 // ---------------------------------------------------------------- triangle
 
 #[test]

@@ -175,6 +175,7 @@ pub use self::walk::FirstWalk;
 
 use crate::frame::RasterFrame;
 use crate::scene::Material;
+use crate::shape::{Shape, Sphere};
 use crate::voxelize::{VoxelScene, WorldLight, WorldObject};
 use crate::world::{Bounds, Ray};
 
@@ -487,6 +488,12 @@ pub struct Tracer<'s> {
     extent: Extent,
     frame: RasterFrame,
     objects: &'s [WorldObject],
+    /// The sphere of each object that is one, by object id up to the last
+    /// sphere, and a NaN sphere for every other object, which refuses
+    /// nothing ([`Tracer::refused`]): 32 bytes an object, so that the
+    /// spheres a ray clearly misses are passed over without reading the
+    /// object table.
+    spheres: Arc<[Sphere]>,
     materials: &'s [Material],
     lights: &'s [WorldLight],
     lights_fx: Vec<Option<[i64; 3]>>,
@@ -506,6 +513,27 @@ pub struct Tracer<'s> {
     background: DVec3,
     intensity: f64,
     opts: TraceOptions,
+}
+
+/// [`Tracer::spheres`] of `objects`: each sphere's, NaN for every other
+/// object, as far as the last sphere.
+fn sphere_table(objects: &[WorldObject]) -> Arc<[Sphere]> {
+    let nan = Sphere {
+        centre: DVec3::NAN,
+        radius: f64::NAN,
+    };
+    let len = objects
+        .iter()
+        .rposition(|o| matches!(o.shape, Shape::Sphere(_)))
+        .map_or(0, |i| i + 1);
+    objects
+        .iter()
+        .take(len)
+        .map(|o| match o.shape {
+            Shape::Sphere(s) => s,
+            _ => nan,
+        })
+        .collect()
 }
 
 /// The source of the shadow classification of a render
@@ -627,6 +655,7 @@ impl<'s> Tracer<'s> {
             extent: scene.frame.extent,
             frame: scene.frame,
             objects: &scene.objects,
+            spheres: sphere_table(&scene.objects),
             materials: &scene.materials,
             lights: &scene.lights,
             lights_fx,
@@ -642,6 +671,19 @@ impl<'s> Tracer<'s> {
             intensity: scene.intensity(),
             opts,
         })
+    }
+
+    /// Whether object `id` is a sphere whose exact tests refuse `ray` for
+    /// `t > tmin` before any root is sought ([`Sphere::refuses`]): then
+    /// [`Surface::first_t`](crate::shape::Surface::first_t) and
+    /// [`Surface::intersect`](crate::shape::Surface::intersect) answer
+    /// `None` for every `tmax`, and the object need not be read.
+    #[inline]
+    pub(super) fn refused(&self, id: u32, ray: &Ray, tmin: f64) -> bool {
+        usize::try_from(id)
+            .ok()
+            .and_then(|i| self.spheres.get(i))
+            .is_some_and(|s| s.refuses(ray, tmin))
     }
 
     /// The raster index and cell of voxel `v` when it lies in the raster

@@ -479,6 +479,11 @@ impl Tracer<'_> {
                         return false;
                     };
                     for &id in store.objects(b) {
+                        // A sphere the segment clearly misses neither
+                        // blocks nor is a volume.
+                        if self.refused(id, segment, tmin) {
+                            continue;
+                        }
                         if let Some(d) = self.direct_volume(id) {
                             // A volume rendered directly lets its
                             // transmittance through (its voxels are on the

@@ -261,6 +261,10 @@ impl Tracer<'_> {
         let shared = ids.len() > 1;
         let vs = self.frame.voxel_size;
         for &id in ids {
+            // A sphere the ray clearly misses is no candidate.
+            if self.refused(id, ray, tmin) {
+                continue;
+            }
             let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) else {
                 continue;
             };
