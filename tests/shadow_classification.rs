@@ -12,6 +12,7 @@ use glam::DVec3;
 use indicatif::ProgressBar;
 use rrt_core::discrete_ray::Connectivity;
 use rrt_core::light::{ExactRecords, classify_voxel};
+use rrt_core::object_table::Shape as FixedShape;
 use rrt_core::voxel::LightVisibility;
 use rrt_host::render::camera::Camera;
 use rrt_host::render::{Image, RenderOptions, render};
@@ -76,6 +77,101 @@ fn random_scene(seed: u64, objects: usize, size: f64) -> String {
             }
         }
     }
+    s
+}
+
+/// NFF triangles of the mesh of a surface of revolution about the z axis
+/// through `c`: `nu` segments around and `nv` bands, ring `j` (parameter
+/// `v = j / nv`) at distance and height `surface(v)` from the axis and
+/// `c`, each vertex's distance from the axis jittered by up to `jitter`
+/// (so neighbouring triangles meet at varied angles); the last ring is
+/// the first when `closed` (a torus), and triangles with two equal
+/// vertices (at a pole) are left out.
+fn revolution_mesh(
+    rng: &mut Rng,
+    c: DVec3,
+    (nu, nv, closed): (usize, usize, bool),
+    jitter: f64,
+    surface: impl Fn(f64) -> (f64, f64),
+) -> String {
+    let rings = if closed { nv } else { nv + 1 };
+    let ring: Vec<Vec<DVec3>> = (0..rings)
+        .map(|j| {
+            let (r, h) = surface(j as f64 / nv as f64);
+            (0..nu)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / nu as f64;
+                    let r = r * (1.0 + uniform(rng, -jitter, jitter));
+                    c + DVec3::new(r * a.cos(), r * a.sin(), h)
+                })
+                .collect()
+        })
+        .collect();
+    let mut s = String::new();
+    let mut tri = |p: [DVec3; 3]| {
+        if p[0] == p[1] || p[1] == p[2] || p[2] == p[0] {
+            return;
+        }
+        s.push_str("p 3\n");
+        for v in p {
+            s.push_str(&format!("{} {} {}\n", v.x, v.y, v.z));
+        }
+    };
+    for j in 0..nv {
+        for i in 0..nu {
+            let k = (i + 1) % nu;
+            let (a, b) = (ring[j][i], ring[j][k]);
+            let next = &ring[(j + 1) % rings];
+            let (d, e) = (next[i], next[k]);
+            tri([a, b, e]);
+            tri([a, e, d]);
+        }
+    }
+    s
+}
+
+/// A random scene of meshes in [-1, 1]³: a floor of two triangles, a
+/// faceted ball and a faceted ring (a torus: it shadows itself) as
+/// triangle meshes, a sphere, two corner spheres that fix the raster's
+/// box, and three lights: one inside the box, two outside.
+fn mesh_scene(seed: u64) -> String {
+    let mut rng = Rng(seed);
+    let mut s = String::from(
+        "v\nfrom 0.3 -2.4 5\nat 0 0 -0.2\nup 0 0 1\nangle 40\nhither 0.01\nresolution 48 48\nb 0 0 0\n",
+    );
+    let inside = point(&mut rng, -0.3, 0.3) + DVec3::new(0.0, 0.0, 0.5);
+    s.push_str(&format!("l {} {} {}\n", inside.x, inside.y, inside.z));
+    s.push_str("l 4 -5 6\nl -7 2 3\n");
+    s.push_str("f 1 0.5 0.2 0.7 0.3 10 0 1\ns -1 -1 -1 0.05\ns 1 1 1 0.05\n");
+    s.push_str("p 3\n-1 -1 -0.9\n1 -1 -0.9\n1 1 -0.9\np 3\n-1 -1 -0.9\n1 1 -0.9\n-1 1 -0.9\n");
+    let ball = point(&mut rng, -0.3, 0.3) + DVec3::new(-0.35, 0.0, -0.4);
+    let r = uniform(&mut rng, 0.25, 0.4);
+    let (nu, nv) = (8 + rng.below(10) as usize, 5 + rng.below(6) as usize);
+    s.push_str(&revolution_mesh(
+        &mut rng,
+        ball,
+        (nu, nv, false),
+        0.06,
+        |v| {
+            let a = std::f64::consts::PI * v;
+            (r * a.sin(), -r * a.cos())
+        },
+    ));
+    let ring = point(&mut rng, -0.2, 0.2) + DVec3::new(0.4, 0.1, -0.5);
+    let (big, small) = (uniform(&mut rng, 0.25, 0.35), uniform(&mut rng, 0.07, 0.12));
+    let (nu, nv) = (10 + rng.below(8) as usize, 6 + rng.below(4) as usize);
+    s.push_str(&revolution_mesh(
+        &mut rng,
+        ring,
+        (nu, nv, true),
+        0.03,
+        |v| {
+            let a = std::f64::consts::TAU * v;
+            (big + small * a.cos(), small * a.sin())
+        },
+    ));
+    let c = point(&mut rng, -0.5, 0.5);
+    s.push_str(&format!("s {} {} {} 0.12\n", c.x, c.y, c.z));
     s
 }
 
@@ -174,6 +270,54 @@ fn lit_voxels_have_only_their_own_objects_between_them_and_each_light() {
     assert!(lit > 2_000, "{lit} lit (voxel, light) pairs");
 }
 
+/// The same on meshes, where the tubes of most voxels run through the
+/// neighbouring triangles' voxels, which the proof clears.
+#[test]
+fn lit_mesh_voxels_have_only_their_own_objects_between_them_and_each_light() {
+    let mut lit = 0;
+    for seed in 100..106u64 {
+        let raster = [32, 40, 48][seed as usize % 3];
+        let vs = exact(&mesh_scene(seed), raster, ExactRecords::Classify);
+        lit += check_lit_voxels(&vs, seed);
+    }
+    eprintln!("{lit} lit (voxel, light) pairs checked");
+    assert!(lit > 2_000, "{lit} lit (voxel, light) pairs");
+}
+
+/// On meshes, the triangles' proofs light voxels that the spheres' alone
+/// leave undecided, and never undecide one: [`classify_voxel`] with the
+/// triangles' geometry against without it, for every record of exact
+/// objects and every light.
+#[test]
+fn triangles_clear_of_the_cube_leave_mesh_voxels_lit() {
+    let (mut gained, mut lit) = (0, 0);
+    for seed in 110..114u64 {
+        let vs = exact(&mesh_scene(seed), 40, ExactRecords::Skip);
+        let raster = vs.raster().unwrap();
+        let store = vs.store().unwrap();
+        for (v, rec) in store.iter() {
+            for light in &vs.lights {
+                let light = vs.frame.to_fixed(light.position).unwrap();
+                let with = |id: u32| fixed_shape(&vs, id);
+                let spheres =
+                    |id: u32| fixed_shape(&vs, id).filter(|s| matches!(s, FixedShape::Sphere(_)));
+                let a =
+                    classify_voxel(&raster, &store, None, with, |_| None, v, rec, light).unwrap();
+                let b = classify_voxel(&raster, &store, None, spheres, |_| None, v, rec, light)
+                    .unwrap();
+                if b == LightVisibility::Visible {
+                    assert_eq!(a, b, "seed {seed}: voxel {v:?}");
+                }
+                lit += usize::from(a == LightVisibility::Visible);
+                gained +=
+                    usize::from(a == LightVisibility::Visible && b != LightVisibility::Visible);
+            }
+        }
+    }
+    eprintln!("{gained} of {lit} lit (voxel, light) pairs lit by the triangles' proofs");
+    assert!(gained > lit / 4, "{gained} of {lit}");
+}
+
 /// Every voxel classified occluded for a light: the segments from its
 /// corners, its centre and random points of its cube to the light each
 /// meet an object that lets no light through, from outside it. Returns
@@ -246,12 +390,14 @@ fn draw(vs: &VoxelScene, opts: TraceOptions, size: u32) -> (Image, RayStats) {
 #[test]
 fn classified_shadows_render_as_exact_shadow_rays() {
     let mut occluded = 0;
-    for seed in 20..28u64 {
-        // Small objects, and larger ones that shadow whole voxels.
+    for seed in 20..30u64 {
+        // Small objects, larger ones that shadow whole voxels, meshes.
         let nff = if seed < 26 {
             random_scene(seed, 40, 0.05)
-        } else {
+        } else if seed < 28 {
             random_scene(seed, 25, 0.3)
+        } else {
+            mesh_scene(seed)
         };
         let vs = exact(&nff, 40, ExactRecords::Classify);
         let rays_only = exact(&nff, 40, ExactRecords::Skip);
@@ -319,14 +465,28 @@ fn adaptive_shadow_rays_render_as_six_connected_ones() {
     assert!(walked > 1000, "{walked} shadow rays");
 }
 
+/// The fixed-point shape of object `id` that the classification reads:
+/// a sphere, or a triangle's vertices, as the fit rounds them.
+fn fixed_shape(vs: &VoxelScene, id: u32) -> Option<FixedShape> {
+    match vs.objects[id as usize].shape {
+        Shape::Sphere(s) => s.to_fixed(&vs.frame).ok().map(FixedShape::Sphere),
+        Shape::Triangle(t) => t.to_fixed(&vs.frame).ok().map(FixedShape::Triangle),
+        _ => None,
+    }
+}
+
 /// The classification computed on demand is the pass's: for every record
 /// of exact objects and every light, [`classify_voxel`] gives the bits the
-/// pass stored.
+/// pass stored; on the random scenes and on meshes.
 #[test]
 fn on_demand_classification_is_the_pass_classification() {
     let mut compared = 0;
-    for seed in 40..46u64 {
-        let nff = random_scene(seed, 50, 0.05);
+    for seed in 40..48u64 {
+        let nff = if seed < 46 {
+            random_scene(seed, 50, 0.05)
+        } else {
+            mesh_scene(seed)
+        };
         let vs = exact(&nff, 40, ExactRecords::Classify);
         let raster = vs.raster().unwrap();
         let store = vs.store().unwrap();
@@ -347,15 +507,17 @@ fn on_demand_classification_is_the_pass_classification() {
                 continue;
             }
             for (k, &light) in lights.iter().enumerate() {
-                let shape = |id: u32| match vs.objects[id as usize].shape {
-                    Shape::Sphere(s) => s.to_fixed(&vs.frame).ok(),
-                    _ => None,
-                };
+                let shape = |id: u32| fixed_shape(&vs, id);
                 let blocker = |id: u32| {
                     let o = &vs.objects[id as usize];
-                    (vs.materials[usize::from(o.material)].transmittance == 0.0)
-                        .then(|| shape(id))
-                        .flatten()
+                    match o.shape {
+                        Shape::Sphere(s)
+                            if vs.materials[usize::from(o.material)].transmittance == 0.0 =>
+                        {
+                            s.to_fixed(&vs.frame).ok()
+                        }
+                        _ => None,
+                    }
                 };
                 let got =
                     classify_voxel(&raster, &store, None, shape, blocker, v, rec, light).unwrap();

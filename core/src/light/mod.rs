@@ -79,7 +79,12 @@
 //! the tube does not stand in the way when the segment from `v`'s centre
 //! to `L` passes farther than its radius plus half the cube's diagonal
 //! from its centre (with a margin for the rounding to fixed point): every
-//! segment from a point of the cube to `L` then passes outside it. And an
+//! segment from a point of the cube to `L` then passes outside it. Nor
+//! does a foreign triangle when the cube (with the same margin) lies
+//! outside its shadow volume from `L`, the points whose segment to `L`
+//! meets it: wholly on the light's side of its plane, or beyond one of
+//! the three planes through `L` and an edge (the neighbouring triangles of
+//! a lit mesh mostly are). And an
 //! opaque sphere met in the tube *occludes* the voxel (`Occluded`) when the
 //! segment from `v`'s centre to `L` passes within its radius less half the
 //! cube's diagonal and half a voxel of its centre, the cube lies that much
@@ -116,7 +121,7 @@ use core::fmt;
 use crate::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
 use crate::error::RayError;
 use crate::fixed::{VOXEL, voxel_centre};
-use crate::geometry::Sphere;
+use crate::geometry::{Sphere, Triangle};
 use crate::object_table::{Lights, Materials, ObjectTable, SCALAR_BITS, Shape};
 use crate::raster::{Extent, Raster, cell};
 use crate::store::{RecordStore, RecordStoreMut};
@@ -518,7 +523,7 @@ fn shade_record<const N: usize>(
             })
         };
         let vis = match (exact, params.exact_records) {
-            (true, _) if dark_side(sphere_of(objects), own, v, light.position) => {
+            (true, _) if dark_side(shape_of(objects), own, v, light.position) => {
                 report.dark_side = report.dark_side.saturating_add(1);
                 LightVisibility::Translucent
             }
@@ -533,7 +538,7 @@ fn shade_record<const N: usize>(
                     view,
                     v,
                     own,
-                    sphere_of(objects),
+                    shape_of(objects),
                     opaque_sphere_of(objects, materials),
                     light.position,
                     found.as_deref_mut(),
@@ -618,24 +623,21 @@ fn shade_record<const N: usize>(
 /// to fixed point by up to one unit per coordinate (the renderer's spheres
 /// and lights are the exact ones).
 fn dark_side(
-    sphere: impl Fn(u32) -> Option<Sphere>,
+    shape: impl Fn(u32) -> Option<Shape>,
     own: &[u32],
     v: [u32; 3],
     light: [i64; 3],
 ) -> bool {
     !own.is_empty()
-        && own
-            .iter()
-            .all(|&id| sphere(id).is_some_and(|s| cube_beyond_terminator(&s, v, light)))
+        && own.iter().all(|&id| match shape(id) {
+            Some(Shape::Sphere(s)) => cube_beyond_terminator(&s, v, light),
+            _ => false,
+        })
 }
 
-/// The fixed-point sphere of object `id` of `objects`, `None` for every
-/// other shape.
-fn sphere_of<'t>(objects: &'t ObjectTable<'_>) -> impl Fn(u32) -> Option<Sphere> + 't {
-    |id| match objects.get(id)?.shape {
-        Shape::Sphere(s) => Some(s),
-        _ => None,
-    }
+/// The fixed-point shape of object `id` of `objects`.
+fn shape_of<'t>(objects: &'t ObjectTable<'_>) -> impl Fn(u32) -> Option<Shape> + 't {
+    |id| Some(objects.get(id)?.shape)
 }
 
 /// The fixed-point sphere of object `id` of `objects` when its material
@@ -662,6 +664,9 @@ const HALF_DIAGONAL: i128 = 56_756;
 /// per coordinate, and under 2^-11 voxel for a light taken by its
 /// direction) and of the shading point to its voxel: 1/256 voxel.
 const CLEARANCE_MARGIN: i128 = 256;
+
+/// [`CLEARANCE_MARGIN`] as a fixed-point length.
+const CLEARANCE_MARGIN_UNITS: i64 = 256;
 
 /// The least shift that brings `big` below 2^28 (at most 100).
 #[inline(always)]
@@ -761,6 +766,127 @@ fn sphere_clears(s: &Sphere, v: [u32; 3], light: [i64; 3]) -> bool {
         return false;
     }
     segment_distance_cmp(w, u, need.saturating_mul(need)).is_gt()
+}
+
+/// Bound on the offsets of a triangle's vertices from a voxel's low
+/// corner for [`triangle_clears`]: 2^29 units (8,192 voxels).
+const TRIANGLE_REACH: u64 = 1 << 29;
+
+/// Bound on the light's offset from a voxel's low corner for
+/// [`triangle_clears`]: 2^50 units (2^34 voxels).
+const LIGHT_REACH: u64 = 1 << 50;
+
+/// `a · b`, exactly, in 128 bits.
+#[inline(always)]
+fn wide(a: i64, b: i64) -> i128 {
+    i128::from(a).wrapping_mul(i128::from(b))
+}
+
+/// Whether triangle `t` provably meets no segment from a point of voxel
+/// `v`'s closed cube, grown by [`CLEARANCE_MARGIN`] on every side (for the
+/// rounding of the renderer's exact triangle and light to fixed point and
+/// of the shading point to its voxel, as in [`sphere_clears`]), to the
+/// light at `light`.
+///
+/// A segment from `p` to `L` meets `t` exactly when `p` lies in `t`'s
+/// *shadow volume* from `L`: on the far side of `t`'s plane from `L` (or
+/// on it), and on `t`'s side of each of the three planes through `L` and
+/// an edge of `t` (or on it). The triangle is cleared when the grown cube
+/// lies strictly outside one of those four closed half-spaces (every
+/// corner outside it): on the light's side of the triangle's plane, with
+/// the light off that plane by the margin; or beyond one of the planes
+/// through the light and an edge.
+///
+/// Exact: with the vertices within [`TRIANGLE_REACH`] and the light within
+/// [`LIGHT_REACH`] of the voxel's low corner (anything farther is not
+/// cleared), edges are below 2^30, the triangle's normal below 2^61, an
+/// edge plane's normal below 2^83 and every product formed below 2^114,
+/// so the wrapping arithmetic never wraps.
+fn triangle_clears(t: &Triangle, v: [u32; 3], light: [i64; 3]) -> bool {
+    // The voxel's low corner: below 2^48.
+    let lo: [i64; 3] = v.map(|k| i64::from(k).wrapping_mul(VOXEL));
+    // Offsets from it, `None` beyond `reach`.
+    let rel = |p: [i64; 3], reach: u64| -> Option<[i64; 3]> {
+        let mut out = [0i64; 3];
+        for ((o, &x), &c) in out.iter_mut().zip(p.iter()).zip(lo.iter()) {
+            *o = x.checked_sub(c).filter(|d| d.unsigned_abs() < reach)?;
+        }
+        Some(out)
+    };
+    let (Some(d0), Some(d1), Some(d2), Some(l)) = (
+        rel(t.vertices[0], TRIANGLE_REACH),
+        rel(t.vertices[1], TRIANGLE_REACH),
+        rel(t.vertices[2], TRIANGLE_REACH),
+        rel(light, LIGHT_REACH),
+    ) else {
+        return false;
+    };
+    let d = [d0, d1, d2];
+    let diff = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] {
+        [
+            a[0].wrapping_sub(b[0]),
+            a[1].wrapping_sub(b[1]),
+            a[2].wrapping_sub(b[2]),
+        ]
+    };
+    // The grown cube, relative to the voxel's low corner: [b0, b1] per axis.
+    let (b0, b1) = (
+        CLEARANCE_MARGIN_UNITS.wrapping_neg(),
+        VOXEL.wrapping_add(CLEARANCE_MARGIN_UNITS),
+    );
+    // The largest value of a·(p − q) over the grown cube (at a corner).
+    let box_max = |a: [i128; 3], q: [i64; 3]| -> i128 {
+        (0..3).fold(0i128, |acc, k| {
+            let low = a[k].wrapping_mul(i128::from(b0.wrapping_sub(q[k])));
+            let high = a[k].wrapping_mul(i128::from(b1.wrapping_sub(q[k])));
+            acc.wrapping_add(low.max(high))
+        })
+    };
+    // The triangle's plane: n = (d1 − d0) × (d2 − d0), each component a
+    // difference of two products below 2^60.
+    let (e1, e2) = (diff(d1, d0), diff(d2, d0));
+    let n: [i64; 3] = [
+        e1[1]
+            .wrapping_mul(e2[2])
+            .wrapping_sub(e1[2].wrapping_mul(e2[1])),
+        e1[2]
+            .wrapping_mul(e2[0])
+            .wrapping_sub(e1[0].wrapping_mul(e2[2])),
+        e1[0]
+            .wrapping_mul(e2[1])
+            .wrapping_sub(e1[1].wrapping_mul(e2[0])),
+    ];
+    let to_light = diff(l, d0);
+    let at_light = (0..3).fold(0i128, |acc, k| acc.wrapping_add(wide(n[k], to_light[k])));
+    let l1 = n.iter().fold(0i128, |acc, x| {
+        acc.wrapping_add(i128::from(x.unsigned_abs()))
+    });
+    if at_light.wrapping_abs() <= l1.wrapping_mul(CLEARANCE_MARGIN) {
+        // The light (nearly) in the triangle's plane: no proof.
+        return false;
+    }
+    let s = if at_light > 0 { 1i128 } else { -1 };
+    // Every point of the grown cube strictly on the light's side.
+    if box_max(n.map(|x| i128::from(x).wrapping_mul(s.wrapping_neg())), d0) < 0 {
+        return true;
+    }
+    // The plane through the light and edge (d_i, d_j), normal m = (d_i −
+    // L) × (d_j − d_i); the triangle lies on the side where m·(p − d_i)
+    // has the sign of m·(d_k − d_i) = (d_i − L)·n = −n·(L − d0), the
+    // opposite of `s` (for the three edges in cyclic order,
+    // (d_j − d_i) × (d_k − d_i) = n). m is normal to d_i − L, so
+    // m·(p − d_i) is m·(p − L).
+    [(0, 1), (1, 2), (2, 0)].iter().any(|&(i, j)| {
+        let u = diff(d[i], l);
+        let e = diff(d[j], d[i]);
+        let m = [
+            wide(u[1], e[2]).wrapping_sub(wide(u[2], e[1])),
+            wide(u[2], e[0]).wrapping_sub(wide(u[0], e[2])),
+            wide(u[0], e[1]).wrapping_sub(wide(u[1], e[0])),
+        ];
+        // The cube beyond the plane: −s·m·(p − d_i) < 0 everywhere.
+        box_max(m.map(|x| x.wrapping_mul(s.wrapping_neg())), d[i]) < 0
+    })
 }
 
 /// What [`sphere_blocks`] keeps between a sphere's surface and the
@@ -1001,16 +1127,17 @@ fn blocks<const N: usize>(
 /// blocks every segment from the cube to the light,
 /// [`LightVisibility::Translucent`] (undecided) otherwise, and undecided
 /// without a walk when the cube lies wholly on the dark side of its
-/// objects, all spheres. `sphere` gives the fixed-point sphere of an
-/// object by id, as the object table holds it, and `None` for every other
-/// object: it decides the dark side, and which foreign spheres in the
-/// tube stand clear of the cube's segments to the light. `blocker` gives
+/// objects, all spheres. `shape` gives the fixed-point shape of an
+/// object by id, as the object table holds it (`None` where it is not
+/// known): its spheres decide the dark side, and its spheres and
+/// triangles which foreign objects in the tube stand clear of the cube's
+/// segments to the light. `blocker` gives
 /// the same sphere for the objects whose material lets no light through
 /// (transmission 0), `None` for every other object: those may prove the
 /// voxel occluded. A renderer that
 /// skipped the classification in the pass ([`ExactRecords::Skip`])
 /// computes it here for the voxels its hits need;
-/// the answer depends on nothing but the raster, the store, the spheres,
+/// the answer depends on nothing but the raster, the store, the shapes,
 /// `v` and the light, so it may be memoized and computed in any order. The
 /// caller checks that the objects are exact. The raster's brick level
 /// (`bricks`, [`bricks::shadow_bricks`]), when given, is tried before the
@@ -1027,7 +1154,7 @@ pub fn classify_voxel(
     raster: &Raster<'_>,
     store: &RecordStore<'_>,
     bricks: Option<&ShadowBricks<'_>>,
-    sphere: impl Fn(u32) -> Option<Sphere>,
+    shape: impl Fn(u32) -> Option<Shape>,
     blocker: impl Fn(u32) -> Option<Sphere>,
     v: [u32; 3],
     rec: &VoxelRecord,
@@ -1038,7 +1165,7 @@ pub fn classify_voxel(
         return Err(LightError::ExtentMismatch);
     }
     let own = store.objects(rec);
-    if dark_side(&sphere, own, v, light) {
+    if dark_side(&shape, own, v, light) {
         return Ok(LightVisibility::Translucent);
     }
     if let Some(b) = bricks
@@ -1046,15 +1173,16 @@ pub fn classify_voxel(
     {
         return Ok(LightVisibility::Visible);
     }
-    classify(raster, store, v, own, sphere, blocker, light, None)
+    classify(raster, store, v, own, shape, blocker, light, None)
 }
 
 /// The shadow classification of voxel `v` (objects `own`) for a light at
 /// `light` (module docs, *Shadow classification*):
 /// [`LightVisibility::Visible`] when every non-transparent voxel within
 /// chessboard distance 1 of the 6-connected segment from `v`'s centre to
-/// the light holds only objects of `own` and spheres (`sphere`) that no
-/// segment from the cube to the light meets ([`sphere_clears`]);
+/// the light holds only objects of `own` and spheres and triangles
+/// (`shape`) that no segment from the cube to the light meets
+/// ([`sphere_clears`], [`triangle_clears`]);
 /// [`LightVisibility::Occluded`] when a foreign object of the first
 /// voxel of the tube that holds any is a sphere of `blocker` that blocks
 /// every such segment ([`sphere_blocks`]); else
@@ -1066,7 +1194,7 @@ fn classify(
     view: &RecordStore<'_>,
     v: [u32; 3],
     own: &[u32],
-    sphere: impl Fn(u32) -> Option<Sphere>,
+    shape: impl Fn(u32) -> Option<Shape>,
     blocker: impl Fn(u32) -> Option<Sphere>,
     light: [i64; 3],
     mut found: Option<&mut FoundRecords>,
@@ -1084,16 +1212,29 @@ fn classify(
     let signed = strides.map(usize::cast_signed);
     let dims = extent.dims();
     let own_index = extent.index(v);
-    // The last object found clear of every segment from the cube to the
-    // light ([`sphere_clears`]): neighbouring tube voxels mostly hold it.
-    let cleared = core::cell::Cell::new(None::<u32>);
+    // The last objects found clear of every segment from the cube to the
+    // light ([`sphere_clears`], [`triangle_clears`]), replaced in turn:
+    // neighbouring tube voxels mostly hold them (a mesh's few triangles
+    // near the voxel).
+    let cleared = core::cell::Cell::new([u32::MAX; CLEARED]);
+    let next_slot = core::cell::Cell::new(0usize);
     let clear = |o: u32| -> bool {
-        if cleared.get() == Some(o) {
+        if cleared.get().contains(&o) {
             return true;
         }
-        let yes = sphere(o).is_some_and(|s| sphere_clears(&s, v, light));
+        let yes = match shape(o) {
+            Some(Shape::Sphere(s)) => sphere_clears(&s, v, light),
+            Some(Shape::Triangle(t)) => triangle_clears(&t, v, light),
+            _ => false,
+        };
         if yes {
-            cleared.set(Some(o));
+            let mut ids = cleared.get();
+            let at = next_slot.get() % CLEARED;
+            if let Some(slot) = ids.get_mut(at) {
+                *slot = o;
+            }
+            cleared.set(ids);
+            next_slot.set(at.wrapping_add(1));
         }
         yes
     };
@@ -1213,6 +1354,9 @@ fn classify(
         Piece::Blocked => LightVisibility::Translucent,
     })
 }
+
+/// How many of the objects last cleared a classification remembers.
+const CLEARED: usize = 8;
 
 /// The offsets (per axis, each in −1..=1) of the voxels within chessboard
 /// distance 1 of `u` inside `extent` (`u` among them); with

@@ -971,7 +971,7 @@ fn classification_leaves_the_dark_side_undecided() {
         centre: c,
         radius: r,
     };
-    let shape = |id: u32| (id == 0).then_some(sphere);
+    let shape = |id: u32| (id == 0).then_some(Shape::Sphere(sphere));
     let (mut dark, mut walked) = (0u32, 0u32);
     for light in [vox([200, 90, 30]), vox([24, 24, -40]), vox([30, 20, 26])] {
         for (v, rec) in store.iter() {
@@ -1161,6 +1161,143 @@ fn a_cleared_sphere_meets_no_segment_from_the_cube() {
     );
 }
 
+/// The sign of `(b − a) × (c − a) · (d − a)`, exactly (offsets below
+/// 2^40).
+fn orient(a: [i64; 3], b: [i64; 3], c: [i64; 3], d: [i64; 3]) -> i128 {
+    let u: [i128; 3] = core::array::from_fn(|k| i128::from(b[k] - a[k]));
+    let v: [i128; 3] = core::array::from_fn(|k| i128::from(c[k] - a[k]));
+    let w: [i128; 3] = core::array::from_fn(|k| i128::from(d[k] - a[k]));
+    let x = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    (x[0] * w[0] + x[1] * w[1] + x[2] * w[2]).signum()
+}
+
+/// Whether the closed segment from `p` to `q` meets the closed triangle
+/// `t`, exactly; a segment in the triangle's plane counts as meeting it.
+fn segment_meets_triangle(p: [i64; 3], q: [i64; 3], t: &Triangle) -> bool {
+    let [a, b, c] = t.vertices;
+    let (sp, sq) = (orient(a, b, c, p), orient(a, b, c, q));
+    if sp == 0 && sq == 0 {
+        return true;
+    }
+    if sp == sq {
+        return false;
+    }
+    let s = [orient(p, q, a, b), orient(p, q, b, c), orient(p, q, c, a)];
+    s.iter().all(|&x| x >= 0) || s.iter().all(|&x| x <= 0)
+}
+
+/// [`triangle_clears`] never clears a triangle that a segment from a point
+/// of the cube grown by the margin (its corners, the cube's corners and
+/// centre, random points) to the light meets: random triangles near the
+/// voxel, some sharing an edge through the cube's neighbourhood (a mesh's
+/// neighbours), lights near and up to 2^36 units away. And it clears
+/// triangles next to the voxel, not only far ones.
+#[test]
+fn a_cleared_triangle_meets_no_segment_from_the_cube() {
+    let mut rng = testkit::Rng(0x7a1a_c1ea);
+    let (mut cleared, mut near, mut tested) = (0u32, 0u32, 0u32);
+    let m = CLEARANCE_MARGIN_UNITS;
+    for case in 0..60_000 {
+        let v = [0; 3].map(|_| 4 + rng.below_u32(56));
+        let lo = v.map(|k| i64::from(k) * VOXEL);
+        let around = |rng: &mut testkit::Rng, reach: i64| -> [i64; 3] {
+            core::array::from_fn(|k| lo[k] + rng.range(-reach * VOXEL, (reach + 1) * VOXEL))
+        };
+        let mut vertices = [
+            around(&mut rng, 4),
+            around(&mut rng, 4),
+            around(&mut rng, 4),
+        ];
+        if case % 3 == 0 {
+            // Two vertices on either side of the cube, within a voxel of
+            // it: an edge passing by, as a neighbouring triangle's does.
+            vertices[0] = around(&mut rng, 1);
+            vertices[1] = around(&mut rng, 1);
+        }
+        let t = Triangle {
+            vertices,
+            normals: None,
+        };
+        let light = if case % 2 == 0 {
+            around(&mut rng, 64)
+        } else {
+            [0; 3].map(|_| rng.range(-(1 << 36), 1 << 36))
+        };
+        tested += 1;
+        if !triangle_clears(&t, v, light) {
+            continue;
+        }
+        cleared += 1;
+        let mut points = Vec::new();
+        for c in 0..8i64 {
+            let corner = |lo: i64, hi: i64| -> [i64; 3] {
+                core::array::from_fn(|k| if (c >> k) & 1 == 0 { lo } else { hi })
+            };
+            let plain = corner(0, VOXEL);
+            let grown = corner(-m, VOXEL + m);
+            points.push(core::array::from_fn(|k| lo[k] + plain[k]));
+            points.push(core::array::from_fn(|k| lo[k] + grown[k]));
+        }
+        points.push(v.map(voxel_centre));
+        for _ in 0..6 {
+            points.push(core::array::from_fn(|k| {
+                lo[k] + rng.range(-m, VOXEL + m + 1)
+            }));
+        }
+        for p in points {
+            assert!(
+                !segment_meets_triangle(p, light, &t),
+                "{t:?} cleared for voxel {v:?} and light {light:?}, but the segment from {p:?} meets it"
+            );
+        }
+        // A vertex within two voxels of the cube.
+        if t.vertices
+            .iter()
+            .any(|p| (0..3).all(|k| (p[k] - lo[k]).abs() <= 2 * VOXEL))
+        {
+            near += 1;
+        }
+    }
+    assert!(
+        cleared > tested / 4 && near > 2_000,
+        "{cleared} cleared of {tested}, {near} near"
+    );
+}
+
+/// The triangles' proofs read only offsets they can form exactly: far
+/// vertices or lights, or a light in the triangle's plane, clear nothing,
+/// and huge coordinates do not fail.
+#[test]
+fn far_or_flat_triangles_are_not_cleared() {
+    let v = [3, 4, 5];
+    let lo = v.map(|k| i64::from(k) * VOXEL);
+    let near = |d: [i64; 3]| -> [i64; 3] { core::array::from_fn(|k| lo[k] + d[k] * VOXEL) };
+    // Beside the cube, a light straight above: the plane test clears it.
+    let t = Triangle {
+        vertices: [near([3, 0, 0]), near([4, 0, 0]), near([3, 1, 0])],
+        normals: None,
+    };
+    let above = near([0, 0, 50]);
+    assert!(triangle_clears(&t, v, above));
+    // The light in the triangle's plane.
+    assert!(!triangle_clears(&t, v, near([9, 9, 0])));
+    // A vertex beyond the reach, a light beyond it, the extremes.
+    let mut far = t;
+    far.vertices[2] = near([3, 1 << 14, 0]);
+    assert!(!triangle_clears(&far, v, above));
+    assert!(!triangle_clears(&t, v, [0, 0, 1 << 51]));
+    let huge = Triangle {
+        vertices: [[i64::MAX; 3], [i64::MIN; 3], [0, i64::MAX, i64::MIN]],
+        normals: None,
+    };
+    assert!(!triangle_clears(&huge, v, [i64::MIN; 3]));
+    assert!(!triangle_clears(&t, [u32::MAX; 3], [i64::MAX; 3]));
+}
+
 /// [`shift_below_2_28`] is the least shift that brings its argument below
 /// 2^28.
 #[test]
@@ -1296,10 +1433,10 @@ fn a_clear_sphere_in_the_tube_leaves_the_voxel_lit() {
     );
     let raster = Raster::new(e, &scene.plane).unwrap();
     let store = scene.store();
-    let only_a = |id: u32| (id == 0).then_some(a);
+    let only_a = |id: u32| (id == 0).then_some(Shape::Sphere(a));
     let both = |id: u32| match id {
-        0 => Some(a),
-        1 => Some(b),
+        0 => Some(Shape::Sphere(a)),
+        1 => Some(Shape::Sphere(b)),
         _ => None,
     };
     let mut gained = 0;

@@ -8,7 +8,9 @@ use std::sync::atomic::Ordering;
 
 use glam::DVec3;
 use rrt_core::discrete_ray::{Connectivity, DiscreteRay, WalkEnd};
+use rrt_core::geometry::Triangle as FixedTriangle;
 use rrt_core::light::{LeavingSurface, classify_voxel};
+use rrt_core::object_table::Shape as FixedShape;
 use rrt_core::raster::cell;
 use rrt_core::voxel::{LightVisibility, VoxelRecord};
 use rrt_core::voxelize::NORMAL_ONE;
@@ -315,10 +317,20 @@ impl Tracer<'_> {
                 }
                 let known = (slot.load(Ordering::Relaxed) >> shift) & 3;
                 if known == Classification::UNKNOWN {
-                    // A sphere's fixed-point geometry as the fit makes it,
-                    // made when asked: no copy of the object table is kept.
+                    // A sphere's or triangle's fixed-point geometry as the
+                    // fit makes it, made when asked: no copy of the object
+                    // table is kept.
                     let shape = |id: u32| match self.objects.get(usize::try_from(id).ok()?)?.shape {
-                        Shape::Sphere(s) => s.to_fixed(&self.frame).ok(),
+                        Shape::Sphere(s) => s.to_fixed(&self.frame).ok().map(FixedShape::Sphere),
+                        // Its vertices as the fit rounds them: the proofs
+                        // read nothing else of a triangle.
+                        Shape::Triangle(t) => {
+                            let [a, b, c] = t.vertices.map(|p| self.frame.to_fixed(p));
+                            Some(FixedShape::Triangle(FixedTriangle {
+                                vertices: [a?, b?, c?],
+                                normals: None,
+                            }))
+                        }
                         _ => None,
                     };
                     // The same, for the spheres that let no light through.
