@@ -834,13 +834,22 @@ fn triangle_clears(t: &Triangle, v: [u32; 3], light: [i64; 3]) -> bool {
         CLEARANCE_MARGIN_UNITS.wrapping_neg(),
         VOXEL.wrapping_add(CLEARANCE_MARGIN_UNITS),
     );
-    // The largest value of a·(p − q) over the grown cube (at a corner).
+    // The largest value of a·(p − q) over the grown cube: at the corner
+    // whose bound on each axis the coefficient's sign picks.
     let box_max = |a: [i128; 3], q: [i64; 3]| -> i128 {
         (0..3).fold(0i128, |acc, k| {
-            let low = a[k].wrapping_mul(i128::from(b0.wrapping_sub(q[k])));
-            let high = a[k].wrapping_mul(i128::from(b1.wrapping_sub(q[k])));
-            acc.wrapping_add(low.max(high))
+            let b = if a[k] > 0 { b1 } else { b0 };
+            acc.wrapping_add(a[k].wrapping_mul(i128::from(b.wrapping_sub(q[k]))))
         })
+    };
+    // `a`, or `−a` where the light lies on the positive side of the
+    // triangle's plane.
+    let away = |a: [i128; 3], positive: bool| -> [i128; 3] {
+        if positive {
+            a.map(i128::wrapping_neg)
+        } else {
+            a
+        }
     };
     // The triangle's plane: n = (d1 − d0) × (d2 − d0), each component a
     // difference of two products below 2^60.
@@ -865,9 +874,10 @@ fn triangle_clears(t: &Triangle, v: [u32; 3], light: [i64; 3]) -> bool {
         // The light (nearly) in the triangle's plane: no proof.
         return false;
     }
-    let s = if at_light > 0 { 1i128 } else { -1 };
-    // Every point of the grown cube strictly on the light's side.
-    if box_max(n.map(|x| i128::from(x).wrapping_mul(s.wrapping_neg())), d0) < 0 {
+    let positive = at_light > 0;
+    // Every point of the grown cube strictly on the light's side:
+    // −s·n·(p − d0) < 0 everywhere, s the sign of n·(L − d0).
+    if box_max(away(n.map(i128::from), positive), d0) < 0 {
         return true;
     }
     // The plane through the light and edge (d_i, d_j), normal m = (d_i −
@@ -885,7 +895,7 @@ fn triangle_clears(t: &Triangle, v: [u32; 3], light: [i64; 3]) -> bool {
             wide(u[0], e[1]).wrapping_sub(wide(u[1], e[0])),
         ];
         // The cube beyond the plane: −s·m·(p − d_i) < 0 everywhere.
-        box_max(m.map(|x| x.wrapping_mul(s.wrapping_neg())), d[i]) < 0
+        box_max(away(m, positive), d[i]) < 0
     })
 }
 
