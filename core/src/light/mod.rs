@@ -83,8 +83,8 @@
 //! does a foreign triangle when the cube (with the same margin) lies
 //! outside its shadow volume from `L`, the points whose segment to `L`
 //! meets it: wholly on the light's side of its plane, or beyond one of
-//! the three planes through `L` and an edge (the neighbouring triangles of
-//! a lit mesh mostly are). And an
+//! the three planes through `L` and an edge (as the neighbouring
+//! triangles of a lit mesh often are). And an
 //! opaque sphere met in the tube *occludes* the voxel (`Occluded`) when the
 //! segment from `v`'s centre to `L` passes within its radius less half the
 //! cube's diagonal and half a voxel of its centre, the cube lies that much
