@@ -659,14 +659,15 @@ fn opaque_sphere_of<'t, const N: usize>(
 /// closed cube lies within it of the centre (√3/2 · 2^16 < 56756).
 const HALF_DIAGONAL: i128 = 56_756;
 
-/// What [`sphere_clears`] adds to a sphere's radius for the rounding of
+/// What [`sphere_clears`] adds to a sphere's radius (and [`triangle_clears`]
+/// to the cube's sides) for the rounding of
 /// the renderer's exact sphere and light to fixed point (under one unit
 /// per coordinate, and under 2^-11 voxel for a light taken by its
 /// direction) and of the shading point to its voxel: 1/256 voxel.
-const CLEARANCE_MARGIN: i128 = 256;
+const CLEARANCE_MARGIN_UNITS: i64 = VOXEL / 256;
 
-/// [`CLEARANCE_MARGIN`] as a fixed-point length.
-const CLEARANCE_MARGIN_UNITS: i64 = 256;
+/// [`CLEARANCE_MARGIN_UNITS`] in 128 bits, as the sphere tests use it.
+const CLEARANCE_MARGIN: i128 = CLEARANCE_MARGIN_UNITS as i128;
 
 /// The least shift that brings `big` below 2^28 (at most 100).
 #[inline(always)]
