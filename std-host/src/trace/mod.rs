@@ -68,7 +68,10 @@
 //! true point and normal, and the attributes of the object hit (its own
 //! record: the voxel's, or a neighbouring voxel's it owns); the diffuse
 //! terms are recomputed with the true normal for the lights the bits say
-//! are visible. Voxels whose objects are all missed are the paper's
+//! are visible. An untextured object with exact geometry is shaded with
+//! its material's colour itself, not the 8-bit colour its records store,
+//! so its colour does not depend on the voxel a hit was found from, nor
+//! on the raster. Voxels whose objects are all missed are the paper's
 //! *false hits* ([`RayStats::false_hits`]).
 //!
 //! # No acne
@@ -159,8 +162,8 @@ pub mod verify;
 pub mod walk;
 
 use std::fmt;
-use std::sync::Arc;
 use std::sync::atomic::AtomicU16;
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use rrt_core::discrete_ray::Connectivity;
@@ -421,6 +424,8 @@ struct SurfaceHit {
     voxel: [u32; 3],
     /// The attributes of the object hit (its record).
     rec: VoxelRecord,
+    /// The colour it is shaded with (linear, `[0, 1]`).
+    colour: DVec3,
     /// The object hit.
     object: u32,
     /// The ray parameter of `point`.
@@ -494,7 +499,23 @@ pub struct Tracer<'s> {
     /// spheres a ray clearly misses are passed over without reading the
     /// object table.
     spheres: Arc<[Sphere]>,
+    /// The brick directory of `store`.
+    directory: &'s [u32],
+    /// By object id, what the records it owns around it hold, found when a
+    /// hit on it in a voxel it does not own first asks
+    /// ([`Tracer::attributes_of`]); a function of the records alone.
+    owned: Arc<[OnceLock<Option<Owned>>]>,
+    /// Whether a verified hit's shading reads nothing of its record but
+    /// the material and the colour: the exact mode (the light bits give
+    /// way to exact shadows, the precomputed illumination to the true
+    /// normal) with every object exact (a ray leaving a hit reads the
+    /// record's normal and owner only at voxels of objects without exact
+    /// geometry, for the acne rule).
+    attributes_only: bool,
     materials: &'s [Material],
+    /// By material, the 8-bit colour an untextured object's records hold
+    /// ([`record_colour`](crate::voxelize::materials::record_colour)).
+    record_colours: Arc<[[u8; 3]]>,
     lights: &'s [WorldLight],
     lights_fx: Vec<Option<[i64; 3]>>,
     /// The volumes rendered directly, by object id.
@@ -535,6 +556,39 @@ fn sphere_table(objects: &[WorldObject]) -> Arc<[Sphere]> {
         })
         .collect()
 }
+
+/// An 8-bit colour as values in `[0, 1]`.
+fn rgb(c: [u8; 3]) -> DVec3 {
+    DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])) / 255.0
+}
+
+/// What the records an object owns in a box of voxels around it hold
+/// ([`Tracer::owned`]): any record the search of [`Tracer::attributes_of`]
+/// can find for a hit whose neighbouring voxels all lie in the box is one
+/// of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Owned {
+    /// The box: voxels `lo..hi` on each axis.
+    lo: [u32; 3],
+    hi: [u32; 3],
+    holds: Holds,
+}
+
+/// See [`Owned`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Holds {
+    /// No record.
+    Nothing,
+    /// Records, each with the object's material and its colour as an
+    /// untextured object's records hold it.
+    Plain,
+    /// Records, some with other attributes (a texture).
+    Varied,
+}
+
+/// Voxels the box of [`Owned`] reaches beyond the object's bounds: a voxel
+/// its surface passes through, and that voxel's neighbours, lie within.
+const OWNED_MARGIN: f64 = 3.0;
 
 /// The source of the shadow classification of a render
 /// ([`Tracer::exact_light`]). Clones share what was computed.
@@ -656,7 +710,16 @@ impl<'s> Tracer<'s> {
             frame: scene.frame,
             objects: &scene.objects,
             spheres: sphere_table(&scene.objects),
+            directory: &scene.directory,
+            owned: (0..scene.objects.len()).map(|_| OnceLock::new()).collect(),
+            attributes_only: opts.mode.exact_shadows()
+                && scene.objects.iter().all(|o| o.shape.is_exact()),
             materials: &scene.materials,
+            record_colours: scene
+                .materials
+                .iter()
+                .map(crate::voxelize::materials::record_colour)
+                .collect(),
             lights: &scene.lights,
             lights_fx,
             direct: &scene.direct,

@@ -17,15 +17,11 @@ use rrt_core::voxelize::NORMAL_ONE;
 
 use super::verify::Mailbox;
 use super::walk::surface_voxel;
-use super::{Classification, RayStats, SurfaceHit, Tracer, shading};
+use super::{Classification, RayStats, SurfaceHit, Tracer, rgb, shading};
 use crate::frame::unit_to_fixed;
 use crate::scene::Material;
 use crate::shape::{Shape, Surface};
 use crate::world::Ray;
-
-fn rgb(c: [u8; 3]) -> DVec3 {
-    DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])) / 255.0
-}
 
 impl Tracer<'_> {
     /// Where a ray leaving hit `h` towards the side `side` (a unit normal)
@@ -75,7 +71,7 @@ impl Tracer<'_> {
         let d = ray.dir;
         let front = h.normal.dot(d) <= 0.0;
         let n = if front { h.normal } else { -h.normal };
-        let c = rgb(h.rec.color);
+        let c = h.colour;
         let i = self.intensity;
         // The precomputed illumination is the stored normal's side, at the
         // voxel centre: used as it is for the basic algorithm on that side.

@@ -4,9 +4,10 @@
 
 use glam::DVec3;
 use rrt_core::light::LeavingSurface;
+use rrt_core::store::{BRICK_BITS, brick_dims};
 use rrt_core::voxel::VoxelRecord;
 
-use super::{RayStats, SurfaceHit, Tracer};
+use super::{Holds, OWNED_MARGIN, Owned, RayStats, SurfaceHit, Tracer, rgb};
 use crate::frame::RasterFrame;
 use crate::shape::Shape;
 use crate::voxelize::WorldObject;
@@ -227,6 +228,7 @@ impl Tracer<'_> {
         SurfaceHit {
             voxel: v,
             rec: *rec,
+            colour: rgb(rec.color),
             object: self.store.owner(rec),
             t,
             point: ray.at(t),
@@ -309,7 +311,7 @@ impl Tracer<'_> {
     /// The surface hit of an accepted candidate: its object's attributes
     /// (the voxel's record when the object owns the voxel, else the record
     /// of the nearest neighbouring voxel it owns, else its material's),
-    /// the true point and normal.
+    /// its colour ([`Tracer::colour_of`]), the true point and normal.
     pub(super) fn candidate_hit(&self, ray: &Ray, c: &Candidate) -> SurfaceHit {
         let point = ray.at(c.t);
         let smooth = !c.exact
@@ -320,9 +322,11 @@ impl Tracer<'_> {
         let normal = smooth
             .then(|| self.smooth_normal(c.object, point))
             .flatten();
+        let rec = self.attributes_of(c.object, c.voxel, &c.rec);
         SurfaceHit {
             voxel: c.voxel,
-            rec: self.attributes_of(c.object, c.voxel, &c.rec),
+            rec,
+            colour: self.colour_of(c, &rec),
             object: c.object,
             t: c.t,
             point,
@@ -390,37 +394,147 @@ impl Tracer<'_> {
 
     /// A record with object `id`'s attributes near voxel `v` (record
     /// `rec`): see [`Tracer::candidate_hit`]; of the neighbours it owns,
-    /// the nearest ([`NEIGHBOURS_BY_DISTANCE`]).
+    /// the nearest ([`NEIGHBOURS_BY_DISTANCE`]); without one, `rec` with
+    /// the object's material and that material's colour as an untextured
+    /// object's records hold it. The neighbours are not searched where the
+    /// records the object owns around it ([`Tracer::owned`]) say what the
+    /// search would give: none, or only records whose material and colour
+    /// are those, when they are all the shading reads.
     fn attributes_of(&self, id: u32, v: [u32; 3], rec: &VoxelRecord) -> VoxelRecord {
         if self.store.owner(rec) == id {
             return *rec;
         }
-        for d in NEIGHBOURS_BY_DISTANCE {
-            let (Some(x), Some(y), Some(z)) = (
-                v[0].checked_add_signed(d[0]),
-                v[1].checked_add_signed(d[1]),
-                v[2].checked_add_signed(d[2]),
-            ) else {
-                continue;
-            };
-            let Some((_, c)) = self.opaque_cell([x, y, z]) else {
-                continue;
-            };
-            if let Some(n) = self.store.get_hinted([x, y, z], c)
-                && self.store.owner(n) == id
-            {
-                return *n;
+        let obj = usize::try_from(id).ok().and_then(|i| self.objects.get(i));
+        let mut own = *rec;
+        if let Some(obj) = obj {
+            own.material = obj.material;
+            if let Some(&c) = self.record_colours.get(usize::from(obj.material)) {
+                own.color = c;
             }
         }
-        let mut r = *rec;
-        if let Some(obj) = usize::try_from(id).ok().and_then(|i| self.objects.get(i)) {
-            r.material = obj.material;
-            if let Some(m) = self.materials.get(usize::from(obj.material)) {
-                r.color = [m.colour.x, m.colour.y, m.colour.z]
-                    .map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+        let searched = match self.owned_around(id, v) {
+            Some(Holds::Nothing) => false,
+            Some(Holds::Plain) => !self.attributes_only,
+            Some(Holds::Varied) | None => true,
+        };
+        if searched {
+            for d in NEIGHBOURS_BY_DISTANCE {
+                let (Some(x), Some(y), Some(z)) = (
+                    v[0].checked_add_signed(d[0]),
+                    v[1].checked_add_signed(d[1]),
+                    v[2].checked_add_signed(d[2]),
+                ) else {
+                    continue;
+                };
+                let Some((_, c)) = self.opaque_cell([x, y, z]) else {
+                    continue;
+                };
+                if let Some(n) = self.store.get_hinted([x, y, z], c)
+                    && self.store.owner(n) == id
+                {
+                    return *n;
+                }
             }
         }
-        r
+        own
+    }
+
+    /// The colour candidate `c` with attributes `rec` is shaded with: for
+    /// an object with exact geometry whose record holds its material's
+    /// colour as an untextured object's records do, that colour itself
+    /// (clamped to `[0, 1]` as the records' is), as the exact ray tracer
+    /// shades it, whatever the raster; otherwise the record's 8-bit colour
+    /// (a texture's, or a surface without exact geometry).
+    fn colour_of(&self, c: &Candidate, rec: &VoxelRecord) -> DVec3 {
+        let m = usize::from(rec.material);
+        let plain = c.exact
+            && self.record_colours.get(m) == Some(&rec.color)
+            && usize::try_from(c.object)
+                .ok()
+                .and_then(|i| self.objects.get(i))
+                .is_some_and(|o| o.material == rec.material);
+        match self.materials.get(m) {
+            Some(m) if plain => m.colour.clamp(DVec3::ZERO, DVec3::ONE),
+            _ => rgb(rec.color),
+        }
+    }
+
+    /// What the records object `id` owns hold around voxel `v`, when
+    /// every neighbour of `v` lies in the box [`Tracer::owned`] keeps for
+    /// it (found on first use).
+    fn owned_around(&self, id: u32, v: [u32; 3]) -> Option<Holds> {
+        let slot = usize::try_from(id).ok().and_then(|i| self.owned.get(i))?;
+        let o = slot.get_or_init(|| self.owned_near(id)).as_ref()?;
+        let dims = self.extent.dims();
+        (0..3)
+            .all(|a| {
+                v[a].saturating_sub(1) >= o.lo[a]
+                    && v[a].saturating_add(1).min(dims[a].saturating_sub(1)) < o.hi[a]
+            })
+            .then_some(o.holds)
+    }
+
+    /// [`Owned`] for object `id`: its bounds in voxels grown by
+    /// [`OWNED_MARGIN`], and what the records it owns in the bricks
+    /// meeting that box hold. `None` for an object without bounds.
+    fn owned_near(&self, id: u32) -> Option<Owned> {
+        let i = usize::try_from(id).ok()?;
+        let obj = self.objects.get(i)?;
+        let b = obj.shape.bounds()?;
+        let (lo_w, hi_w) = (
+            self.frame.world_to_raster(b.min),
+            self.frame.world_to_raster(b.max),
+        );
+        if !(lo_w.is_finite() && hi_w.is_finite()) {
+            return None;
+        }
+        let dims = self.extent.dims();
+        // Clamped to the raster, so the conversions are exact.
+        let lo: [u32; 3] = std::array::from_fn(|a| {
+            (lo_w[a].floor() - OWNED_MARGIN).clamp(0.0, f64::from(dims[a])) as u32
+        });
+        let hi: [u32; 3] = std::array::from_fn(|a| {
+            (hi_w[a].floor() + OWNED_MARGIN + 1.0).clamp(0.0, f64::from(dims[a])) as u32
+        });
+        let plain = (
+            obj.material,
+            self.record_colours.get(usize::from(obj.material)).copied(),
+        );
+        let mut holds = Holds::Nothing;
+        if (0..3).all(|a| lo[a] < hi[a]) {
+            let [nx, ny, _] = brick_dims(self.extent).map(|n| n as usize);
+            let brick = |v: u32| (v >> BRICK_BITS) as usize;
+            let records = self.store.records();
+            'bricks: for bz in brick(lo[2])..=brick(hi[2] - 1) {
+                for by in brick(lo[1])..=brick(hi[1] - 1) {
+                    for bx in brick(lo[0])..=brick(hi[0] - 1) {
+                        let k = ny
+                            .checked_mul(bz)
+                            .and_then(|k| k.checked_add(by))
+                            .and_then(|k| k.checked_mul(nx))
+                            .and_then(|k| k.checked_add(bx));
+                        let (Some(&from), Some(&to)) = (
+                            k.and_then(|k| self.directory.get(k)),
+                            k.and_then(|k| self.directory.get(k.checked_add(1)?)),
+                        ) else {
+                            continue;
+                        };
+                        let span = records.get(from as usize..to as usize).unwrap_or(&[]);
+                        for r in span.iter().filter(|r| self.store.owner(r) == id) {
+                            holds = if (r.material, Some(r.color)) == plain {
+                                Holds::Plain
+                            } else {
+                                Holds::Varied
+                            };
+                            if holds == Holds::Varied {
+                                break 'bricks;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Some(Owned { lo, hi, holds })
     }
 
     pub(super) fn accept(&self, ray: &Ray, c: &Candidate, stats: &mut RayStats) -> SurfaceHit {

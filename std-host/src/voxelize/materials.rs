@@ -88,7 +88,7 @@ impl MaterialTable {
             color: self
                 .list
                 .get(usize::from(material))
-                .map_or([0; 3], |m| core_material(m).color_u8()),
+                .map_or([0; 3], record_colour),
         }
     }
 
@@ -101,6 +101,12 @@ impl MaterialTable {
         }
         core
     }
+}
+
+/// The 8-bit colour the records of an untextured object of material `m`
+/// hold.
+pub fn record_colour(m: &Material) -> [u8; 3] {
+    core_material(m).color_u8()
 }
 
 /// A scalar in `[0, ∞)` as the core's 16.16 fixed point, saturating.
