@@ -230,9 +230,9 @@ impl ImageTexture {
     ///
     /// # Errors
     /// [`TextureError::Io`], [`TextureError::NotImage`] for a file that is
-    /// not a PNG or JPEG, [`TextureError::Decode`] for a damaged one or one
-    /// above [`MAX_IMAGE_PIXELS`], [`TextureError::Invalid`] for a bad
-    /// mapping.
+    /// not a PNG or JPEG, [`TextureError::TooLarge`] for one above
+    /// [`MAX_IMAGE_PIXELS`] (refused from its header), [`TextureError::Decode`]
+    /// for a damaged one, [`TextureError::Invalid`] for a bad mapping.
     pub fn open(path: impl AsRef<Path>, mapping: Mapping) -> Result<Self, TextureError> {
         let path = path.as_ref();
         let bytes = std::fs::read(path).map_err(|source| TextureError::Io {
@@ -272,14 +272,27 @@ impl ImageTexture {
                 });
             }
         };
-        let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
-        let mut limits = image::Limits::default();
-        limits.max_alloc = Some(MAX_IMAGE_PIXELS * 4);
-        reader.limits(limits);
-        let img = reader.decode().map_err(|source| TextureError::Decode {
+        let reader = || {
+            let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+            let mut limits = image::Limits::default();
+            limits.max_alloc = Some(MAX_IMAGE_PIXELS * 4);
+            reader.limits(limits);
+            reader
+        };
+        let decode_err = |source| TextureError::Decode {
             path: path.to_path_buf(),
             source,
-        })?;
+        };
+        // The size from the header, before anything is decoded.
+        let (width, height) = reader().into_dimensions().map_err(decode_err)?;
+        if u64::from(width) * u64::from(height) > MAX_IMAGE_PIXELS {
+            return Err(TextureError::TooLarge {
+                path: path.to_path_buf(),
+                width,
+                height,
+            });
+        }
+        let img = reader().decode().map_err(decode_err)?;
         let rgb = img.to_rgb8();
         Self::from_rgb(
             rgb.width(),
@@ -426,6 +439,81 @@ impl WorldTexture for ImageTexture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The signature and header chunk of a PNG of `width`×`height`
+    /// `depth`-bit gray pixels, a data chunk of no pixels (an empty zlib
+    /// stream) and the end chunk.
+    fn png_header(width: u32, height: u32, depth: u8) -> Vec<u8> {
+        fn crc32(bytes: &[u8]) -> u32 {
+            let mut c = u32::MAX;
+            for &b in bytes {
+                c ^= u32::from(b);
+                for _ in 0..8 {
+                    c = if c & 1 != 0 {
+                        0xedb8_8320 ^ (c >> 1)
+                    } else {
+                        c >> 1
+                    };
+                }
+            }
+            !c
+        }
+        let chunk = |kind: &[u8], data: &[u8]| {
+            let mut body = kind.to_vec();
+            body.extend_from_slice(data);
+            let mut out = u32::try_from(data.len()).unwrap().to_be_bytes().to_vec();
+            out.extend_from_slice(&body);
+            out.extend_from_slice(&crc32(&body).to_be_bytes());
+            out
+        };
+        let mut ihdr = width.to_be_bytes().to_vec();
+        ihdr.extend_from_slice(&height.to_be_bytes());
+        ihdr.extend_from_slice(&[depth, 0, 0, 0, 0]);
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.extend(chunk(b"IHDR", &ihdr));
+        png.extend(chunk(
+            b"IDAT",
+            &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01],
+        ));
+        png.extend(chunk(b"IEND", &[]));
+        png
+    }
+
+    /// An image whose header says it has more than [`MAX_IMAGE_PIXELS`]
+    /// pixels (a few bytes of PNG, gigabytes decoded) is refused before
+    /// anything is decoded, naming the file and the size.
+    #[test]
+    fn an_image_above_the_pixel_limit_is_refused_from_its_header() {
+        let mapping = Mapping::Planar {
+            origin: DVec3::ZERO,
+            u_axis: DVec3::X,
+            v_axis: DVec3::Y,
+        };
+        let path = Path::new("huge.png");
+        let err = ImageTexture::from_bytes(path, &png_header(23_000, 23_000, 16), mapping)
+            .expect_err("refused");
+        assert!(
+            matches!(
+                err,
+                TextureError::TooLarge {
+                    width: 23_000,
+                    height: 23_000,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(
+            err.to_string()
+                .starts_with("huge.png: the image is 23000×23000"),
+            "{err}"
+        );
+        // At the limit the header passes, and the missing pixels are a
+        // decoding error.
+        let err = ImageTexture::from_bytes(path, &png_header(16_384, 16_384, 8), mapping)
+            .expect_err("refused");
+        assert!(matches!(err, TextureError::Decode { .. }), "{err}");
+    }
 
     #[test]
     fn wrap_rules() {

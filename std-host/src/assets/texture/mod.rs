@@ -70,6 +70,22 @@ pub enum TextureError {
         #[source]
         source: image::ImageError,
     },
+    /// The image has more pixels than [`MAX_IMAGE_PIXELS`]: refused before
+    /// it is decoded.
+    #[error(
+        "{}: the image is {width}×{height}, {} pixels, more than the {} a texture may have",
+        path.display(),
+        u64::from(*width) * u64::from(*height),
+        image_map::MAX_IMAGE_PIXELS
+    )]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its width in pixels.
+        width: u32,
+        /// Its height in pixels.
+        height: u32,
+    },
     /// A parameter is unusable.
     #[error("{what}: {msg}")]
     Invalid {
