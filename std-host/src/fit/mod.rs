@@ -144,6 +144,15 @@ pub enum FitError {
         /// What it is.
         what: &'static str,
     },
+    /// The object table cannot be allocated (the memory estimate passed,
+    /// but the system refused).
+    #[error("cannot allocate {} for the object table of {objects} objects; use a smaller scene or free memory", Bytes(*bytes))]
+    Alloc {
+        /// Objects the table was to hold.
+        objects: usize,
+        /// Bytes asked for.
+        bytes: u64,
+    },
     /// An object lies too far from the raster for fixed point.
     #[error("{loc}: {what} lies more than 2^{MAX_FIXED_VOXEL_BITS} voxels from the raster")]
     OutOfRange {
@@ -229,12 +238,24 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
             limit: opts.max_memory,
         });
     }
+    let count = scene
+        .spheres
+        .len()
+        .saturating_add(scene.cones.len())
+        .saturating_add(scene.triangle_count())
+        .saturating_add(scene.tori.len());
+    let mut objects = Vec::new();
+    objects
+        .try_reserve_exact(count)
+        .map_err(|_| FitError::Alloc {
+            objects: count,
+            bytes: u64::try_from(count.saturating_mul(size_of::<FittedObject>()))
+                .unwrap_or(u64::MAX),
+        })?;
     let mut table = Table {
         frame: &frame,
         world: frame.world_bounds(),
-        objects: Vec::with_capacity(
-            scene.spheres.len() + scene.cones.len() + scene.triangle_count() + scene.tori.len(),
-        ),
+        objects,
         dropped: Dropped::default(),
     };
     table.add_all(&scene.spheres)?;
