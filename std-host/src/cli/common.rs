@@ -397,7 +397,7 @@ pub fn load_or_build(
     check_view: &dyn Fn(&View) -> Result<(), CliError>,
 ) -> Result<Loaded, CliError> {
     if let Some(p) = path
-        && rasterfile::is_raster_file(p)
+        && rasterfile::names_raster(p)
     {
         for (given, arg) in [
             (raster.raster.is_some(), "--raster"),

@@ -1058,6 +1058,17 @@ pub fn reseal(bytes: &mut [u8]) {
     bytes[at..at + 4].copy_from_slice(&crc.to_le_bytes());
 }
 
+/// Whether `path` is read as a saved raster: its name ends in `.rrt`
+/// (then a file that is not a whole raster is refused as a damaged one,
+/// not read as a scene), or it is a regular file starting with the raster
+/// magic ([`is_raster_file`]).
+#[must_use]
+pub fn names_raster(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("rrt"))
+        || is_raster_file(path)
+}
+
 /// Whether `path` is a regular file starting with the raster magic. Only
 /// a regular file is read: the first bytes of a pipe, a FIFO or a
 /// terminal (`/dev/stdin`) read here would be lost to the scene parser
