@@ -586,9 +586,15 @@ pub(super) enum Holds {
     Varied,
 }
 
-/// Voxels the box of [`Owned`] reaches beyond the object's bounds: a voxel
-/// its surface passes through, and that voxel's neighbours, lie within.
+/// Voxels the box of [`Owned`] reaches beyond the object's bounds, so that
+/// the voxels hits on the object are found from lie within it with their
+/// neighbours (where one does not, the neighbours are searched).
 const OWNED_MARGIN: f64 = 3.0;
+
+/// Records an object's [`Owned`] reads at most, once: each object's scan
+/// is bounded whatever its size (an object whose box holds more has its
+/// neighbours searched).
+const OWNED_SCAN_LIMIT: usize = 1 << 16;
 
 /// The source of the shadow classification of a render
 /// ([`Tracer::exact_light`]). Clones share what was computed.

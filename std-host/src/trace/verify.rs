@@ -7,7 +7,7 @@ use rrt_core::light::LeavingSurface;
 use rrt_core::store::{BRICK_BITS, brick_dims};
 use rrt_core::voxel::VoxelRecord;
 
-use super::{Holds, OWNED_MARGIN, Owned, RayStats, SurfaceHit, Tracer, rgb};
+use super::{Holds, OWNED_MARGIN, OWNED_SCAN_LIMIT, Owned, RayStats, SurfaceHit, Tracer, rgb};
 use crate::frame::RasterFrame;
 use crate::shape::Shape;
 use crate::voxelize::WorldObject;
@@ -476,7 +476,9 @@ impl Tracer<'_> {
 
     /// [`Owned`] for object `id`: its bounds in voxels grown by
     /// [`OWNED_MARGIN`], and what the records it owns in the bricks
-    /// meeting that box hold. `None` for an object without bounds.
+    /// meeting that box hold ([`Holds::Varied`] when those bricks hold more
+    /// than [`OWNED_SCAN_LIMIT`] records: the search is then made as for a
+    /// texture). `None` for an object without bounds.
     fn owned_near(&self, id: u32) -> Option<Owned> {
         let i = usize::try_from(id).ok()?;
         let obj = self.objects.get(i)?;
@@ -501,6 +503,7 @@ impl Tracer<'_> {
             self.record_colours.get(usize::from(obj.material)).copied(),
         );
         let mut holds = Holds::Nothing;
+        let mut scanned = 0usize;
         if (0..3).all(|a| lo[a] < hi[a]) {
             let [nx, ny, _] = brick_dims(self.extent).map(|n| n as usize);
             let brick = |v: u32| (v >> BRICK_BITS) as usize;
@@ -520,6 +523,12 @@ impl Tracer<'_> {
                             continue;
                         };
                         let span = records.get(from as usize..to as usize).unwrap_or(&[]);
+                        scanned = scanned.saturating_add(span.len());
+                        if scanned > OWNED_SCAN_LIMIT {
+                            // Too large to be worth it: searched as before.
+                            holds = Holds::Varied;
+                            break 'bricks;
+                        }
                         for r in span.iter().filter(|r| self.store.owner(r) == id) {
                             holds = if (r.material, Some(r.color)) == plain {
                                 Holds::Plain
