@@ -958,6 +958,16 @@ fn every_bad_value_is_located_at_itself() {
             "2 or more operands",
         ),
         (
+            "csg too many operands",
+            second_object(
+                &format!("csg = {{ union = [{}] }}", vec!["\"a\""; 65].join(", ")),
+                solids,
+            ),
+            "[\"a\", \"a\"",
+            "object[1].csg.union",
+            "65 operands: a CSG tree holds at most 64 nodes",
+        ),
+        (
             "csg operand type",
             second_object(
                 "csg = { difference = [\"a\", { union = [\"b\", 7] }] }",

@@ -266,11 +266,21 @@ impl Builder<'_> {
                 ));
             }
         };
-        if args.len() < 2 || args.len() > MAX_NODES {
+        if args.len() < 2 {
             return Err(self.err(
                 s,
                 &format!("{path}.{op}"),
                 "an operation takes 2 or more operands",
+            ));
+        }
+        if args.len() > MAX_NODES {
+            return Err(self.err(
+                s,
+                &format!("{path}.{op}"),
+                format!(
+                    "{} operands: a CSG tree holds at most {MAX_NODES} nodes",
+                    args.len()
+                ),
             ));
         }
         let mut acc: Option<u16> = None;
