@@ -37,6 +37,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DVec3};
+use rayon::prelude::*;
 
 use crate::world::Bounds;
 
@@ -223,6 +224,35 @@ impl Samples {
         }
     }
 
+    /// Smallest and largest sample (NaN samples skipped; `(0, 0)` when
+    /// every sample is NaN or there is none), over all threads of the
+    /// current rayon pool.
+    #[must_use]
+    pub fn range(&self) -> (f64, f64) {
+        fn of<T: Copy + Sync>(v: &[T], f: impl Fn(T) -> f64 + Sync) -> (f64, f64) {
+            v.par_chunks(1 << 16)
+                .map(|c| {
+                    c.iter()
+                        .map(|&x| f(x))
+                        .filter(|x| !x.is_nan())
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                            (lo.min(x), hi.max(x))
+                        })
+                })
+                .reduce(
+                    || (f64::INFINITY, f64::NEG_INFINITY),
+                    |a, b| (a.0.min(b.0), a.1.max(b.1)),
+                )
+        }
+        let (lo, hi) = match self {
+            Self::U8(v) => of(v, f64::from),
+            Self::I16(v) => of(v, f64::from),
+            Self::U16(v) => of(v, f64::from),
+            Self::F32(v) => of(v, f64::from),
+        };
+        if lo > hi { (0.0, 0.0) } else { (lo, hi) }
+    }
+
     /// Every sample as `f64`, in order.
     pub fn iter(&self) -> Box<dyn Iterator<Item = f64> + '_> {
         match self {
@@ -332,6 +362,8 @@ pub struct Volume {
     inverse: DMat3,
     /// Whether the file gave the geometry (`false`: unit spacing assumed).
     geometry_known: bool,
+    /// Smallest and largest sample, found once ([`Volume::range`]).
+    range: (f64, f64),
 }
 
 impl Volume {
@@ -365,6 +397,7 @@ impl Volume {
             dims,
             inverse: grid.matrix().inverse(),
             grid,
+            range: samples.range(),
             samples,
             geometry_known: true,
         })
@@ -450,17 +483,10 @@ impl Volume {
     }
 
     /// Smallest and largest sample (NaN samples are skipped; a volume of
-    /// only NaN gives `(0, 0)`).
+    /// only NaN gives `(0, 0)`), found once when the volume was made.
     #[must_use]
-    pub fn range(&self) -> (f64, f64) {
-        let (lo, hi) = self
-            .samples
-            .iter()
-            .filter(|v| !v.is_nan())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            });
-        if lo > hi { (0.0, 0.0) } else { (lo, hi) }
+    pub const fn range(&self) -> (f64, f64) {
+        self.range
     }
 
     /// Mean of the samples (NaN samples skipped).
