@@ -908,16 +908,25 @@ fn the_exact_image_does_not_depend_on_the_raster() {
                f 0.4225 0.1009 0.4723 0.4252 0 1 0 1\n\
                s -558.467808 -156380.646 -19475.2945 2.03843015\n";
     let scene = Scene::parse("raster.nff", src.as_bytes()).unwrap();
-    let images: Vec<Vec<u8>> = [64, 100, 400]
-        .into_iter()
-        .map(|n| {
-            let vs = voxelize_exact(&scene, n);
-            draw(&vs, 64, 64, TraceOptions::default(), 1, 1).0.rgb
-        })
-        .collect();
-    for (n, img) in [100, 400].iter().zip(&images[1..]) {
-        let differ = img.iter().zip(&images[0]).filter(|(a, b)| a != b).count();
-        assert_eq!(differ, 0, "raster {n} against 64: {differ} channels differ");
+    assert_same_image_at_rasters(&scene, 64, &[64, 100, 400]);
+}
+
+/// Asserts that `scene`'s exact image, `size` pixels square, is the same
+/// at every raster of `rasters` as at the first.
+#[track_caller]
+fn assert_same_image_at_rasters(scene: &Scene, size: u32, rasters: &[u32]) {
+    let image = |n: u32| {
+        let vs = voxelize_exact(scene, n);
+        draw(&vs, size, size, TraceOptions::default(), 1, 1).0.rgb
+    };
+    let first = image(rasters[0]);
+    for &n in &rasters[1..] {
+        let differ = image(n).iter().zip(&first).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differ, 0,
+            "raster {n} against {}: {differ} channels differ",
+            rasters[0]
+        );
     }
 }
 
@@ -935,16 +944,40 @@ fn the_exact_colour_does_not_depend_on_the_voxels() {
                s -0.7 -0.2 0.08 0.08\ns -0.61 -0.29 0.03 0.03\n\
                f 0.9 0.9 0.7 0.6 0.2 5 0 1\np 4\n-3 -3 0\n3 -3 0\n3 3 0\n-3 3 0\n";
     let scene = Scene::parse("colour.nff", src.as_bytes()).unwrap();
-    let images: Vec<Vec<u8>> = [12, 40, 200]
-        .into_iter()
-        .map(|n| {
-            let vs = voxelize_exact(&scene, n);
-            draw(&vs, 48, 48, TraceOptions::default(), 1, 1).0.rgb
-        })
-        .collect();
-    for (n, img) in [40, 200].iter().zip(&images[1..]) {
-        let differ = img.iter().zip(&images[0]).filter(|(a, b)| a != b).count();
-        assert_eq!(differ, 0, "raster {n} against 12: {differ} channels differ");
+    assert_same_image_at_rasters(&scene, 48, &[12, 40, 200]);
+}
+
+/// A cone flatter than a fixed-point unit (an annulus: radii 1 and 0.5,
+/// height down to 1e-100) keeps the voxels its surface passes through and
+/// is intersected as the annulus it nearly is: it renders as the cone of
+/// height 1e-6, which the quadratic still resolves, pixel for pixel.
+#[test]
+fn a_cone_flatter_than_fixed_point_renders_as_its_annulus() {
+    let image = |h: &str| {
+        let src = format!(
+            "v\nfrom 0 -6 2\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 48 48\n\
+             l 3 -4 8\nf 0.8 0.5 0.3 1 0 0 0 0\nc\n0 0 0 1\n0 0 {h} 0.5\n"
+        );
+        let scene = Scene::parse("flat.nff", src.as_bytes()).unwrap();
+        let (img, stats) = draw(
+            &voxelize_exact(&scene, 64),
+            48,
+            48,
+            TraceOptions::default(),
+            1,
+            1,
+        );
+        assert!(stats.hits > 60, "height {h}: {stats:?}");
+        img.rgb
+    };
+    let resolved = image("1e-6");
+    for h in ["1e-9", "1e-20", "1e-100"] {
+        let differ = image(h)
+            .iter()
+            .zip(&resolved)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "height {h}: {differ} channels differ");
     }
 }
 

@@ -83,12 +83,23 @@ impl Primitive for Cone {
 impl Surface for Cone {
     type Fixed = geometry::Cone;
 
-    /// Degenerate when base and apex round to the same point; radii that
-    /// both round to 0 keep 1/65536 voxel at the wider end.
+    /// A base and apex that round to the same point (a cone flatter than
+    /// a fixed-point unit: an annulus or disc) keep one unit between them
+    /// along the axis's largest component, so that the voxels the flat
+    /// surface passes through are voxelized; radii that both round to 0
+    /// keep 1/65536 voxel at the wider end.
     fn to_fixed(&self, frame: &RasterFrame) -> Result<geometry::Cone, Unfit> {
         let mut c = self.to_core(frame).ok_or(Unfit::OutOfRange)?;
         if c.base == c.apex {
-            return Err(Unfit::Degenerate);
+            let axis = (self.apex - self.base).to_array();
+            let k = (0..3)
+                .max_by(|&a, &b| axis[a].abs().total_cmp(&axis[b].abs()))
+                .unwrap_or(0);
+            let step = if axis[k] < 0.0 { -1 } else { 1 };
+            c.apex[k] += step;
+            if c.apex[k].abs() > crate::frame::MAX_FIXED {
+                return Err(Unfit::OutOfRange);
+            }
         }
         if c.base_radius == 0 && c.apex_radius == 0 {
             // Thinner than 1/65536 voxel: keep the wider end's 1.
@@ -199,6 +210,18 @@ impl Cone {
         let qa = dp.dot(dp) - k * k * dy * dy;
         let qb = op.dot(dp) - k * dy * rr;
         let qc = op.dot(op) - rr * rr;
+        if h <= FLAT * r0.max(r1) {
+            // Flatter than the quadratic can resolve (its slope `k` above
+            // 1e7): the annulus between the radii on the plane halfway up,
+            // within `h / 2` of the surface.
+            if dy == 0.0 {
+                return None;
+            }
+            let t = (0.5 * h - oy) / dy;
+            let rho = (op + dp * t).length();
+            return (t > tmin && t < tmax && (r0.min(r1)..=r0.max(r1)).contains(&rho))
+                .then_some((t, ax, k));
+        }
         let dd = d.dot(d);
         let mut roots = [f64::NAN; 2];
         if qa.abs() < 1e-12 * dd {
@@ -237,6 +260,10 @@ impl SolidPrimitive for Cone {
         Some(Box::new(self.to_core(frame)?))
     }
 }
+
+/// A cone whose height is at most this fraction of its larger radius is
+/// intersected as the flat annulus it nearly is ([`Cone::full`]).
+const FLAT: f64 = 1e-7;
 
 /// `embree_nff`'s `cone_normal`: the outward normal of the lateral surface
 /// at `p` (radial direction tilted by the slope `k`).
