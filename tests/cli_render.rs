@@ -273,6 +273,8 @@ fn absurd_sizes_are_refused_up_front() {
                     ],
                     "a 32768×512 image needs about 336.0 MiB",
                 ),
+                // An image the scene's view sizes is named by the view.
+                (&["--max-memory", "1K"], "--max-memory: the view at "),
             ],
         );
         let v = dir.join("v.rrt");
@@ -389,6 +391,63 @@ fn saved_rasters_keep_the_memory_limit_and_the_verified_image() {
         let saved = image(&[r], "saved.ppm");
         let direct = image(&[scene, "--raster", "96"], "scene.ppm");
         assert_eq!(saved, direct);
+    });
+}
+
+/// A TOML scene's own data counts against `--max-memory` before it is
+/// read or made: the samples of all its volumes together (each within the
+/// limit alone) and the vertices a Bézier tessellation would make, each
+/// refused at its key with the limit; under a limit the data fits, the
+/// scene renders.
+#[test]
+fn a_scenes_volumes_and_vertices_keep_the_memory_limit() {
+    in_temp_dir("scene-memory", |dir| {
+        let ball = "balls = [[0, 0, 0, 1, 1]]";
+        let head = "[camera]\nfrom = [0, -6, 1]\nat = [0, 0, 0]\nangle = 40\nresolution = [16, 16]\n\
+                    [material.m]\ncolour = [0.8, 0.3, 0.3]\n";
+        // Two volumes of 64³ float samples: 1 MiB each.
+        let mut volumes = head.to_string();
+        for (i, x) in [-1.5, 1.5].iter().enumerate() {
+            volumes += &format!(
+                "[volume.v{i}]\nmetaballs = {{ dims = [64, 64, 64], min = [-1.2, -1.2, -1.2], max = [1.2, 1.2, 1.2], {ball} }}\n\
+                 iso = 0.3\ntranslate = [{x}, 0, 0]\n[[object]]\nmaterial = \"m\"\nvolume = \"v{i}\"\n"
+            );
+        }
+        let v = dir.join("volumes.toml");
+        std::fs::write(&v, &volumes).unwrap();
+        let v = v.to_str().unwrap();
+        let o = dir.join("o.png");
+        let o = o.to_str().unwrap();
+        let q = ["-o", o, "-q", "--max-memory"];
+        fails_with(
+            &[&["render", v][..], &q, &["1536K"]].concat(),
+            "volumes.toml:16:22: volume.v1.metaballs.dims: computed volume: sizes 64×64×64 of float take 1.0 MiB beside the scene's other volumes' 1.0 MiB, more than the memory limit of 1.5 MiB (--max-memory)",
+        );
+        fails_with(
+            &[&["render", v][..], &q, &["512K"]].concat(),
+            "volume.v0.metaballs.dims: computed volume: sizes 64×64×64 of float take 1.0 MiB, more than the memory limit of 512.0 KiB (--max-memory)",
+        );
+        assert!(!Path::new(o).exists());
+        cli(&[&["render", v][..], &q, &["64M"]].concat()).unwrap();
+        assert!(Path::new(o).exists());
+        // One patch at 64 steps: 64² quads of 4 vertices, 48 bytes each.
+        let bpt = "1\n3 3\n".to_string()
+            + &(0..16)
+                .map(|k| format!("{} {} 0\n", f64::from(k / 4) - 1.5, f64::from(k % 4) - 1.5))
+                .collect::<String>();
+        std::fs::write(dir.join("flat.bpt"), bpt).unwrap();
+        let b = dir.join("patch.toml");
+        std::fs::write(
+            &b,
+            head.to_string()
+                + "[[object]]\nmaterial = \"m\"\nbezier = { file = \"flat.bpt\", steps = 64 }\n",
+        )
+        .unwrap();
+        let b = b.to_str().unwrap();
+        fails_with(
+            &[&["render", b][..], &q, &["512K"]].concat(),
+            "16384 vertices take 768.0 KiB, more than the memory limit of 512.0 KiB (--max-memory)",
+        );
     });
 }
 

@@ -236,8 +236,27 @@ fn a_volume_alone_gets_the_pixel_footprint_raster() {
         )
     };
     assert_eq!(size(64, 48), MIN_DEFAULT_RASTER);
-    // Larger images, finer voxels, up to the largest default.
+    // Larger images, finer voxels, up to 8 voxels per sample spacing (the
+    // box holds the 32 samples' cells along its longest axis; and the
+    // margins).
     let (a, b) = (size(512, 384), size(2048, 1536));
     assert!(MIN_DEFAULT_RASTER < a && a < b, "{a} {b}");
+    assert_eq!(size(8192, 6144), 32 * 8 + 4);
     assert!(b <= MAX_DEFAULT_RASTER);
+    // An eye inside the volume's box: a pixel's footprint there is 0, and
+    // the samples bound the raster.
+    let inside = rrt_host::scene::View {
+        from: DVec3::new(0.0, 0.0, 0.9),
+        ..scene.view.clone()
+    };
+    let r = default_raster(
+        &scene,
+        &RasterNeed {
+            view: &inside,
+            image: [64, 48],
+            samples: 1,
+            discrete: false,
+        },
+    );
+    assert_eq!(r, 32 * 8 + 4);
 }

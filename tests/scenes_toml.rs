@@ -671,6 +671,16 @@ fn a_bad_value_is_located_at_itself_with_its_key_path() {
         ),
     );
     assert_at(&msg, 4, 11, "camera.angle");
+    // A negative hither, as NFF refuses it.
+    let msg = error_of(
+        "hither",
+        &format!(
+            "[camera]\nfrom = [0, -5, 1]\nat = [0, 0, 0]\nangle = 40\nhither = -1\nresolution = [8, 8]\n[material.m]\n{}",
+            sphere("1")
+        ),
+    );
+    assert_at(&msg, 5, 10, "camera.hither");
+    assert!(msg.contains("expected a distance ≥ 0"), "{msg}");
     // A material's value.
     let msg = error_of(
         "ks",
@@ -1105,6 +1115,13 @@ fn every_bad_value_is_located_at_itself() {
             "expected a number > 0",
         ),
         (
+            "tiny scale",
+            volume("iso = 0.5\nscale = 1e-300"),
+            "1e-300\n",
+            "volume.v.scale",
+            "not finite or not invertible",
+        ),
+        (
             "raw dims",
             raw("file = \"x.raw\", dims = [0, 2, 2], type = \"u8\""),
             "[0, 2, 2]",
@@ -1402,4 +1419,28 @@ polygon = [[0, 0, 1], [4, 0, 1], [4, 3, 1], [0, 3, 1]]
     let quad = &scene.polygons[1];
     assert!(quad.cut.is_none(), "a convex polygon is its fan");
     assert_eq!(scene.polygon_triangles(quad).count(), 2);
+}
+
+/// An NFF file a TOML scene draws brings its objects, lights and
+/// materials; its view is ignored, so it need not have one (while the
+/// same file alone, as a scene, is refused for the missing view).
+#[test]
+fn an_included_nff_file_needs_no_view() {
+    let d = temp_dir("include-no-view");
+    std::fs::write(
+        d.join("part.nff"),
+        "l 1 -4 6\nf 0.9 0.2 0.1 0.8 0.2 10 0 1\ns 0 0 0 1\ns 2 0 0 0.5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("s.toml"),
+        format!("{CAMERA}[[object]]\nnff = \"part.nff\"\n"),
+    )
+    .unwrap();
+    let scene = Scene::load(d.join("s.toml")).unwrap();
+    assert_eq!(scene.spheres.len(), 2);
+    assert_eq!(scene.lights.len(), 1);
+    assert_eq!(scene.view.from, glam::DVec3::new(0.0, -5.0, 1.0));
+    let e = Scene::load(d.join("part.nff")).unwrap_err().to_string();
+    assert!(e.contains("no view"), "{e}");
 }

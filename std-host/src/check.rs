@@ -67,6 +67,7 @@ pub fn nff_input(data: &[u8]) -> Result<(), String> {
     let opts = ParseOptions {
         max_vertices: 1 << 16,
         max_file_bytes: 1 << 20,
+        view_required: true,
     };
     let Some(scene) = read_or_refused("fuzz.nff", nff::parse_bytes("fuzz.nff", data, &opts))?
     else {

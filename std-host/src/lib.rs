@@ -36,6 +36,8 @@
 //! * [`cli`]: the `rrt` command line; the binary only parses arguments.
 //! * [`world`] and [`frame`]: world-space bounds, rays and hits, and the
 //!   raster's frame, shared by the phases.
+//! * [`memory`]: the machine's memory, the default limit that scenes,
+//!   rasters and images are checked against, byte counts in messages.
 //! * `check` (feature `check`): invariant checkers shared by the tests and
 //!   the fuzz targets.
 //!
@@ -85,6 +87,7 @@ pub mod check;
 pub mod cli;
 pub mod fit;
 pub mod frame;
+pub mod memory;
 pub mod output;
 pub mod progress;
 pub mod render;

@@ -54,9 +54,9 @@ pub struct RasterArgs {
     /// World box to voxelize, `X0,Y0,Z0,X1,Y1,Z1` (default: all geometry).
     #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse_bounds, allow_hyphen_values = true)]
     pub bounds: Option<Bounds>,
-    /// Refuse rasters, and images, needing more memory than this (bytes,
-    /// or with K, M, G, T suffixes; binary units) [default: half of the
-    /// machine's RAM].
+    /// Refuse scenes, rasters and images needing more memory than this
+    /// (bytes, or with K, M, G, T suffixes; binary units) [default: half
+    /// of the machine's RAM].
     #[arg(long, value_name = "SIZE", value_parser = parse_memory)]
     pub max_memory: Option<u64>,
 }
@@ -317,11 +317,17 @@ pub fn progress(show: bool) -> ProgressBar {
 
 /// Reads an NFF or TOML scene (the built-in one for `None`): the bytes
 /// of an NFF file parsed on `bar`, a spinner while a TOML scene and the
-/// files it names are read.
+/// files it names are read; a TOML scene whose volumes and vertices
+/// would take more than `max_memory` bytes is refused before they are
+/// read.
 ///
 /// # Errors
 /// The parser's located error.
-pub fn read_scene(path: Option<&Path>, bar: &ProgressBar) -> Result<(Scene, Duration), CliError> {
+pub fn read_scene(
+    path: Option<&Path>,
+    bar: &ProgressBar,
+    max_memory: u64,
+) -> Result<(Scene, Duration), CliError> {
     let t = Instant::now();
     let scene = match path {
         Some(p)
@@ -329,11 +335,11 @@ pub fn read_scene(path: Option<&Path>, bar: &ProgressBar) -> Result<(Scene, Dura
                 .is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
         {
             crate::progress::spinner(bar, format!("reading {}", p.display()));
-            Scene::load(p)
+            Scene::load_within(p, &ProgressBar::hidden(), max_memory)
         }
         Some(p) => {
             crate::progress::phase(bar, "reading", crate::progress::Unit::Bytes, 0);
-            Scene::load_with(p, bar)
+            Scene::load_within(p, bar, max_memory)
         }
         None => Scene::parse(DEFAULT_SCENE_NAME, DEFAULT_SCENE.as_bytes()),
     };
@@ -432,7 +438,8 @@ pub fn load_or_build(
         });
     }
     let bar = progress(show_progress);
-    let (scene, parse) = match read_scene(path.map(PathBuf::as_path), &bar) {
+    let limit = raster.max_memory.unwrap_or_else(default_max_memory);
+    let (scene, parse) = match read_scene(path.map(PathBuf::as_path), &bar, limit) {
         Ok(r) => r,
         Err(e) => {
             bar.finish_and_clear();
@@ -593,7 +600,7 @@ mod tests {
 
     #[test]
     fn builtin_scene_parses() {
-        let (s, _) = read_scene(None, &ProgressBar::hidden()).unwrap();
+        let (s, _) = read_scene(None, &ProgressBar::hidden(), u64::MAX).unwrap();
         assert_eq!(s.spheres.len(), 91);
         assert_eq!(&*s.file, DEFAULT_SCENE_NAME);
     }

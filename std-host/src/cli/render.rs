@@ -163,7 +163,9 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
                 }
                 None => h,
             };
-            check_image_memory(w, rows, args.bits, format, &args.raster)?;
+            // Named by what set the size: the arguments, or the scene.
+            let sized_by = (args.width.is_none() || args.height.is_none()).then_some(&view.loc);
+            check_image_memory(w, rows, args.bits, format, &args.raster, sized_by)?;
             Ok((Camera::new(&view, w, h)?, view, w, h))
         };
     // The raster is fitted to the base view (the scene's with the
@@ -285,13 +287,15 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
 /// Refuses an image of `width` × `rows` pixels whose memory (the
 /// rendered image, [`image_bytes`], and its encoding in `format`:
 /// `bits`-bit codes, or OpenEXR's, made whole in memory) is more than
-/// `--max-memory` allows.
+/// `--max-memory` allows; named by the scene's view at `sized_by` when
+/// the scene's resolution set the size, by `--width/--height` otherwise.
 fn check_image_memory(
     width: u32,
     rows: u32,
     bits: u8,
     format: Format,
     raster: &RasterArgs,
+    sized_by: Option<&crate::scene::SourceLoc>,
 ) -> Result<(), CliError> {
     let limit = raster.max_memory.unwrap_or_else(default_max_memory);
     let pixels = u64::from(width) * u64::from(rows);
@@ -306,13 +310,20 @@ fn check_image_memory(
     };
     let needed = image_bytes(width, rows, false).saturating_add(codes);
     if needed > limit {
-        return Err(CliError::Arg {
-            arg: "--width/--height",
-            message: format!(
-                "a {width}×{rows} image needs about {}, more than the memory limit of {} (--max-memory)",
-                Bytes(needed),
-                Bytes(limit)
-            ),
+        let (needed, limit) = (Bytes(needed), Bytes(limit));
+        return Err(match sized_by {
+            Some(loc) => CliError::Arg {
+                arg: "--max-memory",
+                message: format!(
+                    "the view at {loc} asks for a {width}×{rows} image, which needs about {needed}, more than the limit of {limit}; give --width and --height"
+                ),
+            },
+            None => CliError::Arg {
+                arg: "--width/--height",
+                message: format!(
+                    "a {width}×{rows} image needs about {needed}, more than the memory limit of {limit} (--max-memory)"
+                ),
+            },
         });
     }
     Ok(())

@@ -4,6 +4,8 @@
 use std::f64::consts::PI;
 use std::fmt;
 
+use crate::memory::Bytes;
+
 use rrt_core::raster::LINE_CELLS;
 use rrt_core::store;
 use rrt_core::voxel::VoxelRecord;
@@ -42,29 +44,6 @@ impl fmt::Display for Dims {
     }
 }
 
-/// A byte count printed with a binary unit (`1.5 GiB`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Bytes(pub u64);
-
-impl fmt::Display for Bytes {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        const UNITS: [&str; 5] = ["KiB", "MiB", "GiB", "TiB", "PiB"];
-        if self.0 < 1024 {
-            return write!(f, "{} B", self.0);
-        }
-        let mut v = self.0 as f64 / 1024.0;
-        let mut unit = UNITS[0];
-        for u in &UNITS[1..] {
-            if v < 1024.0 {
-                break;
-            }
-            v /= 1024.0;
-            unit = u;
-        }
-        write!(f, "{v:.1} {unit}")
-    }
-}
-
 /// An upper-bound estimate of a voxelized raster's memory.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MemoryEstimate {
@@ -87,6 +66,9 @@ pub struct MemoryEstimate {
     pub objects: u64,
     /// Their entries: [`OBJECT_BYTES`] each.
     pub object_table: u64,
+    /// The scene's own data, already in memory: its volumes' samples and
+    /// its vertices ([`Scene::data_bytes`]).
+    pub scene: u64,
 }
 
 impl MemoryEstimate {
@@ -98,6 +80,7 @@ impl MemoryEstimate {
             .saturating_add(self.directory)
             .saturating_add(self.records)
             .saturating_add(self.object_table)
+            .saturating_add(self.scene)
     }
 }
 
@@ -105,14 +88,19 @@ impl fmt::Display for MemoryEstimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "plane {}, line level {}, brick directory and level {}, records for up to {} voxels {}, object table of {} objects {}",
+            "plane {}, line level {}, brick directory and level {}, records for up to {} voxels {}, object table of {} objects {}{}",
             Bytes(self.plane),
             Bytes(self.lines),
             Bytes(self.directory),
             self.record_voxels,
             Bytes(self.records),
             self.objects,
-            Bytes(self.object_table)
+            Bytes(self.object_table),
+            if self.scene > 0 {
+                format!(", the scene's volumes and vertices {}", Bytes(self.scene))
+            } else {
+                String::new()
+            }
         )
     }
 }
@@ -193,6 +181,8 @@ impl SurfaceMeasure {
 /// objects; solid spheres add their volume, `4/3·π·(r + 1)³`. The count is
 /// capped at the raster's voxel count, and each such voxel costs a 20-byte
 /// record.
+/// The scene's own data ([`Scene::data_bytes`]), already in memory, is
+/// counted with them.
 #[must_use]
 pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) -> MemoryEstimate {
     let [nx, ny, nz] = frame.dims().map(u64::from);
@@ -222,5 +212,6 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
         records: record_voxels.saturating_mul(RECORD_BYTES),
         objects: measure.objects as u64,
         object_table: (measure.objects as u64).saturating_mul(OBJECT_BYTES),
+        scene: scene.data_bytes(),
     }
 }

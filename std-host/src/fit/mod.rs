@@ -16,15 +16,15 @@
 //! raster). [`RasterFrame`] keeps the mapping both ways.
 //!
 //! * [`size`]: the raster's frame for a scene ([`frame`]);
-//! * [`memory`]: the memory estimate ([`estimate_memory`]);
-//! * [`meminfo`]: the machine's memory and the default limit.
+//! * [`memory`]: the memory estimate ([`estimate_memory`]), which counts
+//!   the scene's own data too; the machine's memory and the default limit
+//!   are in [`crate::memory`].
 //!
 //! Before anything is allocated, [`MemoryEstimate`] bounds what the
 //! voxelized raster will take, and [`fit`] refuses a raster that would
 //! exceed the caller's limit ([`default_max_memory`]: half the machine's
 //! RAM).
 
-pub mod meminfo;
 pub mod memory;
 pub mod size;
 
@@ -36,10 +36,12 @@ use rrt_core::geometry::Point;
 use rrt_core::object_table as table;
 use rrt_core::raster::MAX_AXIS;
 
-pub use self::meminfo::{default_max_memory, parse_meminfo, total_memory};
-pub use self::memory::{Bytes, Dims, MemoryEstimate, SurfaceMeasure, estimate_memory};
+pub use self::memory::{Dims, MemoryEstimate, SurfaceMeasure, estimate_memory};
 pub use self::size::{DEFAULT_MARGIN, frame};
-pub use self::size::{MAX_DEFAULT_RASTER, MIN_DEFAULT_RASTER, RasterNeed, default_raster};
+pub use self::size::{
+    MAX_DEFAULT_RASTER, MIN_DEFAULT_RASTER, RasterNeed, VOXELS_PER_SAMPLE, default_raster,
+};
+pub use crate::memory::{Bytes, default_max_memory, parse_meminfo, total_memory};
 
 use crate::frame::{MAX_FIXED_VOXEL_BITS, RasterFrame};
 use crate::scene::{Object, Scene, SourceLoc};
@@ -266,7 +268,7 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
             continue;
         }
         for t in scene.polygon_triangles(p) {
-            table.add(t, p.material, "polygon", &p.loc)?;
+            table.add(t, p.material, p.kind(), &p.loc)?;
         }
     }
     table.add_all(&scene.tori)?;
@@ -324,7 +326,7 @@ fn beyond_world(scene: &Scene) -> Result<(), FitError> {
     {
         return Err(FitError::BeyondWorld {
             loc: p.loc.clone(),
-            what: "polygon",
+            what: p.kind(),
         });
     }
     first(&scene.tori)

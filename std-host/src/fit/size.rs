@@ -118,6 +118,10 @@ pub struct RasterNeed<'v> {
     pub discrete: bool,
 }
 
+/// Most voxels per sample spacing the default raster gives a scene whose
+/// only voxel objects are sampled volumes' iso-surfaces.
+pub const VOXELS_PER_SAMPLE: f64 = 8.0;
+
 /// The raster size (voxels along the scene's longest axis) used when none
 /// is given: fitted to the scene and the image, between
 /// [`MIN_DEFAULT_RASTER`] and [`MAX_DEFAULT_RASTER`].
@@ -134,7 +138,9 @@ pub struct RasterNeed<'v> {
 /// models, CSG only) starts from [`MIN_DEFAULT_RASTER`]. Where voxels are the picture (the paper's mode;
 /// volumes, `.vox` models and CSG results, which have no exact geometry),
 /// a voxel is in addition no larger than a pixel's footprint at the
-/// scene's nearest point to the eye. With volumes rendered directly, a
+/// scene's nearest point to the eye, but for that no smaller than
+/// 1/[`VOXELS_PER_SAMPLE`] of the finest sample spacing where sampled
+/// volumes are the only such objects. With volumes rendered directly, a
 /// voxel is no smaller than their finest sample spacing.
 #[must_use]
 pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
@@ -182,7 +188,25 @@ pub fn default_raster(scene: &Scene, need: &RasterNeed<'_>) -> u32 {
     let voxel_objects =
         !(scene.volumes.is_empty() && scene.voxes.is_empty() && scene.csgs.is_empty());
     if need.discrete || voxel_objects {
-        r = r.max(pixel_raster(&bounds, longest, need));
+        let mut pixel = pixel_raster(&bounds, longest, need);
+        // Iso-surfaces of sampled volumes, the only voxel objects: voxels
+        // finer than VOXELS_PER_SAMPLE a sample spacing add records, not
+        // detail (an eye inside the scene's box asks for the largest
+        // raster however coarse the data).
+        if !need.discrete && scene.voxes.is_empty() && scene.csgs.is_empty() {
+            let spacing = scene
+                .volumes
+                .iter()
+                .map(|v| v.data.sample_spacing())
+                .fold(f64::INFINITY, f64::min);
+            let finest =
+                (longest / spacing * VOXELS_PER_SAMPLE).ceil() + f64::from(2 * DEFAULT_MARGIN);
+            if finest.is_finite() && finest < f64::from(pixel) {
+                // Below pixel ≤ 2^16.
+                pixel = finest as u32;
+            }
+        }
+        r = r.max(pixel);
     }
     // Volumes rendered directly are pictures of their samples: voxels
     // finer than the finest sample spacing add records, not detail.

@@ -5,8 +5,8 @@ use super::*;
 use rrt_core::fixed::VOXEL;
 use rrt_core::geometry::NORMAL_ONE;
 
-use super::meminfo::FALLBACK_TOTAL_MEMORY;
 use super::memory::OBJECT_BYTES;
+use crate::memory::FALLBACK_TOTAL_MEMORY;
 use crate::shape::{Sphere, Triangle};
 use crate::world::Ray;
 
@@ -248,8 +248,11 @@ fn memory_estimate_and_refusal() {
 
     // The object table: the two triangles.
     assert_eq!((m.objects, m.object_table), (2, 2 * OBJECT_BYTES));
-    // 43264 + 676 + 765 + 19240·20 = 429505 bytes, and the objects.
-    assert_eq!(m.total(), 429_505 + 2 * OBJECT_BYTES);
+    // The scene's own data: the square's four vertices.
+    assert_eq!(m.scene, 4 * crate::scene::toml::VERTEX_BYTES);
+    // 43264 + 676 + 765 + 19240·20 = 429505 bytes, the objects and the
+    // scene's data.
+    assert_eq!(m.total(), 429_505 + 2 * OBJECT_BYTES + m.scene);
     let e = fit(
         &s,
         &FitOptions {
@@ -263,8 +266,8 @@ fn memory_estimate_and_refusal() {
         format!(
             "raster 104×104×4: needs about {} (plane 42.2 KiB, line level 676 B, brick \
              directory and level 765 B, records for up to 19240 voxels 375.8 KiB, object table \
-             of 2 objects {}), more than the limit of 256.0 KiB; use a smaller raster or a \
-             larger memory limit",
+             of 2 objects {}, the scene's volumes and vertices 192 B), more than the limit of \
+             256.0 KiB; use a smaller raster or a larger memory limit",
             Bytes(m.total()),
             Bytes(2 * OBJECT_BYTES)
         )

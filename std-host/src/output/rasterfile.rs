@@ -1398,16 +1398,21 @@ fn read_meta(bytes: &[u8], path: &Path, h: &Header) -> Result<Meta, RasterFileEr
     };
     Extent::new(dims[0], dims[1], dims[2]).map_err(|e| invalid(e.to_string()))?;
     // The far corner finite and apart from the origin on every axis: the
-    // voxels have a size in world coordinates.
+    // voxels have a size in world coordinates. A fit makes frames of
+    // geometry within the world's limit, grown by its margin of at most
+    // DEFAULT_MARGIN voxels of at most the world's width a side.
     let far = origin + DVec3::from(dims.map(f64::from)) * voxel_size;
+    let reach = WORLD_LIMIT * f64::from(1 + 2 * crate::fit::DEFAULT_MARGIN);
     if !(origin.is_finite()
         && voxel_size.is_normal()
         && voxel_size > 0.0
         && far.is_finite()
-        && (far - origin).min_element() > 0.0)
+        && (far - origin).min_element() > 0.0
+        && origin.abs().max_element() <= reach
+        && far.abs().max_element() <= reach)
     {
         return Err(invalid(format!(
-            "world frame (origin ({:e}, {:e}, {:e}), voxel size {voxel_size:e}) is not a finite box of voxels",
+            "world frame (origin ({:e}, {:e}, {:e}), voxel size {voxel_size:e}) is not a finite box of voxels within ±{reach:e} world units",
             origin.x, origin.y, origin.z
         )));
     }
@@ -2363,6 +2368,28 @@ mod tests {
             .to_string();
         assert!(e.starts_with("t.rrt: the raster needs"), "{e}");
         assert!(e.contains("more than the limit of 1000 B"), "{e}");
+    }
+
+    /// A frame far beyond any a fit makes of geometry within the world's
+    /// limit (a voxel size written over) is refused, not rendered empty.
+    #[test]
+    fn a_frame_beyond_the_world_limit_is_refused() {
+        let mut s = built(BuildOptions::new(24));
+        let good = save_bytes(&s, Path::new("t.rrt")).unwrap();
+        assert!(load_bytes(Path::new("t.rrt"), &good).is_ok());
+        // 24 voxels of 5e59 reach 1.2e61.
+        for size in [5e59, 1e300] {
+            s.frame.voxel_size = size;
+            let bytes = save_bytes(&s, Path::new("t.rrt")).unwrap();
+            let Err(e) = load_bytes(Path::new("t.rrt"), &bytes).map(drop) else {
+                panic!("voxel size {size:e} loaded");
+            };
+            let e = e.to_string();
+            assert!(
+                e.contains("is not a finite box of voxels within ±5e60 world units"),
+                "{size:e}: {e}"
+            );
+        }
     }
 
     #[test]

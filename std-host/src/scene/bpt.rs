@@ -14,7 +14,8 @@
 //! Numbers are separated by any white space (one point per line is
 //! customary, not required); `#` starts a comment to the end of the line;
 //! a UTF-8 byte-order mark at the start is skipped.
-//! Every number must be finite; the file must hold exactly the announced
+//! Every number must be finite and within ±1e60 (the world's limit,
+//! [`WORLD_LIMIT`](crate::world::WORLD_LIMIT)); the file must hold exactly the announced
 //! patches. Errors name the file, line and column of the offending token.
 //!
 //! ```
@@ -180,7 +181,10 @@ pub fn parse(file: &str, text: &str) -> Result<Vec<Control>, SceneError> {
                 for c in &mut xyz {
                     let tok = t.next();
                     match tok.and_then(|(s, _, _)| s.parse::<f64>().ok()) {
-                        Some(v) if v.is_finite() => *c = v,
+                        Some(v) if v.abs() <= crate::world::WORLD_LIMIT => *c = v,
+                        Some(v) if v.is_finite() => {
+                            return Err(bad(&t, tok, "control point", "a number within ±1e60"));
+                        }
                         _ => {
                             return Err(bad(&t, tok, "control point", "a finite number"));
                         }
@@ -242,6 +246,13 @@ mod tests {
         assert_eq!(
             e,
             "t.bpt:18:3: control point: expected a finite number, found \"nan\""
+        );
+        let e = parse("t.bpt", &(text.clone() + "1 -2e60 0\n"))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "t.bpt:18:3: control point: expected a number within ±1e60, found \"-2e60\""
         );
         let e = parse("t.bpt", &(text.clone() + "1 2\n"))
             .unwrap_err()

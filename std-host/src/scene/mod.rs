@@ -251,6 +251,18 @@ pub struct Polygon {
 }
 
 impl Polygon {
+    /// What the polygon is called in messages: `polygonal patch` for a
+    /// patch with vertex normals (NFF `pp`, a tessellated Bézier patch,
+    /// a smooth mesh's face), `polygon` otherwise.
+    #[must_use]
+    pub const fn kind(&self) -> &'static str {
+        if self.patch {
+            "polygonal patch"
+        } else {
+            "polygon"
+        }
+    }
+
     /// The vertex index range.
     #[must_use]
     pub fn range(&self) -> std::ops::Range<usize> {
@@ -373,6 +385,21 @@ impl Scene {
         path: impl AsRef<std::path::Path>,
         progress: &indicatif::ProgressBar,
     ) -> Result<Self, SceneError> {
+        Self::load_within(path, progress, crate::memory::default_max_memory())
+    }
+
+    /// [`Scene::load_with`], refusing a TOML scene whose own data (its
+    /// volumes' samples and its vertices, [`toml::Options::max_memory`])
+    /// would take more than `max_memory` bytes, before they are read or
+    /// made.
+    ///
+    /// # Errors
+    /// As [`Scene::load`].
+    pub fn load_within(
+        path: impl AsRef<std::path::Path>,
+        progress: &indicatif::ProgressBar,
+        max_memory: u64,
+    ) -> Result<Self, SceneError> {
         let path = path.as_ref();
         let name = path
             .file_name()
@@ -388,7 +415,13 @@ impl Scene {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
         {
-            toml::load(path, &toml::Options::default())
+            toml::load(
+                path,
+                &toml::Options {
+                    max_memory,
+                    ..toml::Options::default()
+                },
+            )
         } else {
             nff::load_with(path, &ParseOptions::default(), progress)
         }
@@ -400,6 +433,30 @@ impl Scene {
     /// As [`Scene::load`], less the file-system errors.
     pub fn parse(file: &str, bytes: &[u8]) -> Result<Self, SceneError> {
         nff::parse_bytes(file, bytes, &ParseOptions::default())
+    }
+
+    /// Bytes the scene's own data takes: the samples of its volumes (each
+    /// counted once, however many objects and CSG leaves share it) and
+    /// [`toml::VERTEX_BYTES`] per polygon vertex.
+    #[must_use]
+    pub fn data_bytes(&self) -> u64 {
+        let mut seen = std::collections::HashSet::new();
+        let leaves = self
+            .csgs
+            .iter()
+            .flat_map(|c| &c.leaves)
+            .filter_map(|l| match &l.shape {
+                Solid::Volume(v) => Some(v),
+                _ => None,
+            });
+        let mut bytes = (self.vertices.len() as u64).saturating_mul(toml::VERTEX_BYTES);
+        for v in self.volumes.iter().map(|o| &o.data).chain(leaves) {
+            if seen.insert(Arc::as_ptr(&v.volume)) {
+                let n = v.volume.samples().len() as u64;
+                bytes = bytes.saturating_add(n.saturating_mul(v.volume.sample_type().size()));
+            }
+        }
+        bytes
     }
 
     /// The vertices of `polygon` (empty if its range is out of bounds,

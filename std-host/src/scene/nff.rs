@@ -84,6 +84,10 @@ pub struct ParseOptions {
     pub max_vertices: u64,
     /// Largest file [`load`] reads, in bytes.
     pub max_file_bytes: u64,
+    /// Whether a file without a view (`v` block) is refused. A scene
+    /// read without one (a TOML scene's `nff = "x.nff"`, whose view is
+    /// ignored) gets a placeholder view looking down −z from `(0, 0, 1)`.
+    pub view_required: bool,
 }
 
 impl ParseOptions {
@@ -98,6 +102,7 @@ impl Default for ParseOptions {
         Self {
             max_vertices: Self::DEFAULT_MAX_VERTICES,
             max_file_bytes: Self::DEFAULT_MAX_FILE_BYTES,
+            view_required: true,
         }
     }
 }
@@ -481,8 +486,18 @@ impl<'a> Parser<'a> {
         if !self.any {
             return Err(SceneError::Empty { file: self.file });
         }
-        let Some(view) = self.view else {
-            return Err(SceneError::MissingView { file: self.file });
+        let view = match self.view {
+            Some(view) => view,
+            None if !self.opts.view_required => View {
+                from: DVec3::Z,
+                at: DVec3::ZERO,
+                up: DVec3::Y,
+                angle: 45.0,
+                hither: 0.0,
+                resolution: [1, 1],
+                loc: SourceLoc::new(Arc::clone(&self.file), 1, 1),
+            },
+            None => return Err(SceneError::MissingView { file: self.file }),
         };
         let mut b = self.scene;
         if b.spheres.is_empty() && b.cones.is_empty() && b.polygons.is_empty() {

@@ -30,6 +30,8 @@ pub(super) struct Builder<'t> {
     pub(super) opts: Options,
     pub(super) materials: BTreeMap<String, usize>,
     pub(super) volumes: BTreeMap<String, SceneVolume>,
+    /// Bytes the samples of the volumes read so far take.
+    pub(super) volume_bytes: Cell<u64>,
 }
 
 /// The vector, if its numbers are finite and within
@@ -126,8 +128,8 @@ impl Builder<'_> {
         if !(view.angle > 0.0 && view.angle < 180.0) {
             return Err(self.err(cs, "camera.angle", "expected 0 < angle < 180"));
         }
-        if !view.hither.is_finite() {
-            return Err(self.err(cs, "camera.hither", "expected a finite number"));
+        if !(view.hither.is_finite() && view.hither >= 0.0) {
+            return Err(self.err(cs, "camera.hither", "expected a distance ≥ 0"));
         }
         if view.resolution.contains(&0) || view.resolution.iter().any(|&r| r > 1 << 15) {
             return Err(self.err(cs, "camera.resolution", "expected 1 to 32768 pixels"));
@@ -219,6 +221,54 @@ impl Builder<'_> {
         })
     }
 
+    /// Refuses `more` vertices beside those `scene` holds when they pass
+    /// [`Options::max_vertices`](super::Options::max_vertices), or when
+    /// they and the volumes' samples would take more than
+    /// [`Options::max_memory`](super::Options::max_memory); checked before
+    /// they are made.
+    pub(super) fn room_for_vertices(
+        &self,
+        scene: &Scene,
+        more: usize,
+        span: &std::ops::Range<usize>,
+        key: &str,
+    ) -> Result<(), SceneError> {
+        let total = scene.vertices.len().saturating_add(more);
+        if total > self.opts.max_vertices {
+            return Err(self.err(
+                span.clone(),
+                key,
+                format!(
+                    "{total} vertices, more than the scene's limit of {}",
+                    self.opts.max_vertices
+                ),
+            ));
+        }
+        let bytes = (total as u64)
+            .saturating_mul(super::VERTEX_BYTES)
+            .saturating_add(self.volume_bytes.get());
+        if bytes > self.opts.max_memory {
+            return Err(self.err(
+                span.clone(),
+                key,
+                format!(
+                    "{total} vertices take {}{}, more than the memory limit of {} (--max-memory)",
+                    crate::memory::Bytes(bytes - self.volume_bytes.get()),
+                    if self.volume_bytes.get() > 0 {
+                        format!(
+                            " beside the volumes' {}",
+                            crate::memory::Bytes(self.volume_bytes.get())
+                        )
+                    } else {
+                        String::new()
+                    },
+                    crate::memory::Bytes(self.opts.max_memory)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     pub(super) fn push_polygon(
         &self,
         scene: &mut Scene,
@@ -228,13 +278,7 @@ impl Builder<'_> {
         loc: &SourceLoc,
         span: &std::ops::Range<usize>,
     ) -> Result<(), SceneError> {
-        if scene.vertices.len().saturating_add(vertices.len()) > self.opts.max_vertices {
-            return Err(self.err(
-                span.clone(),
-                "object",
-                format!("more than {} vertices in the scene", self.opts.max_vertices),
-            ));
-        }
+        self.room_for_vertices(scene, vertices.len(), span, "object")?;
         let cut = super::super::polygon::cut(vertices)
             .map_err(|problem| self.err(span.clone(), "object", problem))?;
         let first = scene.vertices.len();

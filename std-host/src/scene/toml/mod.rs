@@ -88,7 +88,15 @@ pub struct Options {
     pub max_patch_steps: u32,
     /// Whether files may be read at all (the fuzz target parses without).
     pub read_files: bool,
+    /// Most bytes the scene's own data may take together: the samples of
+    /// all its volumes and [`VERTEX_BYTES`] per polygon vertex (the memory
+    /// limit `--max-memory` sets; half the machine's memory by default).
+    pub max_memory: u64,
 }
+
+/// Bytes a polygon vertex takes in a [`Scene`]: its position and its
+/// normal.
+pub const VERTEX_BYTES: u64 = 2 * std::mem::size_of::<glam::DVec3>() as u64;
 
 impl Default for Options {
     fn default() -> Self {
@@ -98,6 +106,7 @@ impl Default for Options {
             max_vertices: 1 << 26,
             max_patch_steps: 64,
             read_files: true,
+            max_memory: crate::memory::default_max_memory(),
         }
     }
 }
@@ -153,6 +162,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene
         opts: *opts,
         materials: BTreeMap::new(),
         volumes: BTreeMap::new(),
+        volume_bytes: std::cell::Cell::new(0),
     }
     .build(&doc)
 }

@@ -211,14 +211,23 @@ impl Builder<'_> {
         let (path, shown) = self.path(&b.file, "object.bezier.file")?;
         let patches = bpt::load(&path, &shown)
             .map_err(|e| self.err(b.file.span(), "object.bezier.file", with_causes(&e)))?;
-        let per = (b.steps as usize + 1).pow(2);
-        if patches
-            .len()
-            .saturating_mul(per)
-            .saturating_add(scene.vertices.len())
-            > self.opts.max_vertices
+        // Each patch is steps² quads of 4 vertices.
+        let quads = patches.len().saturating_mul((b.steps as usize).pow(2));
+        let vertices = quads.saturating_mul(4);
+        self.room_for_vertices(scene, vertices, s, "object.bezier")?;
+        // Made fallibly: an allocation the machine refuses is an error.
+        if scene.vertices.try_reserve(vertices).is_err()
+            || scene.normals.try_reserve(vertices).is_err()
+            || scene.polygons.try_reserve(quads).is_err()
         {
-            return Err(self.err(s.clone(), "object.bezier", "too many vertices"));
+            return Err(self.err(
+                s.clone(),
+                "object.bezier",
+                format!(
+                    "cannot allocate {} for the {vertices} vertices of {quads} quads",
+                    crate::memory::Bytes((vertices as u64).saturating_mul(super::VERTEX_BYTES))
+                ),
+            ));
         }
         for p in &patches {
             let c = p.map(|row| row.map(|q| at.transform.transform_point3(q)));
@@ -237,15 +246,12 @@ impl Builder<'_> {
         let (path, shown) = self.path(&m.file, "object.mesh.file")?;
         let mesh = obj::load(&path, &shown)
             .map_err(|e| self.err(m.file.span(), "object.mesh.file", with_causes(&e)))?;
-        if mesh
-            .triangles
-            .len()
-            .saturating_mul(3)
-            .saturating_add(scene.vertices.len())
-            > self.opts.max_vertices
-        {
-            return Err(self.err(s.clone(), "object.mesh", "too many vertices"));
-        }
+        self.room_for_vertices(
+            scene,
+            mesh.triangles.len().saturating_mul(3),
+            s,
+            "object.mesh",
+        )?;
         let normals = if m.smooth {
             Some(
                 mesh.normals
@@ -359,7 +365,12 @@ impl Builder<'_> {
                 format!("{shown}: {what}, not an NFF scene: draw it with {how}"),
             ));
         }
-        let inc = nff::load(&path, &nff::ParseOptions::default())
+        // Its view is ignored: it need not have one.
+        let opts = nff::ParseOptions {
+            view_required: false,
+            ..nff::ParseOptions::default()
+        };
+        let inc = nff::load(&path, &opts)
             .map_err(|e| self.err(n.span(), "object.nff", with_causes(&e)))?;
         self.include(scene, inc, s)
     }
@@ -370,9 +381,7 @@ impl Builder<'_> {
         inc: Scene,
         s: &std::ops::Range<usize>,
     ) -> Result<(), SceneError> {
-        if scene.vertices.len().saturating_add(inc.vertices.len()) > self.opts.max_vertices {
-            return Err(self.err(s.clone(), "object.nff", "too many vertices"));
-        }
+        self.room_for_vertices(scene, inc.vertices.len(), s, "object.nff")?;
         let m0 = scene.materials.len();
         let v0 = scene.vertices.len();
         scene.materials.extend(inc.materials);

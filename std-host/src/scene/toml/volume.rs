@@ -10,7 +10,7 @@ use glam::DVec3;
 
 use super::build::Builder;
 use super::schema::{Exact, VolumeDef};
-use crate::assets::volume::computed::{self, Metaball, Metaballs};
+use crate::assets::volume::computed::{Metaball, Metaballs};
 use crate::assets::volume::raw::{self, RawSpec};
 use crate::assets::volume::{self, Classifier, Endian, Grid, Placement, SampleType, Volume};
 use crate::scene::error::{SceneError, with_causes};
@@ -28,6 +28,9 @@ impl Builder<'_> {
         let given = [d.file.is_some(), d.raw.is_some(), d.metaballs.is_some()];
         self.exactly_one(&given, &s, &key("file"), "file (NRRD), raw, metaballs")?;
         let data = self.volume_data(d, &s, &key)?;
+        let bytes = data.samples().len() as u64 * data.sample_type().size();
+        self.volume_bytes
+            .set(self.volume_bytes.get().saturating_add(bytes));
         let classifier = self.classifier(d, &s, &key)?;
         let placement = self.placement(d, &data, &s, &key)?;
         Ok(SceneVolume {
@@ -45,10 +48,47 @@ impl Builder<'_> {
         key: &dyn Fn(&str) -> String,
     ) -> Result<Volume, SceneError> {
         let s = s.clone();
+        // What the volumes read before leave of the memory limit.
+        let left = self.opts.max_memory.saturating_sub(self.volume_bytes.get());
+        let limits = volume::Limits {
+            max_bytes: self.opts.volume.max_bytes.min(left),
+            ..self.opts.volume
+        };
+        let limits = &limits;
+        // Beyond what the memory limit leaves, the reader's refusal is
+        // said against that limit.
+        let over = |e: volume::VolumeError| -> String {
+            match &e {
+                volume::VolumeError::TooLarge {
+                    path,
+                    at,
+                    dims,
+                    ty,
+                    bytes,
+                    ..
+                } if left < self.opts.volume.max_bytes => {
+                    let held = self.volume_bytes.get();
+                    format!(
+                        "{}{at}: sizes {dims} of {ty} take {}{}, more than the memory limit of {} (--max-memory)",
+                        path.display(),
+                        crate::memory::Bytes(*bytes),
+                        if held > 0 {
+                            format!(
+                                " beside the scene's other volumes' {}",
+                                crate::memory::Bytes(held)
+                            )
+                        } else {
+                            String::new()
+                        },
+                        crate::memory::Bytes(self.opts.max_memory)
+                    )
+                }
+                _ => with_causes(&e),
+            }
+        };
         if let Some(f) = &d.file {
             let (path, _) = self.path(f, &key("file"))?;
-            volume::nrrd::read(&path, &self.opts.volume)
-                .map_err(|e| self.err(f.span(), &key("file"), with_causes(&e)))
+            volume::nrrd::read(&path, limits).map_err(|e| self.err(f.span(), &key("file"), over(e)))
         } else if let Some(r) = &d.raw {
             let sample_type = match r.sample_type.as_str() {
                 "uint8" | "u8" => SampleType::U8,
@@ -98,8 +138,8 @@ impl Builder<'_> {
                 grid: Grid::axis_aligned(r.spacing.0, DVec3::ZERO),
                 skip: r.skip,
             };
-            raw::read(&path, &spec, &self.opts.volume)
-                .map_err(|e| self.err(r.file.span(), &key("raw.file"), with_causes(&e)))
+            raw::read(&path, &spec, limits)
+                .map_err(|e| self.err(r.file.span(), &key("raw.file"), over(e)))
         } else if let Some(m) = &d.metaballs {
             let lo = self.vec3(&s, &key("metaballs.min"), m.min)?;
             let hi = self.vec3(&s, &key("metaballs.max"), m.max)?;
@@ -131,13 +171,9 @@ impl Builder<'_> {
                     strength: b[4],
                 });
             }
-            computed::sample(
-                &Metaballs(balls),
-                m.dims.0,
-                Grid::axis_aligned(spacing, lo),
-                &self.opts.volume,
-            )
-            .map_err(|e| self.err(s.clone(), &key("metaballs.dims"), e.to_string()))
+            Metaballs(balls)
+                .sample(m.dims.0, Grid::axis_aligned(spacing, lo), limits)
+                .map_err(|e| self.err(s.clone(), &key("metaballs.dims"), over(e)))
         } else {
             Err(self.err(s.clone(), &key("file"), "no data"))
         }
@@ -186,8 +222,15 @@ impl Builder<'_> {
                 if !(scale.is_finite() && scale > 0.0) {
                     return Err(self.err(s, &key("scale"), "expected a number > 0"));
                 }
+                // Named by the key that breaks it: the scale alone, else the
+                // translation.
+                let culprit = if Placement::new(glam::DVec3::ZERO, scale).is_err() {
+                    "scale"
+                } else {
+                    "translate"
+                };
                 Placement::new(translate, scale)
-                    .map_err(|e| self.err(s.clone(), &key("translate"), e.to_string()))
+                    .map_err(|e| self.err(s.clone(), &key(culprit), e.to_string()))
             }
             _ => Err(self.err(s, &key("fit"), "give fit, or translate and scale, not both")),
         }

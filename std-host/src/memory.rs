@@ -1,4 +1,6 @@
-//! The machine's memory (`/proc/meminfo`) and the default memory limit.
+//! The machine's memory (`/proc/meminfo`), the default memory limit that
+//! scenes, rasters and images are checked against, and byte counts as
+//! messages print them.
 
 /// Machine memory assumed when `/proc/meminfo` cannot be read.
 pub const FALLBACK_TOTAL_MEMORY: u64 = 8 << 30;
@@ -35,4 +37,33 @@ pub fn total_memory() -> Option<u64> {
 #[must_use]
 pub fn default_max_memory() -> u64 {
     total_memory().unwrap_or(FALLBACK_TOTAL_MEMORY) / 2
+}
+
+/// A byte count printed with a binary unit (`1.5 GiB`).
+///
+/// ```
+/// use rrt_host::memory::Bytes;
+/// assert_eq!(Bytes(1536 << 20).to_string(), "1.5 GiB");
+/// assert_eq!(Bytes(100).to_string(), "100 B");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bytes(pub u64);
+
+impl std::fmt::Display for Bytes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        const UNITS: [&str; 5] = ["KiB", "MiB", "GiB", "TiB", "PiB"];
+        if self.0 < 1024 {
+            return write!(f, "{} B", self.0);
+        }
+        let mut v = self.0 as f64 / 1024.0;
+        let mut unit = UNITS[0];
+        for u in &UNITS[1..] {
+            if v < 1024.0 {
+                break;
+            }
+            v /= 1024.0;
+            unit = u;
+        }
+        write!(f, "{v:.1} {unit}")
+    }
 }
