@@ -633,6 +633,25 @@ fn damaged_raster_files_are_refused() {
 
     let e = cli(&["info", dir.join("missing.rrt").to_str().unwrap()]).unwrap_err();
     assert!(e.contains("missing.rrt: cannot open"), "{e}");
+    let folder = dir.join("folder.rrt");
+    std::fs::create_dir(&folder).unwrap();
+    let e = cli(&["info", folder.to_str().unwrap()]).unwrap_err();
+    assert!(e.contains("folder.rrt: cannot read: a directory"), "{e}");
+    // A raster through a pipe is read once, in full, and checked.
+    let fifo = dir.join("pipe.rrt");
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        let (f, bytes) = (fifo.clone(), sparse.clone());
+        let writer = std::thread::spawn(move || std::fs::write(f, bytes));
+        let out = cli(&["info", "--check", fifo.to_str().unwrap()]).unwrap();
+        writer.join().unwrap().unwrap();
+        assert!(out.contains("the raster loads"), "{out}");
+    } else {
+        eprintln!("mkfifo is not available: the pipe is not checked");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

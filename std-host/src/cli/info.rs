@@ -31,15 +31,15 @@ pub struct InfoArgs {
 /// [`CliError`] for a file that is not a valid raster or whose checksums
 /// do not match.
 pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
-    let i = rasterfile::info(&args.file)?;
-    if args.check {
+    let i = if args.check {
         let bar = super::common::progress(!args.quiet);
         crate::progress::phase(&bar, "checking", crate::progress::Unit::Bytes, 0);
-        let verified = rasterfile::verify(&args.file, &bar)
-            .and_then(|()| rasterfile::load_with(&args.file, &bar).map(drop));
+        let checked = rasterfile::inspect(&args.file, Some(&bar));
         bar.finish_and_clear();
-        verified?;
-    }
+        checked?
+    } else {
+        rasterfile::inspect(&args.file, None)?
+    };
     let [nx, ny, nz] = i.dims;
     let max =
         i.origin + glam::DVec3::new(f64::from(nx), f64::from(ny), f64::from(nz)) * i.voxel_size;

@@ -1466,9 +1466,11 @@ fn read_meta(bytes: &[u8], path: &Path, h: &Header) -> Result<Meta, RasterFileEr
     Ok(m)
 }
 
-/// A raster file's bytes: mapped, or none for an empty file.
+/// A raster file's bytes: mapped, read (from a pipe or device, which
+/// cannot be mapped), or none for an empty file.
 enum Mapped {
     Map(Mmap),
+    Read(Vec<u8>),
     Empty,
 }
 
@@ -1477,13 +1479,16 @@ impl std::ops::Deref for Mapped {
     fn deref(&self) -> &[u8] {
         match self {
             Self::Map(m) => m,
+            Self::Read(b) => b,
             Self::Empty => &[],
         }
     }
 }
 
 /// Maps the file at `path` (read-only, shared): its bytes are read from
-/// the page cache as they are used, not read in full.
+/// the page cache as they are used, not read in full. A pipe or device
+/// (`/dev/stdin`) is read in full instead, up to the default memory
+/// limit; a directory is refused as one.
 #[allow(unsafe_code)]
 fn map(path: &Path) -> Result<Mapped, RasterFileError> {
     let io = |what, source| RasterFileError::Io {
@@ -1492,8 +1497,37 @@ fn map(path: &Path) -> Result<Mapped, RasterFileError> {
         source,
     };
     let file = File::open(path).map_err(|e| io("cannot open", e))?;
-    let len = file.metadata().map_err(|e| io("cannot read", e))?.len();
-    if len == 0 {
+    let meta = file.metadata().map_err(|e| io("cannot read", e))?;
+    if meta.is_dir() {
+        return Err(io(
+            "cannot read",
+            std::io::Error::other("a directory, not a raster file"),
+        ));
+    }
+    if !meta.is_file() {
+        let limit = default_max_memory();
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(
+            &mut std::io::Read::take(file, limit.saturating_add(1)),
+            &mut bytes,
+        )
+        .map_err(|e| io("cannot read", e))?;
+        if bytes.len() as u64 > limit {
+            return Err(io(
+                "cannot read",
+                std::io::Error::other(format!(
+                    "more than the memory limit of {} from a stream",
+                    Bytes(limit)
+                )),
+            ));
+        }
+        return Ok(if bytes.is_empty() {
+            Mapped::Empty
+        } else {
+            Mapped::Read(bytes)
+        });
+    }
+    if meta.len() == 0 {
         return Ok(Mapped::Empty);
     }
     // SAFETY: the map is read-only (a shared mapping of the file); rrt
@@ -1611,9 +1645,29 @@ fn u32_from(b: &[u8]) -> u32 {
 /// # Errors
 /// As [`load`], for the header and meta section.
 pub fn info(path: &Path) -> Result<Info, RasterFileError> {
+    info_from(&map(path)?, path)
+}
+
+/// [`info`], and with `check`, [`verify`] and a full [`load_with`] on
+/// `check`'s progress bar, from one reading of the file (so that a pipe,
+/// which can be read once, is checked too).
+///
+/// # Errors
+/// As [`info`], [`verify`] and [`load`].
+pub fn inspect(path: &Path, check: Option<&ProgressBar>) -> Result<Info, RasterFileError> {
     let bytes = map(path)?;
-    let h = read_header(&bytes, path)?;
-    let m = read_meta(&bytes, path, &h)?;
+    let info = info_from(&bytes, path)?;
+    if let Some(progress) = check {
+        verify_from(&bytes, path, progress)?;
+        load_from(&bytes, path, progress, default_max_memory())?;
+    }
+    Ok(info)
+}
+
+/// [`info`] of the file's `bytes`.
+fn info_from(bytes: &[u8], path: &Path) -> Result<Info, RasterFileError> {
+    let h = read_header(bytes, path)?;
+    let m = read_meta(bytes, path, &h)?;
     let count = |k: usize, len: u64| {
         let (codec, _, off, l) = h.sections[k];
         entry_count(&bytes[off as usize..(off + l) as usize], codec, len).unwrap_or(0)
@@ -1665,8 +1719,12 @@ fn memory_needed(voxels: u64, directory: u64, records: u64, lists: u64) -> u64 {
 /// the first section that does not match, or [`RasterFileError::Invalid`]
 /// for a non-zero padding byte.
 pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError> {
-    let bytes = map(path)?;
-    let h = read_header(&bytes, path)?;
+    verify_from(&map(path)?, path, progress)
+}
+
+/// [`verify`] of the file's `bytes`.
+fn verify_from(bytes: &[u8], path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError> {
+    let h = read_header(bytes, path)?;
     progress.set_length(h.file_len);
     progress.set_position(0);
     let (n, header_len, entry) = layout(h.version);
@@ -1677,7 +1735,7 @@ pub fn verify(path: &Path, progress: &ProgressBar) -> Result<(), RasterFileError
     let checksum_end = (16 + entry * n + 4) as u64;
     let mut gaps = vec![(checksum_end, header_len)];
     for (i, &k) in order.iter().enumerate() {
-        section(&bytes, path, &h, k, progress, |_, _| {})?;
+        section(bytes, path, &h, k, progress, |_, _| {})?;
         let (_, _, off, len) = h.sections[k];
         let end = off + len;
         let next = order
