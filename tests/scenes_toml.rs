@@ -1233,8 +1233,9 @@ fn meshes_models_and_volumes_are_not_read_as_nff() {
 }
 
 /// A capped cone or CSG solid too thin for the raster's fixed point is
-/// refused at its own definition as a degenerate solid, not as a broken
-/// raster's "CSG leaf 0".
+/// refused at its own definition (the object's shape key, or the tree's
+/// `[solid.NAME]`) as a degenerate solid, not as a broken raster's "CSG
+/// leaf 0".
 #[test]
 fn degenerate_solids_are_named_at_their_definition() {
     let d = temp_dir("degenerate-solid");
@@ -1242,22 +1243,17 @@ fn degenerate_solids_are_named_at_their_definition() {
     let p = d.join("cone.toml");
     let text = second_object(cone, "");
     std::fs::write(&p, &text).unwrap();
-    let line = text
-        .lines()
-        .collect::<Vec<_>>()
-        .iter()
-        .rposition(|l| *l == "[[object]]")
-        .unwrap()
-        + 1;
+    let line = text.lines().position(|l| l == cone).unwrap() + 1;
     let scene = Scene::load(&p).unwrap();
     let e = build(&scene, &BuildOptions::new(64), &ProgressBar::hidden())
         .err()
         .unwrap()
         .to_string();
+    // At the `cone` key's value: column 8, after `cone = `.
     assert_eq!(
         e,
         format!(
-            "{}:{line}:1: capped cone: too thin or too small to have an inside at the raster's precision (a degenerate solid)",
+            "{}:{line}:8: capped cone: too thin or too small to have an inside at the raster's precision (a degenerate solid)",
             p.display()
         )
     );

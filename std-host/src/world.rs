@@ -24,6 +24,31 @@ use glam::DVec3;
 /// ```
 pub const WORLD_LIMIT: f64 = 1e60;
 
+/// A world number as messages and reports print it: Rust's shortest
+/// decimal form in the usual range, the exponent form where that would
+/// spell out dozens of digits.
+///
+/// ```
+/// use rrt_host::world::Coord;
+/// assert_eq!(Coord(2.5).to_string(), "2.5");
+/// assert_eq!(Coord(-1e60).to_string(), "-1e60");
+/// assert_eq!(Coord(1.25e-9).to_string(), "1.25e-9");
+/// assert_eq!(Coord(0.0).to_string(), "0");
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct Coord(pub f64);
+
+impl std::fmt::Display for Coord {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-6..1e16).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
 /// Whether every coordinate of `v` lies within [`WORLD_LIMIT`] (so is
 /// finite).
 ///

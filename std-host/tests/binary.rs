@@ -247,6 +247,18 @@ fn arguments_out_of_range_are_refused_as_the_help_says() {
             ][..],
             "contain no geometry",
         ),
+        // Bounds at the world's limit are spelt with exponents.
+        (
+            &[
+                "render",
+                "-o",
+                "/tmp/rrt-never-written.png",
+                "--raster",
+                "32",
+                "--bounds=-1e60,-1e60,-1e60,-0.9e60,-0.9e60,-0.9e60",
+            ][..],
+            "the bounds [-1e60, -1e60, -1e60] to [-9e59, -9e59, -9e59] contain no geometry",
+        ),
     ] {
         let out = rrt(args);
         assert!(!out.status.success(), "{args:?}");

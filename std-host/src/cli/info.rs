@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use super::CliError;
 use crate::fit::Bytes;
 use crate::output::rasterfile;
+use crate::world::Coord;
 use rrt_core::light::ExactRecords;
 use rrt_core::voxelize::Separation;
 
@@ -60,9 +61,14 @@ pub fn run(args: &InfoArgs, out: &mut impl Write) -> Result<(), CliError> {
     writeln!(
         out,
         "world bounds: [{}, {}, {}] to [{}, {}, {}]",
-        i.origin.x, i.origin.y, i.origin.z, max.x, max.y, max.z
+        Coord(i.origin.x),
+        Coord(i.origin.y),
+        Coord(i.origin.z),
+        Coord(max.x),
+        Coord(max.y),
+        Coord(max.z)
     )?;
-    writeln!(out, "voxel size: {}", i.voxel_size)?;
+    writeln!(out, "voxel size: {}", Coord(i.voxel_size))?;
     writeln!(
         out,
         "separation: {}",

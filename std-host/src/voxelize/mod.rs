@@ -75,6 +75,7 @@ use self::texture::MaterialTextures;
 use crate::fit::{self, Bytes, FitError, FitOptions};
 use crate::progress::Unit;
 use crate::scene::{Scene, SourceLoc};
+use crate::world::Coord;
 
 /// How to build.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -175,7 +176,8 @@ pub enum BuildError {
     /// The explicit bounds hold no surface voxel of any object.
     #[error(
         "{file}: the bounds [{}, {}, {}] to [{}, {}, {}] contain no geometry: the image would be empty",
-        bounds.min.x, bounds.min.y, bounds.min.z, bounds.max.x, bounds.max.y, bounds.max.z
+        Coord(bounds.min.x), Coord(bounds.min.y), Coord(bounds.min.z),
+        Coord(bounds.max.x), Coord(bounds.max.y), Coord(bounds.max.z)
     )]
     EmptyBounds {
         /// The scene file.

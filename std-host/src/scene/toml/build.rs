@@ -65,7 +65,7 @@ impl Builder<'_> {
     }
 
     /// `key` with the index of the `[[object]]` or `[[light]]` being built.
-    fn full_key(&self, key: &str) -> String {
+    pub(super) fn full_key(&self, key: &str) -> String {
         if let Some((list, i)) = self.entry.get()
             && let Some(rest) = key.strip_prefix(list)
             && (rest.is_empty() || rest.starts_with('.'))

@@ -181,6 +181,7 @@ impl Builder<'_> {
         root: &Spanned<CsgOp>,
         material: Option<&Spanned<String>>,
         s: &std::ops::Range<usize>,
+        loc: SourceLoc,
     ) -> Result<(), SceneError> {
         let default_material = match material {
             Some(m) => Some(self.material_of(Some(m), s, "object.material")?),
@@ -189,7 +190,7 @@ impl Builder<'_> {
         let mut csg = Csg {
             nodes: Vec::new(),
             leaves: Vec::new(),
-            loc: self.loc(s.clone()),
+            loc,
         };
         self.csg_op(
             doc,

@@ -68,11 +68,14 @@ impl Builder<'_> {
                 }
                 return self.nff(scene, n, &s);
             }
-            ShapeDef::Csg(c) => return self.csg(scene, doc, c, d.material.as_ref(), &s),
+            ShapeDef::Csg(c) => {
+                let loc = self.shape_loc(shape, &s);
+                return self.csg(scene, doc, c, d.material.as_ref(), &s, loc);
+            }
             _ => self.material_of(d.material.as_ref(), &s, "object.material")?,
         };
         let at = At {
-            loc: self.loc(s.clone()),
+            loc: self.shape_loc(shape, &s),
             span: s,
             material,
             transform,
@@ -89,6 +92,13 @@ impl Builder<'_> {
             ShapeDef::Vox(v) => self.vox(scene, v, at),
             ShapeDef::Nff(_) | ShapeDef::Csg(_) => Ok(()),
         }
+    }
+
+    /// Where the object's shape is given (its shape key's value), which
+    /// later refusals of the object (the voxelizers', the fit's) name.
+    fn shape_loc(&self, shape: ShapeDef<'_>, s: &Range<usize>) -> SourceLoc {
+        let key = self.full_key(&format!("object.{}", shape.key()));
+        self.loc(self.spans.value(&key).unwrap_or_else(|| s.clone()))
     }
 
     /// Scale, then the rotations in x, y, z order (degrees), then the

@@ -466,6 +466,25 @@ pub(super) enum ShapeDef<'d> {
 pub(super) const SHAPE_KEYS: &str =
     "sphere, cone, polygon, box, torus, bezier, mesh, nff, volume, vox, csg";
 
+impl ShapeDef<'_> {
+    /// The object key that gives this shape.
+    pub(super) const fn key(self) -> &'static str {
+        match self {
+            Self::Sphere(_) => "sphere",
+            Self::Cone(_) => "cone",
+            Self::Polygon(_) => "polygon",
+            Self::Box(_) => "box",
+            Self::Torus(_) => "torus",
+            Self::Bezier(_) => "bezier",
+            Self::Mesh(_) => "mesh",
+            Self::Nff(_) => "nff",
+            Self::Volume(_) => "volume",
+            Self::Vox(_) => "vox",
+            Self::Csg(_) => "csg",
+        }
+    }
+}
+
 impl ObjectDef {
     /// The shape keys the object gives, in the order of [`SHAPE_KEYS`].
     pub(super) fn shapes(&self) -> Vec<ShapeDef<'_>> {
