@@ -329,6 +329,74 @@ fn triangle_random_rays_against_plane_and_barycentrics() {
     }
 }
 
+/// A vertex far from the others costs no precision near them: a sliver
+/// with one vertex up to 1e15 away answers rays near its narrow end as the
+/// same triangle with its vertices listed in any order, and as the exact
+/// inside test (the sliver's edges there are the lines through (1, -1) and
+/// (0, 1) towards the far vertex).
+#[test]
+fn triangle_with_a_far_vertex_keeps_precision_near_the_others() {
+    let down = [0.0, 0.0, -1.0];
+    for far in [1e6, 1e9, 1e12, 1e15] {
+        let v = [
+            DVec3::new(-far, -far, 0.0),
+            DVec3::new(1.0, -1.0, 0.0),
+            DVec3::Y,
+        ];
+        let orders = [[0, 1, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+        for i in 0..=40 {
+            for j in 0..=40 {
+                let (x, y) = (-1.0 + 0.05 * f64::from(i), -1.0 + 0.05 * f64::from(j));
+                let r = ray([x, y, 2.0], down);
+                let hits: Vec<_> = orders
+                    .iter()
+                    .map(|o| triangle(&r, o.map(|k| v[k]), None, 0.0, INF).map(|h| h.t))
+                    .collect();
+                assert!(
+                    hits.iter().all(|h| *h == hits[0]),
+                    "far {far}, ({x}, {y}): {hits:?}"
+                );
+                if let Some(t) = hits[0] {
+                    close(t, 2.0, 1e-12);
+                }
+            }
+        }
+    }
+}
+
+/// Triangles that share an edge leave no crack along it, whatever the
+/// coordinates: a square of side 2e16 cut along its diagonal is met by
+/// every ray through points on and near that diagonal, at the square's
+/// plane.
+#[test]
+fn triangles_sharing_an_edge_leave_no_crack() {
+    for size in [1.0, 1e3, 1e9, 1e16, 1e40] {
+        let q = [
+            DVec3::new(-size, -size, 0.0),
+            DVec3::new(size, -size, 0.0),
+            DVec3::new(size, size, 0.0),
+            DVec3::new(-size, size, 0.0),
+        ];
+        let halves = [[q[0], q[1], q[2]], [q[0], q[2], q[3]]];
+        let mut g = Uniform(rrt_core::rng::Rng::new(7));
+        for _ in 0..2000 {
+            // A point on the diagonal, or a rounding step off it, near the
+            // centre, seen from a random point above.
+            let s = g.range(-0.5, 0.5) * size.min(4.0);
+            let p = DVec3::new(s, s * (1.0 + g.range(-1e-15, 1e-15)), 0.0);
+            let o = p + g.vec(-3.0, 3.0).with_z(g.range(1.0, 5.0));
+            let r = Ray::new(o, p - o);
+            let hit = halves
+                .iter()
+                .filter_map(|&v| triangle(&r, v, None, 0.0, INF))
+                .map(|h| h.t)
+                .next();
+            let t = hit.unwrap_or_else(|| panic!("size {size}: crack at {p}"));
+            close(t, 1.0, 1e-9);
+        }
+    }
+}
+
 // -------------------------------------------------------------------- cone
 
 /// The cylinder of radius 1 from the origin to (0, 0, 2), open at both

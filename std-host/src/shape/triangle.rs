@@ -32,36 +32,101 @@ impl Triangle {
     /// Where `ray` crosses the triangle in `(tmin, tmax)`: `(t, u, v)`, the
     /// parameter and the barycentrics of vertices 1 and 2 of
     /// [`Surface::intersect`]'s hit.
+    ///
+    /// The watertight test of Woop, Benthin and Wald (JCGT 2013): the
+    /// vertices are taken relative to the ray's origin and sheared so that
+    /// the ray runs along an axis; the three edge functions are then 2D
+    /// cross products of vertex pairs, each edge's computed from its two
+    /// vertices alone. So no vertex is privileged (a vertex far from the
+    /// others costs no precision near them), and triangles that share an
+    /// edge compute that edge's function to the same value up to sign: a
+    /// ray through a shared edge meets at least one of them, however large
+    /// the coordinates.
     #[inline(always)]
     fn crossing(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<(f64, f64, f64)> {
-        let [v0, v1, v2] = self.vertices;
-        let e1 = v1 - v0;
-        let e2 = v2 - v0;
-        let p = ray.dir.cross(e2);
-        let det = e1.dot(p);
-        // A ray in the plane (|det| ≤ 1e-14·|e1|·|e2|·|dir|) misses; that
-        // test's square roots are taken last, for rays that pass the others
-        // (with det = 0 the barycentric tests below fail on NaN or ∞).
-        let inv = 1.0 / det;
-        let s = ray.origin - v0;
-        let u = s.dot(p) * inv;
-        if !(0.0..=1.0).contains(&u) {
+        let a = ray.dir.abs();
+        // The driving axis kz; kx, ky follow it cyclically, swapped when the
+        // ray runs down kz, so that the shear keeps the winding.
+        let down = |k: f64| k < 0.0;
+        if a.x >= a.y && a.x >= a.z {
+            if down(ray.dir.x) {
+                self.sheared::<2, 1, 0>(ray, tmin, tmax)
+            } else {
+                self.sheared::<1, 2, 0>(ray, tmin, tmax)
+            }
+        } else if a.y >= a.z {
+            if down(ray.dir.y) {
+                self.sheared::<0, 2, 1>(ray, tmin, tmax)
+            } else {
+                self.sheared::<2, 0, 1>(ray, tmin, tmax)
+            }
+        } else if down(ray.dir.z) {
+            self.sheared::<1, 0, 2>(ray, tmin, tmax)
+        } else {
+            self.sheared::<0, 1, 2>(ray, tmin, tmax)
+        }
+    }
+
+    /// [`Self::crossing`] for the axes `KX`, `KY`, `KZ` (the driving axis).
+    #[inline(always)]
+    fn sheared<const KX: usize, const KY: usize, const KZ: usize>(
+        &self,
+        ray: &Ray,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<(f64, f64, f64)> {
+        let d = ray.dir.to_array();
+        let (sx, sy) = (d[KX] / d[KZ], d[KY] / d[KZ]);
+        let [p0, p1, p2] = self.vertices.map(|v| (v - ray.origin).to_array());
+        let shear = |p: [f64; 3]| (p[KX] - sx * p[KZ], p[KY] - sy * p[KZ]);
+        let ((ax, ay), (bx, by), (cx, cy)) = (shear(p0), shear(p1), shear(p2));
+        // Twice the signed areas of the sub-triangles the ray's point
+        // makes with each edge: the weights of vertices 0, 1 and 2. Seen
+        // from either side: the weights share a sign (edges included).
+        let w0 = cx * by - cy * bx;
+        let w1 = ax * cy - ay * cx;
+        if (w0 < 0.0 && w1 > 0.0) || (w0 > 0.0 && w1 < 0.0) {
             return None;
         }
-        let q = s.cross(e1);
-        let v = ray.dir.dot(q) * inv;
-        if !(v >= 0.0 && u + v <= 1.0) {
+        let w2 = bx * ay - by * ax;
+        if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) && (w0 > 0.0 || w1 > 0.0 || w2 > 0.0) {
             return None;
         }
-        let t = e2.dot(q) * inv;
-        if !(t > tmin && t < tmax) {
-            return None;
-        }
-        let scale = e1.length() * e2.length() * ray.dir.length();
+        let det = w0 + w1 + w2;
+        // A ray in the triangle's plane (or a triangle with no area) misses:
+        // the projected area vanishes against the products it is made of.
+        let scale = (cx * by).abs()
+            + (cy * bx).abs()
+            + (ax * cy).abs()
+            + (ay * cx).abs()
+            + (bx * ay).abs()
+            + (by * ax).abs();
         if !(det.abs() > 1e-14 * scale) {
             return None;
         }
-        Some((t, u, v))
+        // The parameter from the plane through the vertex nearest the
+        // origin: its rounding grows with that vertex's distance, where an
+        // interpolation of the three vertices' depths would grow with the
+        // farthest's.
+        let [v0, v1, v2] = self.vertices;
+        let n = (v1 - v0).cross(v2 - v0);
+        let near =
+            [p1, p2]
+                .into_iter()
+                .map(DVec3::from_array)
+                .fold(DVec3::from_array(p0), |a, b| {
+                    if b.abs().max_element() < a.abs().max_element() {
+                        b
+                    } else {
+                        a
+                    }
+                });
+        let t = n.dot(near) / n.dot(ray.dir);
+        if !(t > tmin && t < tmax) {
+            return None;
+        }
+        let inv = 1.0 / det;
+        Some((t, w1 * inv, w2 * inv))
     }
 }
 
@@ -114,7 +179,7 @@ impl Surface for Triangle {
         triangle::triangle
     );
 
-    /// Ray–triangle (Möller–Trumbore), edges included. With `normals`, the
+    /// Ray–triangle (the watertight test), edges included. With `normals`, the
     /// normal is the normalised barycentric interpolation
     /// `w·n0 + u·n1 + v·n2` (`w = 1 − u − v`, as `embree_nff`); without, or
     /// if that interpolation vanishes, the face normal `(v1−v0) × (v2−v0)`.
