@@ -367,13 +367,16 @@ pub struct Volume {
 }
 
 impl Volume {
-    /// A volume from its parts.
+    /// A volume from its parts. Infinite `float` samples are taken as the
+    /// largest finite `float` of their sign (a trilinear interpolation with
+    /// an infinity in it would give ∞ or NaN, not a value between
+    /// its samples); NaN samples stay NaN, which is transparent.
     ///
     /// # Errors
     /// [`VolumeError::Invalid`] when a dimension is 0 or above
     /// [`MAX_AXIS`], the sample count is not the product of the
     /// dimensions, or the grid is not usable.
-    pub fn new(dims: [u32; 3], grid: Grid, samples: Samples) -> Result<Self, VolumeError> {
+    pub fn new(dims: [u32; 3], grid: Grid, mut samples: Samples) -> Result<Self, VolumeError> {
         let invalid = |msg: String| VolumeError::Invalid {
             what: "volume".into(),
             msg,
@@ -393,6 +396,13 @@ impl Volume {
             )));
         }
         grid.validate().map_err(invalid)?;
+        if let Samples::F32(v) = &mut samples {
+            v.par_chunks_mut(1 << 16).for_each(|c| {
+                for x in c.iter_mut().filter(|x| x.is_infinite()) {
+                    *x = f32::MAX.copysign(*x);
+                }
+            });
+        }
         Ok(Self {
             dims,
             inverse: grid.matrix().inverse(),
@@ -781,6 +791,24 @@ mod tests {
         assert_eq!(b.max, DVec3::new(13.5, 25.0, 34.5));
         assert_eq!(v.range(), (0.0, 123.0));
         assert!(!v.is_cubic());
+    }
+
+    /// Infinite samples interpolate as the largest finite floats: every
+    /// point between an infinite sample and a 0 lies above any iso value,
+    /// none is NaN (transparent), and the range is finite.
+    #[test]
+    fn infinite_samples_are_the_largest_finite_floats() {
+        let s = vec![f32::INFINITY, 0.0, f32::NEG_INFINITY, f32::NAN];
+        let v = Volume::new([4, 1, 1], Grid::unit(), Samples::F32(s)).unwrap();
+        let max = f64::from(f32::MAX);
+        assert_eq!(v.range(), (-max, max));
+        for k in 0..=10 {
+            let x = f64::from(k) / 10.0;
+            let at = v.sample_index(DVec3::new(x, 0.0, 0.0)).unwrap();
+            assert!(at.is_finite() && at >= 0.0, "{x}: {at}");
+            assert!(x == 1.0 || at > 1e37, "{x}: {at}");
+        }
+        assert!(v.value(3, 0, 0).unwrap().is_nan());
     }
 
     #[test]
