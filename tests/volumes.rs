@@ -143,6 +143,59 @@ fn headerless_raw() {
     assert!(e.to_string().contains("no-such.raw"), "{e}");
 }
 
+/// A volume file or detached data file that is a pipe, a device or a
+/// folder is refused before it is opened (opening a pipe would wait for a
+/// writer, a device could be read without end).
+#[test]
+fn volume_data_must_be_a_regular_file() {
+    let header = |data: &str| {
+        format!(
+            "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: {data}\n\n"
+        )
+    };
+    let dir = tmp("special");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("pipe.raw");
+    let mut cases = vec![("/dev/zero".to_owned(), "not a regular file")];
+    cases.push((dir.display().to_string(), "a directory, not a file"));
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        cases.push((fifo.display().to_string(), "not a regular file"));
+    } else {
+        eprintln!("mkfifo is not available: the pipe is not checked");
+    }
+    // The message with its causes, as the command line shows it.
+    let chain = |e: VolumeError| {
+        let mut s = e.to_string();
+        let mut at: Option<&dyn std::error::Error> = std::error::Error::source(&e);
+        while let Some(c) = at {
+            s = format!("{s}: {c}");
+            at = c.source();
+        }
+        s
+    };
+    for (data, why) in &cases {
+        let nhdr = dir.join("v.nhdr");
+        std::fs::write(&nhdr, header(data)).unwrap();
+        let e = chain(nrrd::read(&nhdr, &Limits::default()).unwrap_err());
+        assert!(e.contains(data) && e.contains(why), "{data}: {e}");
+        let spec = RawSpec {
+            dims: [2, 2, 2],
+            sample_type: SampleType::U8,
+            endian: Endian::Little,
+            grid: Grid::unit(),
+            skip: 0,
+        };
+        let e = chain(raw::read(Path::new(data), &spec, &Limits::default()).unwrap_err());
+        assert!(e.contains(why), "{data}: {e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// The NRRD volume `../shared/data/volumes/<name>`, which must have
 /// `dims` samples, or a skip message.
 #[track_caller]

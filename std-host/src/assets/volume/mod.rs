@@ -712,6 +712,19 @@ impl VolumeError {
 
     /// `path` opened, and its length.
     pub(crate) fn open(path: &Path) -> Result<(std::fs::File, u64), Self> {
+        // Checked before opening: opening a pipe waits for a writer.
+        let meta = std::fs::metadata(path).map_err(Self::io(path))?;
+        if !meta.is_file() {
+            let what = if meta.is_dir() {
+                "a directory, not a file"
+            } else {
+                "not a regular file (a pipe, socket or device)"
+            };
+            return Err(Self::io(path)(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                what,
+            )));
+        }
         let file = std::fs::File::open(path).map_err(Self::io(path))?;
         let len = file.metadata().map_err(Self::io(path))?.len();
         Ok((file, len))

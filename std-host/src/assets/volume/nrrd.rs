@@ -46,7 +46,6 @@
 //! exactly the samples the header promises: short data and extra data are
 //! both errors (a header whose `sizes` lie is caught either way).
 
-use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
@@ -106,9 +105,7 @@ pub fn read(path: impl AsRef<Path>, limits: &Limits) -> Result<Volume, VolumeErr
     match &header.data_file {
         None => decode(path, &mut reader, header.header_bytes, len, &header, limits),
         Some(data) => {
-            let dio = VolumeError::io(data);
-            let f = File::open(data).map_err(dio)?;
-            let dlen = f.metadata().map_err(dio)?.len();
+            let (f, dlen) = VolumeError::open(data)?;
             decode(data, &mut BufReader::new(f), 0, dlen, &header, limits)
         }
     }
@@ -133,7 +130,7 @@ pub fn parse_bytes(name: &str, bytes: &[u8], limits: &Limits) -> Result<Volume, 
 /// As [`read`], for the header.
 pub fn read_header(path: impl AsRef<Path>, limits: &Limits) -> Result<Header, VolumeError> {
     let path = path.as_ref();
-    let file = File::open(path).map_err(VolumeError::io(path))?;
+    let (file, _) = VolumeError::open(path)?;
     parse_header(path, &mut BufReader::new(file), limits, true)
 }
 
