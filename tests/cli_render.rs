@@ -349,6 +349,39 @@ fn saved_raster_options_are_checked() {
     });
 }
 
+/// The raster and the image count together against `--max-memory`: with
+/// a limit that each fits alone (a 512² image takes about 5.2 MiB, balls1's
+/// raster 96 under 0.6 MiB) but not both, a scene and its saved raster are
+/// refused, naming both; with room for both, they render.
+#[test]
+fn the_raster_and_the_image_share_the_memory_limit() {
+    in_temp_dir("shared-limit", |dir| {
+        let rrt = dir.join("t.rrt");
+        let r = rrt.to_str().unwrap();
+        let scene = data("balls1.nff");
+        let scene = scene.to_str().unwrap();
+        cli(&["voxelize", scene, "-o", r, "--raster", "96", "-q"]).unwrap();
+        let o = dir.join("o.png");
+        let o = o.to_str().unwrap();
+        let size = ["--width", "512", "--height", "512", "-q", "-o", o];
+        let raster = ["--raster", "96"];
+        let tight = ["--max-memory", "5400K"];
+        fails_with(
+            &[&["render", scene][..], &raster, &size, &tight].concat(),
+            ", the image 5.2 MiB), more than the limit of 5.3 MiB",
+        );
+        fails_with(
+            &[&["render", r][..], &size, &tight].concat(),
+            "t.rrt: the raster takes 257.0 KiB once loaded and the image 5.2 MiB, together more than the limit of 5.3 MiB",
+        );
+        assert!(!Path::new(o).exists());
+        let room = ["--max-memory", "6M"];
+        cli(&[&["render", scene][..], &raster, &size, &room].concat()).unwrap();
+        cli(&[&["render", r][..], &size, &room].concat()).unwrap();
+        assert!(Path::new(o).exists());
+    });
+}
+
 /// A saved raster is refused when loading it would need more memory than
 /// `--max-memory`, as a scene's raster is, before it is made; and a raster
 /// saved for the verified mode renders the scene's verified image, byte

@@ -202,7 +202,8 @@ pub fn render<'py>(
         let check_view = |v: &rrt_host::scene::View| {
             let v = overrides.apply(v);
             let (w, h) = size(&v);
-            Camera::new(&v, w, h).map(|_| ()).map_err(Into::into)
+            // The Python caller holds the image; it is not counted here.
+            Camera::new(&v, w, h).map(|_| 0).map_err(Into::into)
         };
         let loaded = load_or_build(
             scene.as_ref(),
@@ -213,6 +214,7 @@ pub fn render<'py>(
                 width: a.width,
                 height: a.height,
                 samples: a.supersample,
+                memory: 0,
             },
             a.threads,
             false,

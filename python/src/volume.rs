@@ -326,6 +326,7 @@ fn build(
                 width: w,
                 height: h,
                 samples: k,
+                memory: 0,
             },
             threads,
             &ProgressBar::hidden(),

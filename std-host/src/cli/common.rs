@@ -11,7 +11,7 @@ use rrt_core::light::ExactRecords;
 
 use super::CliError;
 use super::ray::ConnectivityArg;
-use crate::fit::{FitOptions, RasterNeed, default_max_memory, default_raster};
+use crate::fit::{Bytes, FitOptions, RasterNeed, default_max_memory, default_raster};
 use crate::output::rasterfile;
 use crate::scene::{Scene, View};
 use crate::trace::Mode;
@@ -360,6 +360,9 @@ pub struct ImageNeed<'a> {
     pub height: Option<u32>,
     /// Rays per pixel.
     pub samples: u32,
+    /// Bytes of the image the raster is rendered into, counted with the
+    /// raster against the memory limit (0: none, or not yet known).
+    pub memory: u64,
 }
 
 /// Where a render's scene comes from.
@@ -387,12 +390,15 @@ pub enum Loaded {
 /// else parses and voxelizes it as an NFF or TOML scene (the built-in
 /// scene for `None`); the loading or the voxelizing runs on `threads`
 /// threads (0: one per core). `check_view` sees the scene's view before
-/// any voxelizing (a bad view is refused before the long work).
+/// any voxelizing (a bad view is refused before the long work) and
+/// returns the bytes of the image to be rendered, which count with the
+/// raster against `--max-memory`.
 ///
 /// # Errors
 /// The parser's, builder's or raster file's error; `--raster` or
 /// `--bounds` given for a saved raster; `--bounds` that hold none of the
-/// scene's geometry; `check_view`'s error.
+/// scene's geometry; `check_view`'s error; a raster and image that
+/// together need more than the memory limit.
 pub fn load_or_build(
     path: Option<&PathBuf>,
     raster: &RasterArgs,
@@ -400,7 +406,7 @@ pub fn load_or_build(
     image: &ImageNeed<'_>,
     threads: usize,
     show_progress: bool,
-    check_view: &dyn Fn(&View) -> Result<(), CliError>,
+    check_view: &dyn Fn(&View) -> Result<u64, CliError>,
 ) -> Result<Loaded, CliError> {
     if let Some(p) = path
         && rasterfile::names_raster(p)
@@ -431,7 +437,19 @@ pub fn load_or_build(
         let scene = pool.install(|| rasterfile::load_within(p, &bar, limit));
         bar.finish_and_clear();
         let scene = scene?;
-        check_view(&scene.view)?;
+        let image = check_view(&scene.view)?;
+        if scene.memory().saturating_add(image) > limit {
+            return Err(CliError::Arg {
+                arg: "--max-memory",
+                message: format!(
+                    "{}: the raster takes {} once loaded and the image {}, together more than the limit of {}",
+                    p.display(),
+                    Bytes(scene.memory()),
+                    Bytes(image),
+                    Bytes(limit)
+                ),
+            });
+        }
         return Ok(Loaded::Saved {
             scene,
             load: t.elapsed(),
@@ -446,8 +464,10 @@ pub fn load_or_build(
             return Err(e);
         }
     };
-    let built = check_view(&scene.view)
-        .and_then(|()| build_scene(&scene, raster, purpose, image, threads, &bar));
+    let built = check_view(&scene.view).and_then(|memory| {
+        let image = ImageNeed { memory, ..*image };
+        build_scene(&scene, raster, purpose, &image, threads, &bar)
+    });
     bar.finish_and_clear();
     let (vs, report) = built?;
     Ok(Loaded::Built {
@@ -499,6 +519,7 @@ pub fn build_scene(
     };
     let mut opts = raster.build_options(purpose, default_raster(scene, &need));
     opts.threads = threads;
+    opts.fit.image = image.memory;
     build(scene, &opts, bar).map_err(|e| {
         use crate::voxelize::BuildError;
         let beyond_fixed_point = matches!(

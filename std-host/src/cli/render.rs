@@ -150,24 +150,25 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     let mut first_output = Some(first);
     // Frame k's view, image size and camera, checked before voxelizing
     // (the first frame) and again for each render.
-    let camera_of =
-        |scene_view: &crate::scene::View, k: u64| -> Result<(Camera, View, u32, u32), CliError> {
-            let view = frames.view(k, &args.view.apply(scene_view));
-            let [rw, rh] = view.resolution;
-            let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
-            check_sizes(w, h, args.supersample)?;
-            let rows = match args.tile {
-                Some(t) => {
-                    let r = t.band(h)?.rows(h);
-                    r.end - r.start
-                }
-                None => h,
-            };
-            // Named by what set the size: the arguments, or the scene.
-            let sized_by = (args.width.is_none() || args.height.is_none()).then_some(&view.loc);
-            check_image_memory(w, rows, args.bits, format, &args.raster, sized_by)?;
-            Ok((Camera::new(&view, w, h)?, view, w, h))
+    let camera_of = |scene_view: &crate::scene::View,
+                     k: u64|
+     -> Result<(Camera, View, u32, u32, u64), CliError> {
+        let view = frames.view(k, &args.view.apply(scene_view));
+        let [rw, rh] = view.resolution;
+        let (w, h) = (args.width.unwrap_or(rw), args.height.unwrap_or(rh));
+        check_sizes(w, h, args.supersample)?;
+        let rows = match args.tile {
+            Some(t) => {
+                let r = t.band(h)?.rows(h);
+                r.end - r.start
+            }
+            None => h,
         };
+        // Named by what set the size: the arguments, or the scene.
+        let sized_by = (args.width.is_none() || args.height.is_none()).then_some(&view.loc);
+        let bytes = check_image_memory(w, rows, args.bits, format, &args.raster, sized_by)?;
+        Ok((Camera::new(&view, w, h)?, view, w, h, bytes))
+    };
     // The raster is fitted to the base view (the scene's with the
     // overrides), whichever frames are rendered.
     let loaded = load_or_build(
@@ -179,10 +180,11 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
             width: args.width,
             height: args.height,
             samples: args.supersample,
+            memory: 0,
         },
         args.threads,
         !args.quiet,
-        &|v| camera_of(v, chosen.start).map(|_| ()),
+        &|v| camera_of(v, chosen.start).map(|c| c.4),
     )?;
     let scene = match &loaded {
         Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
@@ -218,7 +220,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     // Bands name their scene (read once: it reads every record).
     let fingerprint = args.tile.map(|_| scene.fingerprint()).unwrap_or_default();
     for k in chosen {
-        let (camera, view, w, h) = camera_of(&scene.view, k)?;
+        let (camera, view, w, h, _) = camera_of(&scene.view, k)?;
         let output = match first_output.take() {
             Some(o) => o,
             None => ImageOutput::create(&names.path(k), encoding)?,
@@ -289,6 +291,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
 /// `bits`-bit codes, or OpenEXR's, made whole in memory) is more than
 /// `--max-memory` allows; named by the scene's view at `sized_by` when
 /// the scene's resolution set the size, by `--width/--height` otherwise.
+/// Returns those bytes.
 fn check_image_memory(
     width: u32,
     rows: u32,
@@ -296,7 +299,7 @@ fn check_image_memory(
     format: Format,
     raster: &RasterArgs,
     sized_by: Option<&crate::scene::SourceLoc>,
-) -> Result<(), CliError> {
+) -> Result<u64, CliError> {
     let limit = raster.max_memory.unwrap_or_else(default_max_memory);
     let pixels = u64::from(width) * u64::from(rows);
     let codes = match format {
@@ -326,7 +329,7 @@ fn check_image_memory(
             },
         });
     }
-    Ok(())
+    Ok(needed)
 }
 
 /// What every band of one image shares, for its [`BandTag`]: the view,

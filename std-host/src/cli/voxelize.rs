@@ -98,6 +98,7 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         width: None,
         height: None,
         samples: 1,
+        memory: 0,
     };
     let loaded = load_or_build(
         args.scene.as_ref(),
@@ -106,7 +107,7 @@ pub fn run(args: &VoxelizeArgs, out: &mut impl Write) -> Result<(), CliError> {
         &image,
         args.threads,
         !args.quiet,
-        &|_| Ok(()),
+        &|_| Ok(0),
     );
     let Loaded::Built {
         scene,

@@ -69,6 +69,9 @@ pub struct MemoryEstimate {
     /// The scene's own data, already in memory: its volumes' samples and
     /// its vertices ([`Scene::data_bytes`]).
     pub scene: u64,
+    /// The image the raster is rendered into, held beside it
+    /// ([`super::FitOptions::image`]).
+    pub image: u64,
 }
 
 impl MemoryEstimate {
@@ -81,6 +84,7 @@ impl MemoryEstimate {
             .saturating_add(self.records)
             .saturating_add(self.object_table)
             .saturating_add(self.scene)
+            .saturating_add(self.image)
     }
 }
 
@@ -88,7 +92,7 @@ impl fmt::Display for MemoryEstimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "plane {}, line level {}, brick directory and level {}, records for up to {} voxels {}, object table of {} objects {}{}",
+            "plane {}, line level {}, brick directory and level {}, records for up to {} voxels {}, object table of {} objects {}{}{}",
             Bytes(self.plane),
             Bytes(self.lines),
             Bytes(self.directory),
@@ -98,6 +102,11 @@ impl fmt::Display for MemoryEstimate {
             Bytes(self.object_table),
             if self.scene > 0 {
                 format!(", the scene's volumes and vertices {}", Bytes(self.scene))
+            } else {
+                String::new()
+            },
+            if self.image > 0 {
+                format!(", the image {}", Bytes(self.image))
             } else {
                 String::new()
             }
@@ -213,5 +222,6 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
         objects: measure.objects as u64,
         object_table: (measure.objects as u64).saturating_mul(OBJECT_BYTES),
         scene: scene.data_bytes(),
+        image: 0,
     }
 }

@@ -58,8 +58,12 @@ pub struct FitOptions {
     pub bounds: Option<Bounds>,
     /// Voxels of margin around computed bounds on every side.
     pub margin: u32,
-    /// Refuse rasters whose estimated memory exceeds this many bytes.
+    /// Refuse rasters whose estimated memory, with `image`, exceeds this
+    /// many bytes.
     pub max_memory: u64,
+    /// Bytes of the image the raster is rendered into, held beside it and
+    /// counted against `max_memory` with it (0: none).
+    pub image: u64,
     /// Count sphere interiors in the memory estimate (a voxelizer that
     /// fills solids); surfaces are always counted.
     pub solid_spheres: bool,
@@ -76,6 +80,7 @@ impl FitOptions {
             bounds: None,
             margin: DEFAULT_MARGIN,
             max_memory: default_max_memory(),
+            image: 0,
             solid_spheres: true,
         }
     }
@@ -232,7 +237,10 @@ pub fn fit(scene: &Scene, opts: &FitOptions) -> Result<Fitted, FitError> {
         beyond_world(scene)?;
     }
     let frame = frame(scene, opts)?;
-    let memory = estimate_memory(scene, &frame, opts.solid_spheres);
+    let memory = MemoryEstimate {
+        image: opts.image,
+        ..estimate_memory(scene, &frame, opts.solid_spheres)
+    };
     if memory.total() > opts.max_memory {
         return Err(FitError::TooMuchMemory {
             dims: Dims(frame.dims()),

@@ -225,14 +225,16 @@ pub enum BuildError {
         what: &'static str,
     },
     /// The exact record count exceeds the memory limit.
-    #[error("raster {dims}: the scene has {records} surface voxels; plane, directory, records and object table need {}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), Bytes(*limit))]
+    #[error("raster {dims}: the scene has {records} surface voxels; plane, directory, records and object table need {}{}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), if *image > 0 { format!(" beside the image's {}", Bytes(*image)) } else { String::new() }, Bytes(*limit))]
     TooMuchMemory {
         /// Voxels per axis.
         dims: fit::Dims,
         /// Records counted.
         records: usize,
-        /// Bytes needed.
+        /// Bytes the raster needs.
         needed: u64,
+        /// Bytes of the image beside it ([`FitOptions::image`]).
+        image: u64,
         /// The limit.
         limit: u64,
     },
@@ -372,11 +374,12 @@ pub fn build(
         .unwrap_or(u64::MAX)
         // The object table's forms (fitted, the core's, the world's).
         .saturating_add((n as u64).saturating_mul(fit::memory::OBJECT_BYTES));
-        if needed > opts.fit.max_memory {
+        if needed.saturating_add(opts.fit.image) > opts.fit.max_memory {
             return Err(BuildError::TooMuchMemory {
                 dims: fit::Dims(extent.dims()),
                 records: c.records,
                 needed,
+                image: opts.fit.image,
                 limit: opts.fit.max_memory,
             });
         }
