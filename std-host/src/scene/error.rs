@@ -180,6 +180,18 @@ pub enum SceneError {
         /// What is wrong.
         problem: &'static str,
     },
+    /// Reading the file would take more memory than the limit.
+    #[error("{file}: {what} take about {} to read, more than the memory limit of {} (--max-memory)", crate::memory::Bytes(*bytes), crate::memory::Bytes(*limit))]
+    TooMuchMemory {
+        /// The file.
+        file: Arc<str>,
+        /// What it holds, counted (`3 vertices and 3 face corners`).
+        what: String,
+        /// The bytes reading it takes.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
     /// A directive that may appear once appears again.
     #[error("{loc}: {what}: a second one; the first is on line {first_line}")]
     Duplicate {

@@ -67,10 +67,42 @@ pub struct Mesh {
 /// parse, a non-finite coordinate, a mesh without faces or with more than
 /// [`MAX_TRIANGLES`] triangles.
 pub fn load(path: &Path, name: &str) -> Result<Mesh, SceneError> {
-    let name: Arc<str> = Arc::from(name);
-    let text = read_text(path, &name, "an OBJ mesh", MAX_FILE_BYTES)?;
-    parse(&name, &text)
+    load_within(path, name, crate::memory::default_max_memory())
 }
+
+/// [`load`], refusing a file whose text, or whose elements once read
+/// ([`READ_BYTES`] per element), would take more than `max_memory` bytes,
+/// before they are read.
+///
+/// # Errors
+/// As [`load`], and [`SceneError::FileTooLarge`] or
+/// [`SceneError::TooMuchMemory`] for the memory limit.
+pub fn load_within(path: &Path, name: &str, max_memory: u64) -> Result<Mesh, SceneError> {
+    let name: Arc<str> = Arc::from(name);
+    let text = read_text(path, &name, "an OBJ mesh", MAX_FILE_BYTES.min(max_memory)).map_err(
+        |e| match e {
+            // The memory limit, not the format's, refused it.
+            SceneError::FileTooLarge { file, size, .. } if max_memory < MAX_FILE_BYTES => {
+                SceneError::TooMuchMemory {
+                    file,
+                    what: format!("its {size} bytes of text"),
+                    bytes: size,
+                    limit: max_memory,
+                }
+            }
+            e => e,
+        },
+    )?;
+    parse_within(&name, &text, max_memory)
+}
+
+/// Bytes that reading an OBJ file into a scene takes per element, beside
+/// its text: per vertex, normal or texture coordinate line (the reader's
+/// `f32`s), and per face corner (the reader's index and its lookup of
+/// distinct corners, this module's `f64` positions, normals and
+/// triangles, and the scene's vertex with its normal, which the mesh
+/// becomes while it is still held).
+pub const READ_BYTES: [u64; 2] = [12, 96];
 
 fn invalid(
     file: &Arc<str>,
@@ -163,18 +195,33 @@ fn check_coordinates<'a>(
 /// Checks, with their lines and columns, what tobj would drop or report
 /// without a location (see the module docs): every vertex and normal
 /// coordinate, the vertex count of every face and every face index.
-fn prescan(file: &Arc<str>, text: &str) -> Result<(), SceneError> {
+fn prescan(file: &Arc<str>, text: &str, max_memory: u64) -> Result<(), SceneError> {
     // Totals for positive indices (tobj resolves them once the object is
     // complete, against everything read by then; the whole file bounds
-    // that), running counts for negative ones.
+    // that), running counts for negative ones; and the faces' corners.
     let mut totals = [0i64; 3];
+    let mut corners = 0u64;
     for line in text.lines() {
-        match line.split_whitespace().next() {
+        let mut words = line.split_whitespace();
+        match words.next() {
             Some("v") => totals[0] += 1,
             Some("vt") => totals[1] += 1,
             Some("vn") => totals[2] += 1,
+            Some("f") => corners += words.count() as u64,
             _ => {}
         }
+    }
+    let elements = totals.iter().map(|&n| n.unsigned_abs()).sum::<u64>();
+    let bytes = (text.len() as u64)
+        .saturating_add(elements.saturating_mul(READ_BYTES[0]))
+        .saturating_add(corners.saturating_mul(READ_BYTES[1]));
+    if bytes > max_memory {
+        return Err(SceneError::TooMuchMemory {
+            file: Arc::clone(file),
+            what: format!("{elements} vertex, normal and texture lines and {corners} face corners"),
+            bytes,
+            limit: max_memory,
+        });
     }
     let mut seen = [0i64; 3];
     // Positive indices past the elements read so far, with their line and
@@ -302,11 +349,20 @@ impl BufRead for Counting<'_> {
 /// # Errors
 /// As [`load`], less the file-system errors.
 pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
+    parse_within(file, text, crate::memory::default_max_memory())
+}
+
+/// [`parse`], refusing text whose elements would take more than
+/// `max_memory` bytes with it ([`load_within`]).
+///
+/// # Errors
+/// As [`load_within`], less the file-system errors.
+pub fn parse_within(file: &str, text: &str, max_memory: u64) -> Result<Mesh, SceneError> {
     let file: Arc<str> = Arc::from(file);
     // tobj takes `\u{feff}v` for an unknown statement and drops that
     // vertex, renumbering every one after it.
     let text = without_bom(text);
-    prescan(&file, text)?;
+    prescan(&file, text, max_memory)?;
     // tobj reads `l` like `f`, as a face when it has three vertices or
     // more; lines are ignored, so `l` becomes `#` (same byte, same lines).
     let polyline = |line: &str| line.split_whitespace().next() == Some("l");
@@ -495,6 +551,30 @@ pub fn smooth_normals(mesh: &Mesh) -> Vec<DVec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A mesh whose text or elements would take more than the memory
+    /// limit is refused before it is read, naming the limit.
+    #[test]
+    fn meshes_keep_the_memory_limit() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 3\n";
+        // 40 bytes of text, 3 vertices (36 bytes), 6 corners (576 bytes).
+        assert_eq!(parse_within("t.obj", text, 652).unwrap().triangles.len(), 2);
+        let e = parse_within("t.obj", text, 651).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "t.obj: 3 vertex, normal and texture lines and 6 face corners take about 652 B to read, more than the memory limit of 651 B (--max-memory)"
+        );
+        let dir = std::env::temp_dir().join(format!("rrt-obj-limit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("t.obj");
+        std::fs::write(&p, text).unwrap();
+        let e = load_within(&p, "t.obj", 39).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "t.obj: its 40 bytes of text take about 40 B to read, more than the memory limit of 39 B (--max-memory)"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn indices_are_checked_with_their_line() {

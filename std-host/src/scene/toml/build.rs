@@ -226,6 +226,14 @@ impl Builder<'_> {
     /// they and the volumes' samples would take more than
     /// [`Options::max_memory`](super::Options::max_memory); checked before
     /// they are made.
+    /// The bytes the scene's data takes so far against the memory limit:
+    /// its vertices and its volumes' samples.
+    pub(super) fn data_bytes(&self, scene: &Scene) -> u64 {
+        (scene.vertices.len() as u64)
+            .saturating_mul(super::VERTEX_BYTES)
+            .saturating_add(self.volume_bytes.get())
+    }
+
     pub(super) fn room_for_vertices(
         &self,
         scene: &Scene,

@@ -254,7 +254,9 @@ impl Builder<'_> {
         let s = &at.span;
         let transform = at.transform;
         let (path, shown) = self.path(&m.file, "object.mesh.file")?;
-        let mesh = obj::load(&path, &shown)
+        // What the scene's volumes and vertices leave of the limit.
+        let left = self.opts.max_memory.saturating_sub(self.data_bytes(scene));
+        let mesh = obj::load_within(&path, &shown, left)
             .map_err(|e| self.err(m.file.span(), "object.mesh.file", with_causes(&e)))?;
         self.room_for_vertices(
             scene,
