@@ -671,6 +671,23 @@ fn a_bad_value_is_located_at_itself_with_its_key_path() {
         ),
     );
     assert_at(&msg, 4, 11, "camera.angle");
+    // An `up` parallel to the view: at itself when given, named as the
+    // default (at the camera table) when not.
+    let view = |up: &str| {
+        format!(
+            "[camera]\nfrom = [0, 0, 5]\nat = [0, 0, 0]\nangle = 40\nresolution = [8, 8]\n{up}[material.m]\n{}",
+            sphere("1")
+        )
+    };
+    let msg = error_of("up", &view("up = [0, 0, -2]\n"));
+    assert_at(&msg, 6, 6, "camera.up");
+    assert!(
+        msg.ends_with("parallel to the view direction (camera.at − camera.from)"),
+        "{msg}"
+    );
+    let msg = error_of("up", &view(""));
+    assert_at(&msg, 1, 1, "camera.up");
+    assert!(msg.contains("the default [0, 0, 1] is parallel"), "{msg}");
     // A negative hither, as NFF refuses it.
     let msg = error_of(
         "hither",

@@ -551,3 +551,38 @@ fn shared_scene_nodes_cannot_blow_up() {
         "{e}"
     );
 }
+
+/// A `.vox` cell wider than [`rrt_host::voxelize::vox::MAX_VOX_SCALE`]
+/// raster voxels is refused at the model's key with the cell's width (not
+/// as a model out of the raster's reach).
+#[test]
+fn a_cell_wider_than_the_limit_is_named() {
+    use rrt_host::voxelize::{BuildOptions, build};
+    let dir = std::env::temp_dir().join(format!("rrt-vox-cell-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("m.vox"), bytes(false)).unwrap();
+    let p = dir.join("cell.toml");
+    std::fs::write(
+        &p,
+        "[camera]\nfrom = [0, -6, 2]\nat = [0, 0, 0]\nangle = 40\nresolution = [8, 8]\n[material.m]\n[[object]]\nmaterial = \"m\"\nvox = { file = \"m.vox\", cell = 1000 }\n",
+    )
+    .unwrap();
+    let scene = rrt_host::scene::Scene::load(&p).unwrap();
+    let mut opts = BuildOptions::new(1024);
+    opts.fit.bounds = Some(rrt_host::world::Bounds {
+        min: glam::DVec3::ZERO,
+        max: glam::DVec3::ONE,
+    });
+    let e = build(&scene, &opts, &indicatif::ProgressBar::hidden())
+        .err()
+        .unwrap()
+        .to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{}:9:7: vox cell: 1024000 raster voxels across, more than 4096; give a coarser --raster or a smaller cell",
+            p.display()
+        )
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

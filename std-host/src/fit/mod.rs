@@ -46,7 +46,7 @@ pub use crate::memory::{Bytes, default_max_memory, parse_meminfo, total_memory};
 use crate::frame::{MAX_FIXED_VOXEL_BITS, RasterFrame};
 use crate::scene::{Object, Scene, SourceLoc};
 use crate::shape::{Shape, Surface, Unfit};
-use crate::world::{Bounds, WORLD_LIMIT, within_world};
+use crate::world::{Bounds, Coord, WORLD_LIMIT, within_world};
 
 /// How to fit the raster.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -442,7 +442,7 @@ impl Table<'_> {
 
 /// What is wrong with geometry bounds `min` to `max` that fit no raster.
 fn no_extent(min: DVec3, max: DVec3) -> String {
-    let p = |v: DVec3| format!("({:e}, {:e}, {:e})", v.x, v.y, v.z);
+    let p = |v: DVec3| format!("({}, {}, {})", Coord(v.x), Coord(v.y), Coord(v.z));
     if min.cmpgt(max).any() {
         "nothing to fit a raster to: every object is empty (an empty CSG result, a .vox model without voxels)".to_string()
     } else if !(max - min).is_finite() {

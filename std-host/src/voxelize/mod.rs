@@ -224,6 +224,17 @@ pub enum BuildError {
         /// What it is.
         what: &'static str,
     },
+    /// A `.vox` cell wider than [`vox::MAX_VOX_SCALE`] raster voxels.
+    #[error(
+        "{loc}: vox cell: {voxels} raster voxels across, more than {}; give a coarser --raster or a smaller cell",
+        vox::MAX_VOX_SCALE
+    )]
+    VoxCell {
+        /// Where the model is placed.
+        loc: SourceLoc,
+        /// Raster voxels per cell.
+        voxels: f64,
+    },
     /// The exact record count exceeds the memory limit.
     #[error("raster {dims}: the scene has {records} surface voxels; plane, directory, records and object table need {}{}, more than the limit of {}; use a smaller raster or a larger memory limit", Bytes(*needed), if *image > 0 { format!(" beside the image's {}", Bytes(*image)) } else { String::new() }, Bytes(*limit))]
     TooMuchMemory {

@@ -118,11 +118,17 @@ pub const MAX_VOX_SCALE: u32 = 4096;
 pub fn placement(v: &VoxObject, frame: &RasterFrame) -> Result<VoxPlacement, BuildError> {
     let scale = (v.cell / frame.voxel_size).round().max(1.0);
     if scale.is_nan() || scale > f64::from(MAX_VOX_SCALE) {
-        return Err(BuildError::out_of_range(&v.loc, "vox cell"));
+        return Err(BuildError::VoxCell {
+            loc: v.loc.clone(),
+            voxels: scale,
+        });
     }
     let o = frame.world_to_raster(v.position).floor();
     if !(o.is_finite() && o.abs().max_element() < f64::from(1u32 << 30)) {
-        return Err(BuildError::out_of_range(&v.loc, "vox position"));
+        return Err(BuildError::out_of_range(
+            &v.loc,
+            "vox model (its position, moved by the file's scene-graph translations)",
+        ));
     }
     Ok(VoxPlacement {
         offset: [o.x as i64, o.y as i64, o.z as i64],

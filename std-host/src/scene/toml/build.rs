@@ -123,7 +123,16 @@ impl Builder<'_> {
             return Err(self.err(cs, "camera.at", "equals camera.from"));
         }
         if view.up.cross(view.at - view.from).length_squared() == 0.0 {
-            return Err(self.err(cs, "camera.up", "parallel to the view direction"));
+            // A default `up` is not in the file: the view direction is
+            // what the file sets.
+            // (A key the file lacks is located at its table.)
+            let given = self.spans.value("camera.up") != self.spans.value("camera");
+            let msg = if given {
+                "parallel to the view direction (camera.at − camera.from)"
+            } else {
+                "the default [0, 0, 1] is parallel to the view direction (camera.at − camera.from); give camera.up"
+            };
+            return Err(self.err(cs, "camera.up", msg));
         }
         if !(view.angle > 0.0 && view.angle < 180.0) {
             return Err(self.err(cs, "camera.angle", "expected 0 < angle < 180"));
