@@ -59,7 +59,8 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// Reads the OBJ file at `path`; `name` names it in messages.
+/// Reads the OBJ file at `path`; `name` names it in messages. No memory
+/// limit beyond [`MAX_FILE_BYTES`] (the caller's: [`load_within`]).
 ///
 /// # Errors
 /// [`SceneError`]s naming the file (and line and column where there is
@@ -67,7 +68,7 @@ pub struct Mesh {
 /// parse, a non-finite coordinate, a mesh without faces or with more than
 /// [`MAX_TRIANGLES`] triangles.
 pub fn load(path: &Path, name: &str) -> Result<Mesh, SceneError> {
-    load_within(path, name, crate::memory::default_max_memory())
+    load_within(path, name, u64::MAX)
 }
 
 /// [`load`], refusing a file whose text, or whose elements once read
@@ -344,12 +345,13 @@ impl BufRead for Counting<'_> {
     }
 }
 
-/// Parses OBJ text; `file` names it in messages.
+/// Parses OBJ text; `file` names it in messages, with no memory limit
+/// (the same answer on every machine; the caller's: [`parse_within`]).
 ///
 /// # Errors
 /// As [`load`], less the file-system errors.
 pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
-    parse_within(file, text, crate::memory::default_max_memory())
+    parse_within(file, text, u64::MAX)
 }
 
 /// [`parse`], refusing text whose elements would take more than
