@@ -2,6 +2,11 @@
 //! temporary name in the target's own directory, flushed and synced, and
 //! renamed over the target only when complete.
 //!
+//! The temporary file exists only while the output is written: creating
+//! an [`AtomicFile`] checks that it can be made (creates and removes it),
+//! so an unwritable target fails before any work, and the first write
+//! makes it again. A process killed outright (SIGKILL, the out-of-memory
+//! killer) while it computes the output therefore leaves nothing behind.
 //! An [`AtomicFile`] that is dropped before [`AtomicFile::commit`] (an
 //! error on the way) removes its temporary file. [`remove_on_interrupt`]
 //! installs a SIGINT/SIGTERM (Ctrl-C) handler that removes every pending
@@ -74,9 +79,11 @@ pub struct AtomicFile {
 const NAME_MAX: usize = 255;
 
 impl AtomicFile {
-    /// Creates the temporary file `NAME.PID-N.tmp` in `target`'s
-    /// directory (`N` counts the outputs of this process; `.rrt.PID-N.tmp`
-    /// when that would be longer than 255 bytes).
+    /// An output to `target`, written under the temporary name
+    /// `NAME.PID-N.tmp` in its directory (`N` counts the outputs of this
+    /// process; `.rrt.PID-N.tmp` when that would be longer than 255
+    /// bytes). The temporary file is created and removed here, to check
+    /// that it can be, and created again by the first [`AtomicFile::file`].
     ///
     /// # Errors
     /// `target` is a directory or has no file name, or the temporary file
@@ -109,20 +116,27 @@ impl AtomicFile {
         };
         tmp_name.push(suffix);
         let tmp = target.with_file_name(tmp_name);
-        // Registered before it exists, so an interruption between the two
-        // cannot leave it behind.
-        let mut list = pending();
-        list.push(tmp.clone());
-        let file = File::options().write(true).create_new(true).open(&tmp);
-        if file.is_err() {
-            list.retain(|p| *p != tmp);
-        }
-        drop(list);
-        Ok(Self {
+        let mut out = Self {
             target: target.to_path_buf(),
             tmp,
-            file: Some(file?),
-        })
+            file: None,
+        };
+        out.open()?;
+        out.discard();
+        Ok(out)
+    }
+
+    /// Creates the temporary file, registered before it exists so that an
+    /// interruption between the two cannot leave it behind.
+    fn open(&mut self) -> io::Result<&mut File> {
+        let mut list = pending();
+        list.push(self.tmp.clone());
+        let file = File::options().write(true).create_new(true).open(&self.tmp);
+        if file.is_err() {
+            list.retain(|p| *p != self.tmp);
+        }
+        drop(list);
+        Ok(self.file.insert(file?))
     }
 
     /// The target path.
@@ -137,22 +151,30 @@ impl AtomicFile {
         &self.tmp
     }
 
-    /// The open temporary file.
+    /// The temporary file, created on the first call.
     ///
-    /// # Panics
-    /// Never: the file is only taken by `commit`, which consumes `self`.
-    pub fn file(&mut self) -> &mut File {
-        self.file.as_mut().expect("open until committed")
+    /// # Errors
+    /// The temporary file cannot be created (the folder was removed or made
+    /// read-only since [`AtomicFile::create`]).
+    pub fn file(&mut self) -> io::Result<&mut File> {
+        match self.file {
+            Some(ref mut f) => Ok(f),
+            None => self.open(),
+        }
     }
 
-    /// Syncs the temporary file and renames it over the target (then
-    /// syncs the directory, where the platform allows).
+    /// Syncs the temporary file (created empty if nothing was written) and
+    /// renames it over the target (then syncs the directory, where the
+    /// platform allows).
     ///
     /// # Errors
     /// Syncing or renaming failed; the temporary file is removed and the
     /// target is untouched.
     pub fn commit(mut self) -> io::Result<()> {
-        let file = self.file.take().expect("open until committed");
+        self.file()?;
+        let Some(file) = self.file.take() else {
+            return Err(io::Error::other("the temporary file is not open"));
+        };
         if let Err(e) = file.sync_all() {
             self.discard();
             return Err(e);
@@ -227,13 +249,15 @@ mod tests {
         let target = d.join("x.bin");
         std::fs::write(&target, b"old").unwrap();
         let mut f = AtomicFile::create(&target).unwrap();
-        f.file().write_all(b"half").unwrap();
+        // Nothing beside the target until the first write.
+        assert_eq!(names(&d), ["x.bin"]);
+        f.file().unwrap().write_all(b"half").unwrap();
         assert_eq!(names(&d).len(), 2);
         drop(f);
         assert_eq!(std::fs::read(&target).unwrap(), b"old");
         assert_eq!(names(&d), ["x.bin"]);
         let mut f = AtomicFile::create(&target).unwrap();
-        f.file().write_all(b"new").unwrap();
+        f.file().unwrap().write_all(b"new").unwrap();
         f.commit().unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
         assert_eq!(names(&d), ["x.bin"]);
@@ -250,7 +274,7 @@ mod tests {
         for len in [243, 244, 250, 255] {
             let target = d.join(format!("{}.png", "a".repeat(len - 4)));
             let mut f = AtomicFile::create(&target).unwrap();
-            f.file().write_all(b"x").unwrap();
+            f.file().unwrap().write_all(b"x").unwrap();
             f.commit().unwrap();
             assert_eq!(std::fs::read(&target).unwrap(), b"x", "{len}");
         }

@@ -301,7 +301,7 @@ impl ImageOutput {
                 stdout.flush().map_err(io)
             }
             Target::File(mut file) => {
-                let mut w = BufWriter::with_capacity(1 << 20, file.file());
+                let mut w = BufWriter::with_capacity(1 << 20, file.file().map_err(io)?);
                 encode(self.format, self.encoding, &image, &mut w, &path)?;
                 w.flush().map_err(io)?;
                 drop(w);

@@ -530,7 +530,7 @@ fn save_trusting(
         what: "cannot write",
         source,
     };
-    let len = write_raster(scene, out.file(), progress, format, trust).map_err(io)?;
+    let len = write_raster(scene, out.file().map_err(io)?, progress, format, trust).map_err(io)?;
     out.commit().map_err(io)?;
     Ok(len)
 }
