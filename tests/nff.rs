@@ -346,6 +346,37 @@ fn huge_non_convex_polygons_are_refused_at_their_count() {
     assert_eq!(s.polygon_triangles(&s.polygons[0]).count(), n - 2);
 }
 
+/// The non-convex polygons of a scene share one budget of ear-clipping
+/// work, the squares of their vertex counts adding up to at most 2^32: a
+/// non-convex polygon of 65536 vertices spends it all, and the next
+/// non-convex polygon, however small, is refused at its vertex count.
+/// Convex polygons cost nothing.
+#[test]
+fn non_convex_polygons_share_one_budget() {
+    let n = rrt_host::scene::polygon::MAX_NONCONVEX_VERTICES;
+    let mut src = format!("f 1 1 1 0.2 0.3 20 0 0\np {n}\n");
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        let r = if k % 2 == 0 { 0.8 } else { 1.0 };
+        src += &format!("{} {} 0\n", r * a.cos(), r * a.sin());
+    }
+    src += "p 4\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n";
+    let comb_line = 9 + n + 1 + 4 + 1;
+    src += &format!("p {}\n", rrt_tests::COMB.len());
+    for (x, y) in rrt_tests::COMB {
+        src += &format!("{x} {y} 2\n");
+    }
+    assert_eq!(
+        err_body(&src),
+        format!(
+            "scene.nff:{comb_line}:3: polygon vertex count: non-convex, and cutting it into \
+             triangles would take the scene's non-convex polygons past their budget (the squares \
+             of their vertex counts may add up to 2^32, one polygon of 65536 vertices): split \
+             them into smaller polygons"
+        )
+    );
+}
+
 #[test]
 fn negative_radius_names_file_line_field() {
     assert_eq!(

@@ -62,12 +62,13 @@ pub fn check_scene(s: &Scene) -> Result<(), String> {
     for o in &s.tori {
         check_object(o, nm)?;
     }
+    let mut budget = super::polygon::CutBudget::scene();
     for p in &s.polygons {
         if p.material >= nm || p.count < 3 || s.vertices.get(p.range()).is_none() {
             return Err(format!("bad polygon {p:?}"));
         }
         // The cut is the one `polygon::cut` makes of the outline.
-        if super::polygon::cut(s.polygon_vertices(p)).as_ref() != Ok(&p.cut) {
+        if super::polygon::cut(s.polygon_vertices(p), &mut budget).as_ref() != Ok(&p.cut) {
             return Err(format!("polygon cut not its outline's: {p:?}"));
         }
         for i in p.range() {

@@ -67,6 +67,7 @@ use indicatif::ProgressBar;
 
 use super::error::{Found, SceneError};
 use super::loc::SourceLoc;
+use super::polygon::CutBudget;
 use super::text::{byte_loc, without_bom};
 use super::{Light, Material, Object, Polygon, Scene, View, ViewDefect};
 use crate::shape::{Cone, Sphere};
@@ -252,6 +253,8 @@ struct Builder {
     polygons: Vec<Polygon>,
     vertices: Vec<DVec3>,
     normals: Vec<DVec3>,
+    /// What cutting non-convex polygons may still cost.
+    cut_budget: CutBudget,
 }
 
 type R<T> = Result<T, SceneError>;
@@ -820,10 +823,12 @@ impl<'a> Parser<'a> {
             self.scene.normals.push(normal);
         }
         let vertices = self.scene.vertices.get(first..).unwrap_or_default();
-        let cut = super::polygon::cut(vertices).map_err(|problem| SceneError::Invalid {
-            loc: count_loc,
-            field: count_field,
-            problem,
+        let cut = super::polygon::cut(vertices, &mut self.scene.cut_budget).map_err(|problem| {
+            SceneError::Invalid {
+                loc: count_loc,
+                field: count_field,
+                problem,
+            }
         })?;
         let material = self.current_material();
         self.scene.polygons.push(Polygon {

@@ -37,6 +37,7 @@ use glam::DVec3;
 
 use super::error::SceneError;
 use super::loc::SourceLoc;
+use super::polygon::CutBudget;
 use super::text::{read_text, without_bom};
 
 /// The most vertices a face may have.
@@ -68,17 +69,24 @@ pub struct Mesh {
 /// parse, a non-finite coordinate, a mesh without faces or with more than
 /// [`MAX_TRIANGLES`] triangles.
 pub fn load(path: &Path, name: &str) -> Result<Mesh, SceneError> {
-    load_within(path, name, u64::MAX)
+    load_within(path, name, u64::MAX, &mut CutBudget::scene())
 }
 
 /// [`load`], refusing a file whose text, or whose elements once read
 /// ([`READ_BYTES`] per element), would take more than `max_memory` bytes,
-/// before they are read.
+/// before they are read, and cutting its non-convex faces from the
+/// scene's `budget`.
 ///
 /// # Errors
 /// As [`load`], and [`SceneError::FileTooLarge`] or
-/// [`SceneError::TooMuchMemory`] for the memory limit.
-pub fn load_within(path: &Path, name: &str, max_memory: u64) -> Result<Mesh, SceneError> {
+/// [`SceneError::TooMuchMemory`] for the memory limit, a
+/// [`SceneError::Invalid`] face beyond the budget.
+pub fn load_within(
+    path: &Path,
+    name: &str,
+    max_memory: u64,
+    budget: &mut CutBudget,
+) -> Result<Mesh, SceneError> {
     let name: Arc<str> = Arc::from(name);
     let text = read_text(path, &name, "an OBJ mesh", MAX_FILE_BYTES.min(max_memory)).map_err(
         |e| match e {
@@ -94,7 +102,7 @@ pub fn load_within(path: &Path, name: &str, max_memory: u64) -> Result<Mesh, Sce
             e => e,
         },
     )?;
-    parse_within(&name, &text, max_memory)
+    parse_within(&name, &text, max_memory, budget)
 }
 
 /// Bytes that reading an OBJ file into a scene takes per element, beside
@@ -351,15 +359,21 @@ impl BufRead for Counting<'_> {
 /// # Errors
 /// As [`load`], less the file-system errors.
 pub fn parse(file: &str, text: &str) -> Result<Mesh, SceneError> {
-    parse_within(file, text, u64::MAX)
+    parse_within(file, text, u64::MAX, &mut CutBudget::scene())
 }
 
 /// [`parse`], refusing text whose elements would take more than
-/// `max_memory` bytes with it ([`load_within`]).
+/// `max_memory` bytes with it, and cutting its non-convex faces from the
+/// scene's `budget` ([`load_within`]).
 ///
 /// # Errors
 /// As [`load_within`], less the file-system errors.
-pub fn parse_within(file: &str, text: &str, max_memory: u64) -> Result<Mesh, SceneError> {
+pub fn parse_within(
+    file: &str,
+    text: &str,
+    max_memory: u64,
+    budget: &mut CutBudget,
+) -> Result<Mesh, SceneError> {
     let file: Arc<str> = Arc::from(file);
     // tobj takes `\u{feff}v` for an unknown statement and drops that
     // vertex, renumbering every one after it.
@@ -500,7 +514,7 @@ pub fn parse_within(file: &str, text: &str, max_memory: u64) -> Result<Mesh, Sce
                     .unwrap_or(u32::MAX)
             };
             // A face has at most MAX_FACE_VERTICES vertices (`prescan`).
-            let cut = super::polygon::cut(&face)
+            let cut = super::polygon::cut(&face, budget)
                 .map_err(|problem| invalid(&file, 1, 1, "face", problem))?;
             mesh.triangles
                 .extend(super::polygon::triangles(&face, cut.as_deref()).map(|t| t.map(off)));
@@ -560,8 +574,17 @@ mod tests {
     fn meshes_keep_the_memory_limit() {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 3\n";
         // 40 bytes of text, 3 vertices (36 bytes), 6 corners (576 bytes).
-        assert_eq!(parse_within("t.obj", text, 652).unwrap().triangles.len(), 2);
-        let e = parse_within("t.obj", text, 651).unwrap_err().to_string();
+        let budget = &mut CutBudget::scene();
+        assert_eq!(
+            parse_within("t.obj", text, 652, budget)
+                .unwrap()
+                .triangles
+                .len(),
+            2
+        );
+        let e = parse_within("t.obj", text, 651, budget)
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             e,
             "t.obj: 3 vertex, normal and texture lines and 6 face corners take about 652 B to read, more than the memory limit of 651 B (--max-memory)"
@@ -570,7 +593,9 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("t.obj");
         std::fs::write(&p, text).unwrap();
-        let e = load_within(&p, "t.obj", 39).unwrap_err().to_string();
+        let e = load_within(&p, "t.obj", 39, &mut CutBudget::scene())
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             e,
             "t.obj: its 40 bytes of text take about 40 B to read, more than the memory limit of 39 B (--max-memory)"

@@ -21,8 +21,11 @@
 //! are what ear clipping makes of it.
 //!
 //! The front-ends cut each polygon once, as they read it, and refuse a
-//! non-convex one of more than [`MAX_NONCONVEX_VERTICES`] vertices (the
-//! cut's memory and time grow with the vertex count).
+//! non-convex one of more than [`MAX_NONCONVEX_VERTICES`] vertices, or one
+//! that would take the scene's non-convex polygons past their
+//! [`CutBudget`]: ear clipping may take time quadratic in the vertex count
+//! (a spiral of 65,536 vertices takes seconds), so the budget bounds the
+//! time a scene file can ask for.
 //!
 //! [`Scene::polygon_triangles`]: super::Scene::polygon_triangles
 
@@ -30,6 +33,51 @@ use glam::DVec3;
 
 /// The most vertices a non-convex polygon may have.
 pub const MAX_NONCONVEX_VERTICES: usize = 1 << 16;
+
+/// The ear-clipping work one scene's non-convex polygons may ask for: the
+/// squares of their vertex counts add up to at most [`CutBudget::SCENE`]
+/// (one polygon of [`MAX_NONCONVEX_VERTICES`] vertices; on this project's
+/// machines the slowest outline of that size, a spiral, is cut in about
+/// 15 s, a comb in 0.2 s). Convex polygons, whose fan is their cut, cost nothing.
+/// One budget covers a whole scene: an NFF file, or a TOML scene with its
+/// polygons and every OBJ mesh it loads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CutBudget {
+    left: u64,
+}
+
+impl Default for CutBudget {
+    fn default() -> Self {
+        Self::scene()
+    }
+}
+
+impl CutBudget {
+    /// The whole budget of one scene (2^32).
+    pub const SCENE: u64 = 1 << 32;
+
+    /// A scene's whole budget.
+    #[must_use]
+    pub const fn scene() -> Self {
+        Self { left: Self::SCENE }
+    }
+
+    /// Spends the work of cutting a non-convex polygon of `n` vertices.
+    fn spend(&mut self, n: usize) -> Result<(), &'static str> {
+        let n = u64::try_from(n).unwrap_or(u64::MAX);
+        match self.left.checked_sub(n.saturating_mul(n)) {
+            Some(left) => {
+                self.left = left;
+                Ok(())
+            }
+            None => Err(
+                "non-convex, and cutting it into triangles would take the scene's non-convex \
+                 polygons past their budget (the squares of their vertex counts may add up to \
+                 2^32, one polygon of 65536 vertices): split them into smaller polygons",
+            ),
+        }
+    }
+}
 
 /// The polygon's normal by Newell's method (twice its area vector): the
 /// side its vertices wind counter-clockwise about, for a non-convex
@@ -67,8 +115,12 @@ fn fan_is_exact(v: &[DVec3], normal: DVec3) -> bool {
 ///
 /// # Errors
 /// A non-convex polygon of more than [`MAX_NONCONVEX_VERTICES`]
-/// vertices, with the problem for the front-end's message at it.
-pub(crate) fn cut(v: &[DVec3]) -> Result<Option<Box<[[u32; 3]]>>, &'static str> {
+/// vertices, or one that `budget` has no room for, with the problem for
+/// the front-end's message at it.
+pub(crate) fn cut(
+    v: &[DVec3],
+    budget: &mut CutBudget,
+) -> Result<Option<Box<[[u32; 3]]>>, &'static str> {
     let normal = newell_normal(v);
     if fan_is_exact(v, normal) {
         return Ok(None);
@@ -79,6 +131,7 @@ pub(crate) fn cut(v: &[DVec3]) -> Result<Option<Box<[[u32; 3]]>>, &'static str> 
                     polygon may have): split it into smaller polygons",
         );
     }
+    budget.spend(v.len())?;
     // Indices fit in u32: at most MAX_NONCONVEX_VERTICES vertices.
     let index = |k: usize| u32::try_from(k).unwrap_or(u32::MAX);
     Ok(Some(match ears(v, normal) {
@@ -188,7 +241,7 @@ pub(crate) mod tests {
 
     /// The triangles of `v` as the front-ends cut it.
     fn cut_into(v: &[DVec3]) -> Vec<[usize; 3]> {
-        let c = cut(v).unwrap();
+        let c = cut(v, &mut CutBudget::scene()).unwrap();
         triangles(v, c.as_deref()).collect()
     }
 
@@ -377,7 +430,7 @@ pub(crate) mod tests {
         let tris = cut_into(&big);
         assert_eq!(tris.len(), big.len() - 2);
         let bigger = gear(MAX_NONCONVEX_VERTICES / 4 + 1);
-        let e = cut(&bigger).unwrap_err();
+        let e = cut(&bigger, &mut CutBudget::scene()).unwrap_err();
         assert!(
             e.contains(&format!("more than {MAX_NONCONVEX_VERTICES} vertices")),
             "{e}"
@@ -389,6 +442,31 @@ pub(crate) mod tests {
                 DVec3::new(a.cos(), a.sin(), 0.0)
             })
             .collect();
-        assert_eq!(cut(&round), Ok(None));
+        assert_eq!(cut(&round, &mut CutBudget::scene()), Ok(None));
+    }
+
+    /// The budget is spent by the non-convex polygons only, by the square
+    /// of their vertex counts, and refuses the first it has no room for.
+    #[test]
+    fn non_convex_polygons_spend_the_scene_budget() {
+        let comb: Vec<DVec3> = COMB.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
+        let square: Vec<DVec3> = COMB[..2]
+            .iter()
+            .chain(&[(4.0, 4.0), (0.0, 4.0)])
+            .map(|&(x, y)| DVec3::new(x, y, 0.0))
+            .collect();
+        let mut budget = CutBudget { left: 3 * 12 * 12 };
+        for _ in 0..3 {
+            assert!(cut(&comb, &mut budget).unwrap().is_some());
+            assert_eq!(cut(&square, &mut budget), Ok(None));
+        }
+        assert_eq!(budget.left, 0);
+        let e = cut(&comb, &mut budget).unwrap_err();
+        assert!(e.contains("budget") && e.contains("2^32"), "{e}");
+        assert_eq!(cut(&square, &mut budget), Ok(None));
+        // The whole budget holds one of the largest non-convex polygons.
+        let mut budget = CutBudget::scene();
+        budget.spend(MAX_NONCONVEX_VERTICES).unwrap();
+        assert!(budget.spend(3).is_err());
     }
 }

@@ -15,6 +15,7 @@ use super::spans::Spans;
 use crate::scene::error::SceneError;
 use crate::scene::loc::SourceLoc;
 use crate::scene::objects::SceneVolume;
+use crate::scene::polygon::CutBudget;
 use crate::scene::text::byte_loc;
 use crate::scene::{Light, Material, Polygon, Scene, View};
 
@@ -32,6 +33,9 @@ pub(super) struct Builder<'t> {
     pub(super) volumes: BTreeMap<String, SceneVolume>,
     /// Bytes the samples of the volumes read so far take.
     pub(super) volume_bytes: Cell<u64>,
+    /// What cutting non-convex polygons, the scene's and its meshes', may
+    /// still cost.
+    pub(super) cut_budget: Cell<CutBudget>,
 }
 
 /// The vector, if its numbers are finite and within
@@ -296,8 +300,10 @@ impl Builder<'_> {
         span: &std::ops::Range<usize>,
     ) -> Result<(), SceneError> {
         self.room_for_vertices(scene, vertices.len(), span, "object")?;
-        let cut = super::super::polygon::cut(vertices)
+        let mut budget = self.cut_budget.get();
+        let cut = super::super::polygon::cut(vertices, &mut budget)
             .map_err(|problem| self.err(span.clone(), "object", problem))?;
+        self.cut_budget.set(budget);
         let first = scene.vertices.len();
         scene.vertices.extend_from_slice(vertices);
         match normals {

@@ -256,8 +256,10 @@ impl Builder<'_> {
         let (path, shown) = self.path(&m.file, "object.mesh.file")?;
         // What the scene's volumes and vertices leave of the limit.
         let left = self.opts.max_memory.saturating_sub(self.data_bytes(scene));
-        let mesh = obj::load_within(&path, &shown, left)
+        let mut budget = self.cut_budget.get();
+        let mesh = obj::load_within(&path, &shown, left, &mut budget)
             .map_err(|e| self.err(m.file.span(), "object.mesh.file", with_causes(&e)))?;
+        self.cut_budget.set(budget);
         self.room_for_vertices(
             scene,
             mesh.triangles.len().saturating_mul(3),
