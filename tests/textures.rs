@@ -269,6 +269,21 @@ fn solid_textures() {
         m.world_color(DVec3::new(4.0, 0.0, 0.0), UP, [0; 3]),
         [130, 130, 145]
     );
+    // Its origin moves the pattern: the marble from (1, 0, 0) at p is the
+    // marble from the world origin at p − (1, 0, 0).
+    let moved = Marble::new(1, DVec3::X, 4.0, 1.0, 0.0, 4, [vein, stone])
+        .unwrap()
+        .with_origin(DVec3::X)
+        .unwrap();
+    assert_eq!(
+        moved.world_color(DVec3::new(2.0, 5.0, -3.0), UP, [0; 3]),
+        stone
+    );
+    assert_eq!(
+        moved.world_color(DVec3::new(4.0, 0.0, 0.0), UP, [0; 3]),
+        vein
+    );
+    assert!(m.clone().with_origin(DVec3::NAN).is_err());
     // With turbulence the veins wander: colours differ off the lattice,
     // depend on the seed, and stay between the two colours.
     let t1 = Marble::new(1, DVec3::X, 4.0, 0.7, 3.0, 5, [vein, stone]).unwrap();

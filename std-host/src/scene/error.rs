@@ -8,14 +8,19 @@ use std::sync::Arc;
 use super::loc::SourceLoc;
 
 /// `e`'s message followed by those of its causes, each after `: ` (an
-/// I/O error's reason, a decoder's), for errors a TOML scene reports as
-/// text at the key that names the file.
+/// I/O error's reason, a decoder's; a cause its error already ends with
+/// once), for errors a TOML scene reports as text at the key that names
+/// the file.
 pub(crate) fn with_causes(e: &(dyn std::error::Error + 'static)) -> String {
     let mut msg = e.to_string();
     let mut cause = e.source();
     while let Some(c) = cause {
-        msg.push_str(": ");
-        msg.push_str(&c.to_string());
+        // A cause its error already quotes at its end is said once.
+        let text = c.to_string();
+        if !msg.ends_with(&text) {
+            msg.push_str(": ");
+            msg.push_str(&text);
+        }
         cause = c.source();
     }
     msg

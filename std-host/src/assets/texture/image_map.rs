@@ -234,12 +234,56 @@ impl ImageTexture {
     /// [`MAX_IMAGE_PIXELS`] (refused from its header), [`TextureError::Decode`]
     /// for a damaged one, [`TextureError::Invalid`] for a bad mapping.
     pub fn open(path: impl AsRef<Path>, mapping: Mapping) -> Result<Self, TextureError> {
+        Self::open_within(path, mapping, u64::MAX)
+    }
+
+    /// [`ImageTexture::open`], refusing an image that would take more than
+    /// `max_memory` bytes while it is read and decoded (the file, the
+    /// decoder's pixels and the texture's: [`ImageTexture::decode_bytes`]),
+    /// told from the file's size and the image's header before its pixels
+    /// are decoded.
+    ///
+    /// # Errors
+    /// As [`ImageTexture::open`], and [`TextureError::TooMuchMemory`].
+    pub fn open_within(
+        path: impl AsRef<Path>,
+        mapping: Mapping,
+        max_memory: u64,
+    ) -> Result<Self, TextureError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|source| TextureError::Io {
+        let io = |source| TextureError::Io {
             path: path.to_path_buf(),
             source,
-        })?;
-        Self::from_bytes(path, &bytes, mapping)
+        };
+        let size = std::fs::metadata(path).map_err(io)?.len();
+        if size > max_memory {
+            return Err(TextureError::TooMuchMemory {
+                path: path.to_path_buf(),
+                what: format!("its {size} bytes"),
+                bytes: size,
+                limit: max_memory,
+            });
+        }
+        let bytes = std::fs::read(path).map_err(io)?;
+        Self::decode_within(path, &bytes, mapping, max_memory)
+    }
+
+    /// Bytes that decoding a `width`×`height` image whose decoder gives
+    /// `decoded` bytes of pixels takes at its peak, beside the file's
+    /// bytes: the decoder's pixels, their 8-bit RGB form and the
+    /// texture's pixels (3 bytes each).
+    #[must_use]
+    pub fn decode_bytes(width: u32, height: u32, decoded: u64) -> u64 {
+        let rgb = u64::from(width)
+            .saturating_mul(u64::from(height))
+            .saturating_mul(3);
+        decoded.saturating_add(rgb.saturating_mul(2))
+    }
+
+    /// The bytes the texture's pixels take.
+    #[must_use]
+    pub fn bytes(&self) -> u64 {
+        (self.pixels.len() as u64).saturating_mul(3)
     }
 
     /// Decodes a PNG or JPEG held in memory, named `path` in errors.
@@ -247,6 +291,17 @@ impl ImageTexture {
     /// # Errors
     /// As [`ImageTexture::open`].
     pub fn from_bytes(path: &Path, bytes: &[u8], mapping: Mapping) -> Result<Self, TextureError> {
+        Self::decode_within(path, bytes, mapping, u64::MAX)
+    }
+
+    /// [`ImageTexture::from_bytes`] within `max_memory`, `bytes` included
+    /// ([`ImageTexture::open_within`]).
+    fn decode_within(
+        path: &Path,
+        bytes: &[u8],
+        mapping: Mapping,
+        max_memory: u64,
+    ) -> Result<Self, TextureError> {
         let format = match image::guess_format(bytes) {
             Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => f,
             Ok(other) => {
@@ -284,7 +339,10 @@ impl ImageTexture {
             source,
         };
         // The size from the header, before anything is decoded.
-        let (width, height) = reader().into_dimensions().map_err(decode_err)?;
+        let decoder = reader().into_decoder().map_err(decode_err)?;
+        let (width, height) = image::ImageDecoder::dimensions(&decoder);
+        let decoded = image::ImageDecoder::total_bytes(&decoder);
+        drop(decoder);
         if u64::from(width) * u64::from(height) > MAX_IMAGE_PIXELS {
             return Err(TextureError::TooLarge {
                 path: path.to_path_buf(),
@@ -292,14 +350,24 @@ impl ImageTexture {
                 height,
             });
         }
-        let img = reader().decode().map_err(decode_err)?;
-        let rgb = img.to_rgb8();
-        Self::from_rgb(
-            rgb.width(),
-            rgb.height(),
-            rgb.pixels().map(|p| p.0).collect(),
-            mapping,
-        )
+        let need = (bytes.len() as u64).saturating_add(Self::decode_bytes(width, height, decoded));
+        if need > max_memory {
+            return Err(TextureError::TooMuchMemory {
+                path: path.to_path_buf(),
+                what: format!("the {width}×{height} image"),
+                bytes: need,
+                limit: max_memory,
+            });
+        }
+        let rgb = reader().decode().map_err(decode_err)?.into_rgb8();
+        let (width, height) = rgb.dimensions();
+        let pixels = rgb
+            .as_raw()
+            .chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
+        drop(rgb);
+        Self::from_rgb(width, height, pixels, mapping)
     }
 
     /// An image from its pixels (row 0 at the top, `width` per row).

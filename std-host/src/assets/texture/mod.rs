@@ -86,6 +86,24 @@ pub enum TextureError {
         /// Its height in pixels.
         height: u32,
     },
+    /// Reading and decoding the image would take more memory than the
+    /// limit: refused from the file's size and the image's header.
+    #[error(
+        "{}: {what} takes about {} to read and decode, more than the memory limit of {} (--max-memory)",
+        path.display(),
+        crate::memory::Bytes(*bytes),
+        crate::memory::Bytes(*limit)
+    )]
+    TooMuchMemory {
+        /// The file.
+        path: PathBuf,
+        /// What takes the memory (`the 4096×4096 image`).
+        what: String,
+        /// The bytes it takes.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
+    },
     /// A parameter is unusable.
     #[error("{what}: {msg}")]
     Invalid {

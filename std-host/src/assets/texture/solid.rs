@@ -190,11 +190,13 @@ fn check_noise_params(
     Ok(())
 }
 
-/// Marble: veins across `direction`, `sin(2π·(p·d)/period + turbulence ·
-/// turb(p/noise_scale))`, mapped from `[-1, 1]` onto `vein` … `stone`.
+/// Marble: veins across `direction`, `sin(2π·(q·d)/period + turbulence ·
+/// turb(q/noise_scale))` of `q = p − origin`, mapped from `[-1, 1]` onto
+/// `vein` … `stone`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Marble {
     noise: Perlin,
+    origin: DVec3,
     direction: DVec3,
     period: f64,
     noise_scale: f64,
@@ -230,6 +232,7 @@ impl Marble {
         })?;
         Ok(Self {
             noise: Perlin::new(seed),
+            origin: DVec3::ZERO,
             direction,
             period,
             noise_scale,
@@ -240,10 +243,26 @@ impl Marble {
     }
 }
 
+impl Marble {
+    /// The same marble with its pattern moved from the world origin to
+    /// `origin` (the default is the world origin).
+    ///
+    /// # Errors
+    /// [`TextureError::Invalid`] for an origin that is not finite.
+    pub fn with_origin(mut self, origin: DVec3) -> Result<Self, TextureError> {
+        if !origin.is_finite() {
+            return Err(invalid("marble", format!("origin {origin} is not finite")));
+        }
+        self.origin = origin;
+        Ok(self)
+    }
+}
+
 impl WorldTexture for Marble {
     fn world_color(&self, p: DVec3, _n: DVec3, _base: [u8; 3]) -> [u8; 3] {
-        let t = self.noise.turbulence(p / self.noise_scale, self.octaves);
-        let s = (TAU * p.dot(self.direction) / self.period + self.turbulence * t).sin();
+        let q = p - self.origin;
+        let t = self.noise.turbulence(q / self.noise_scale, self.octaves);
+        let s = (TAU * q.dot(self.direction) / self.period + self.turbulence * t).sin();
         mix(self.colors[0], self.colors[1], (s + 1.0) / 2.0)
     }
 }

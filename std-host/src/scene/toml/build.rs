@@ -33,6 +33,8 @@ pub(super) struct Builder<'t> {
     pub(super) volumes: BTreeMap<String, SceneVolume>,
     /// Bytes the samples of the volumes read so far take.
     pub(super) volume_bytes: Cell<u64>,
+    /// Bytes the pixels of the image textures read so far take.
+    pub(super) texture_bytes: Cell<u64>,
     /// What cutting non-convex polygons, the scene's and its meshes', may
     /// still cost.
     pub(super) cut_budget: Cell<CutBudget>,
@@ -244,7 +246,15 @@ impl Builder<'_> {
     pub(super) fn data_bytes(&self, scene: &Scene) -> u64 {
         (scene.vertices.len() as u64)
             .saturating_mul(super::VERTEX_BYTES)
-            .saturating_add(self.volume_bytes.get())
+            .saturating_add(self.asset_bytes())
+    }
+
+    /// Bytes the samples of the volumes and the pixels of the image
+    /// textures read so far take.
+    pub(super) fn asset_bytes(&self) -> u64 {
+        self.volume_bytes
+            .get()
+            .saturating_add(self.texture_bytes.get())
     }
 
     pub(super) fn room_for_vertices(
@@ -265,20 +275,21 @@ impl Builder<'_> {
                 ),
             ));
         }
+        let held = self.asset_bytes();
         let bytes = (total as u64)
             .saturating_mul(super::VERTEX_BYTES)
-            .saturating_add(self.volume_bytes.get());
+            .saturating_add(held);
         if bytes > self.opts.max_memory {
             return Err(self.err(
                 span.clone(),
                 key,
                 format!(
                     "{total} vertices take {}{}, more than the memory limit of {} (--max-memory)",
-                    crate::memory::Bytes(bytes - self.volume_bytes.get()),
-                    if self.volume_bytes.get() > 0 {
+                    crate::memory::Bytes(bytes - held),
+                    if held > 0 {
                         format!(
-                            " beside the volumes' {}",
-                            crate::memory::Bytes(self.volume_bytes.get())
+                            " beside the {} of the volumes and textures",
+                            crate::memory::Bytes(held)
                         )
                     } else {
                         String::new()

@@ -6,7 +6,7 @@ use glam::DVec3;
 use super::build::Builder;
 use super::schema::{MaterialDef, NoiseDef, TextureDef};
 use crate::assets::texture::{
-    AnyTexture, Blend, Checker, ImageTexture, Mapping, Marble, Wood, Wrap,
+    AnyTexture, Blend, Checker, ImageTexture, Mapping, Marble, TextureError, Wood, Wrap,
 };
 use crate::scene::error::{SceneError, with_causes};
 use crate::scene::objects::{SceneTexture, TextureKind};
@@ -125,6 +125,7 @@ impl Builder<'_> {
                 Checker::new(origin, size, c.colours.map(|c| c.0)).map_err(bad("checker"))?,
             )
         } else if let Some(m) = &d.marble {
+            let origin = self.vec3(&s, &k("marble.origin"), m.origin)?;
             let dir = direction(m.direction, "marble.direction")?;
             noise(m, "marble")?;
             AnyTexture::Marble(
@@ -137,6 +138,7 @@ impl Builder<'_> {
                     m.octaves,
                     m.colours.map(|c| c.0),
                 )
+                .and_then(|m| m.with_origin(origin))
                 .map_err(bad("marble"))?,
             )
         } else if let Some(w) = &d.wood {
@@ -201,8 +203,30 @@ impl Builder<'_> {
                 }
             };
             let (path, _) = self.path(&i.file, &k("image.file"))?;
-            let img = ImageTexture::open(&path, mapping)
-                .map_err(|e| self.err(i.file.span(), &k("image.file"), with_causes(&e)))?;
+            // What the volumes and textures read before leave of the
+            // memory limit.
+            let left = self.opts.max_memory.saturating_sub(self.asset_bytes());
+            let held = self.asset_bytes();
+            let img = ImageTexture::open_within(&path, mapping, left).map_err(|e| {
+                let msg = match &e {
+                    // Said against the whole limit, beside what is held.
+                    TextureError::TooMuchMemory {
+                        path, what, bytes, ..
+                    } if held > 0 => format!(
+                        "{}: {what} takes about {} to read and decode, beside the {} of the \
+                         volumes and textures read before: more than the memory limit of {} \
+                         (--max-memory)",
+                        path.display(),
+                        crate::memory::Bytes(*bytes),
+                        crate::memory::Bytes(held),
+                        crate::memory::Bytes(self.opts.max_memory)
+                    ),
+                    _ => with_causes(&e),
+                };
+                self.err(i.file.span(), &k("image.file"), msg)
+            })?;
+            self.texture_bytes
+                .set(self.texture_bytes.get().saturating_add(img.bytes()));
             AnyTexture::Image(img.with_wrap(wrap))
         } else {
             return Err(self.err(s, key, "no texture"));

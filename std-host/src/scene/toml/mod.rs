@@ -163,6 +163,7 @@ pub fn parse(file: &str, text: &str, dir: &Path, opts: &Options) -> Result<Scene
         materials: BTreeMap::new(),
         volumes: BTreeMap::new(),
         volume_bytes: std::cell::Cell::new(0),
+        texture_bytes: std::cell::Cell::new(0),
         cut_budget: std::cell::Cell::new(super::polygon::CutBudget::scene()),
     }
     .build(&doc)

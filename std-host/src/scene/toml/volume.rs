@@ -48,8 +48,9 @@ impl Builder<'_> {
         key: &dyn Fn(&str) -> String,
     ) -> Result<Volume, SceneError> {
         let s = s.clone();
-        // What the volumes read before leave of the memory limit.
-        let left = self.opts.max_memory.saturating_sub(self.volume_bytes.get());
+        // What the volumes and textures read before leave of the memory
+        // limit.
+        let left = self.opts.max_memory.saturating_sub(self.asset_bytes());
         let limits = volume::Limits {
             max_bytes: self.opts.volume.max_bytes.min(left),
             ..self.opts.volume
@@ -67,14 +68,14 @@ impl Builder<'_> {
                     bytes,
                     ..
                 } if left < self.opts.volume.max_bytes => {
-                    let held = self.volume_bytes.get();
+                    let held = self.asset_bytes();
                     format!(
                         "{}{at}: sizes {dims} of {ty} take {}{}, more than the memory limit of {} (--max-memory)",
                         path.display(),
                         crate::memory::Bytes(*bytes),
                         if held > 0 {
                             format!(
-                                " beside the scene's other volumes' {}",
+                                " beside the {} of the volumes and textures read before",
                                 crate::memory::Bytes(held)
                             )
                         } else {
