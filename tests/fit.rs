@@ -260,3 +260,44 @@ fn a_volume_alone_gets_the_pixel_footprint_raster() {
     );
     assert_eq!(r, 32 * 8 + 4);
 }
+
+/// A spindle torus (its tube wider than its distance from the axis) is
+/// about the size of a sphere of the tube's radius, and gets about that
+/// sphere's default raster, not the largest (its area, taken as the ring
+/// torus's `4π²·R·r`, would vanish with `R`).
+#[test]
+fn a_spindle_torus_gets_a_sphere_sized_raster() {
+    use rrt_host::fit::{RasterNeed, default_raster};
+    let dir = rrt_tests::fresh_dir("fit", "spindle_torus");
+    let size = |shape: &str| {
+        let path = dir.join("t.toml");
+        std::fs::write(
+            &path,
+            format!(
+                "[camera]\nfrom = [0, -6, 2]\nat = [0, 0, 0]\nangle = 40\nresolution = [64, 64]\n\
+                 [material.m]\n[[object]]\nmaterial = \"m\"\n{shape}\n"
+            ),
+        )
+        .unwrap();
+        let scene = Scene::load(&path).unwrap();
+        default_raster(
+            &scene,
+            &RasterNeed {
+                view: &scene.view,
+                image: [64, 64],
+                samples: 1,
+                discrete: false,
+            },
+        )
+    };
+    let sphere = size("sphere = { centre = [0, 0, 0], radius = 1 }");
+    for major in ["1e-6", "0.1", "0.5"] {
+        let torus = size(&format!(
+            "torus = {{ centre = [0, 0, 0], axis = [0, 0, 1], major = {major}, minor = 1 }}"
+        ));
+        assert!(
+            torus <= 2 * sphere,
+            "major {major}: {torus} against the sphere's {sphere}"
+        );
+    }
+}

@@ -1274,21 +1274,91 @@ fn degenerate_solids_are_named_at_their_definition() {
             p.display()
         )
     );
-    // A leaf of a tree: at its [solid.NAME].
-    let solids = "[solid.a]\nsphere = { centre = [0,0,0], radius = 1 }\n[solid.b]\ncone = { base = [0,0,0], base_radius = 1, apex = [0,0,1e-300], apex_radius = 1 }\n";
+    // A leaf of a tree: at its shape's value in its [solid.NAME].
+    let leaf = "cone = { base = [0,0,0], base_radius = 1, apex = [0,0,1e-300], apex_radius = 1 }";
+    let solids =
+        format!("[solid.a]\nsphere = {{ centre = [0,0,0], radius = 1 }}\n[solid.b]\n{leaf}\n");
     let p = d.join("tree.toml");
-    let text = second_object("csg = { union = [\"a\", \"b\"] }", solids);
+    let text = second_object("csg = { union = [\"a\", \"b\"] }", &solids);
     std::fs::write(&p, &text).unwrap();
-    let line = text.lines().position(|l| l == "[solid.b]").unwrap() + 1;
+    let line = text.lines().position(|l| l == leaf).unwrap() + 1;
     let scene = Scene::load(&p).unwrap();
     let e = build(&scene, &BuildOptions::new(64), &ProgressBar::hidden())
         .err()
         .unwrap()
         .to_string();
     assert!(
-        e.starts_with(&format!("{}:{line}:", p.display())) && e.contains(": capped cone: too thin"),
+        e.starts_with(&format!("{}:{line}:8: capped cone: too thin", p.display())),
         "{e}"
     );
+}
+
+/// Every `[solid.NAME]` is checked, whether a tree uses it or not: a bad
+/// value, an unknown material or volume, a solid without a shape.
+#[test]
+fn unused_solids_are_checked() {
+    let cases = [
+        (
+            "cone = { base = [0,0,0], base_radius = nan, apex = [0,0,1], apex_radius = 1 }",
+            "solid.u.cone.base_radius",
+        ),
+        (
+            "material = \"nosuch\"\nsphere = { centre = [0,0,0], radius = 1 }",
+            "no [material.nosuch]",
+        ),
+        ("volume = \"nosuch\"", "no [volume.nosuch]"),
+        (
+            "",
+            "expected exactly one of sphere, box, cone, torus, volume",
+        ),
+    ];
+    for (body, want) in cases {
+        let msg = error_of("unused-solid", &one_object(&format!("[solid.u]\n{body}\n")));
+        assert!(
+            msg.contains(want) && msg.contains("solid.u"),
+            "{body}: {msg}"
+        );
+    }
+    // A solid without a material is fine: a tree gives it one.
+    let d = temp_dir("unused-solid-ok");
+    let p = d.join("ok.toml");
+    std::fs::write(
+        &p,
+        one_object("[solid.u]\nsphere = { centre = [0,0,0], radius = 1 }\n"),
+    )
+    .unwrap();
+    Scene::load(&p).unwrap();
+}
+
+/// A scene of one sphere, then `extra`.
+fn one_object(extra: &str) -> String {
+    format!(
+        "{CAMERA}[[light]]\nposition = [1, 1, 1]\n[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n{extra}"
+    )
+}
+
+/// A marble's `origin` moves its pattern; a non-finite one is refused at
+/// its key.
+#[test]
+fn marble_origin_moves_the_pattern() {
+    let marble = |origin: &str| {
+        format!(
+            "{CAMERA}[[light]]\nposition = [1, -4, 3]\n[material.m.texture.marble]\nperiod = 0.5\ncolours = [[20, 20, 60], [240, 240, 230]]\n{origin}\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n"
+        )
+    };
+    let image = |origin: &str| {
+        let d = temp_dir("marble-origin");
+        let p = d.join("m.toml");
+        std::fs::write(&p, marble(origin)).unwrap();
+        let scene = Scene::load(&p).unwrap();
+        let (vs, _) = build(&scene, &BuildOptions::new(24), &ProgressBar::hidden()).unwrap();
+        records(&vs)
+    };
+    let at_zero = image("");
+    assert_eq!(image("origin = [0, 0, 0]"), at_zero);
+    assert_ne!(image("origin = [0.1, 0.2, 0.3]"), at_zero);
+    let msg = error_of("marble-origin-nan", &marble("origin = [nan, 0, 0]"));
+    assert!(msg.contains("material.m.texture.marble.origin"), "{msg}");
 }
 
 /// An error of a file a scene refers to keeps its cause: the reason a
@@ -1456,4 +1526,50 @@ fn an_included_nff_file_needs_no_view() {
     assert_eq!(scene.view.from, glam::DVec3::new(0.0, -5.0, 1.0));
     let e = Scene::load(d.join("part.nff")).unwrap_err().to_string();
     assert!(e.contains("no view"), "{e}");
+}
+
+/// Image textures count against the memory limit like volumes and
+/// meshes: a 2048×2048 image (about 36 MiB to read and decode, 12 MiB
+/// kept) is refused under a 32 MiB limit before it is decoded, at its key;
+/// two of them do not fit 40 MiB, the first one's pixels held.
+#[test]
+fn image_textures_keep_the_memory_limit() {
+    let d = temp_dir("texture-memory");
+    image::RgbImage::from_pixel(2048, 2048, image::Rgb([90, 120, 150]))
+        .save(d.join("big.png"))
+        .unwrap();
+    let material = |name: &str| {
+        format!(
+            "[material.{name}.texture.image]\nfile = \"big.png\"\nplanar = {{ origin = [-1, 0, -1], u = [2, 0, 0], v = [0, 0, 2] }}\n"
+        )
+    };
+    let text = format!(
+        "{CAMERA}[[light]]\nposition = [1, 1, 1]\n{}{}[[object]]\nmaterial = \"a\"\nsphere = {{ centre = [0,0,0], radius = 1 }}\n",
+        material("a"),
+        material("b")
+    );
+    let p = d.join("t.toml");
+    std::fs::write(&p, &text).unwrap();
+    let load = |mib: u64| {
+        let opts = rrt_host::scene::toml::Options {
+            max_memory: mib << 20,
+            ..Default::default()
+        };
+        rrt_host::scene::toml::parse(&p.display().to_string(), &text, &d, &opts)
+    };
+    let e = load(32).unwrap_err().to_string();
+    assert!(
+        e.contains(":9:8: material.a.texture.image.file: ")
+            && e.contains("the 2048×2048 image takes about 36.")
+            && e.contains("more than the memory limit of 32.0 MiB"),
+        "{e}"
+    );
+    let e = load(40).unwrap_err().to_string();
+    assert!(
+        e.contains("material.b.texture.image.file: ")
+            && e.contains("beside the 12.0 MiB of the volumes and textures read before"),
+        "{e}"
+    );
+    let scene = load(128).unwrap();
+    assert_eq!(scene.textures.len(), 2);
 }

@@ -161,8 +161,7 @@ impl SurfaceMeasure {
             add(area, perimeter);
         }
         for t in &scene.tori {
-            let (big, small) = (t.shape.major, t.shape.minor);
-            add(4.0 * PI * PI * big * small, 0.0);
+            add(torus_area(t.shape.major, t.shape.minor), 0.0);
         }
         m
     }
@@ -177,6 +176,22 @@ impl SurfaceMeasure {
         SURFACE_VOXELS_PER_AREA
             * (self.area / (voxel * voxel) + self.perimeter / voxel + 3.0 * self.objects as f64)
     }
+}
+
+/// The area of the torus swept by a circle of radius `minor` about an
+/// axis at distance `major` from its centre: `4π²·R·r` for a ring torus
+/// (`R ≥ r`); for a spindle torus (`R < r`), whose tube passes through
+/// the axis, the area the sweep covers, `2π·r²·∫|c + cos v| dv` with
+/// `c = R/r` (`8π·r²`, a sphere twice, for `R = 0`).
+fn torus_area(major: f64, minor: f64) -> f64 {
+    if major >= minor {
+        return 4.0 * PI * PI * major * minor;
+    }
+    let c = (major / minor).max(0.0);
+    // The tube crosses the axis where cos v = −c.
+    let theta = (-c).acos();
+    let turn = 4.0 * c * theta + 4.0 * theta.sin() - 2.0 * PI * c;
+    2.0 * PI * minor * minor * turn
 }
 
 /// Upper-bound memory estimate for `scene` voxelized into `frame`,
@@ -223,5 +238,40 @@ pub fn estimate_memory(scene: &Scene, frame: &RasterFrame, solid_spheres: bool) 
         object_table: (measure.objects as u64).saturating_mul(OBJECT_BYTES),
         scene: scene.data_bytes(),
         image: 0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The torus's area is the sweep's, `2π·r·∫|R + r·cos v| dv`, for ring
+    /// and spindle tori alike: continuous where the tube touches the axis,
+    /// a sphere twice when it is centred on it.
+    #[test]
+    fn spindle_tori_have_the_area_of_their_sweep() {
+        let swept = |big: f64, small: f64| {
+            let n = 200_000;
+            let dv = 2.0 * PI / f64::from(n);
+            let sum: f64 = (0..n)
+                .map(|k| (big + small * ((f64::from(k) + 0.5) * dv).cos()).abs())
+                .sum();
+            2.0 * PI * small * sum * dv
+        };
+        for (big, small) in [
+            (2.0, 0.5),
+            (1.0, 1.0),
+            (0.3, 1.0),
+            (0.999, 1.0),
+            (1e-6, 1.0),
+            (0.0, 2.0),
+        ] {
+            let (a, b) = (torus_area(big, small), swept(big, small));
+            assert!(
+                (a - b).abs() <= 1e-6 * b,
+                "R {big}, r {small}: {a} against {b}"
+            );
+        }
+        assert!((torus_area(0.0, 1.0) - 8.0 * PI).abs() < 1e-12);
     }
 }

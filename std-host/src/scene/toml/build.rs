@@ -182,6 +182,12 @@ impl Builder<'_> {
             let sv = self.volume(name, v)?;
             self.volumes.insert(name.clone(), sv);
         }
+        // Every [solid.NAME] is checked, whether a tree uses it or not (a
+        // tree builds its leaves again where it names them). A solid
+        // without a material takes its tree's: none is asked for here.
+        for (name, def) in &doc.solid {
+            self.solid(doc, name, (&def.span(), &format!("solid.{name}")), Some(0))?;
+        }
         self.entry.set(None);
         for (i, o) in doc.object.iter().enumerate() {
             self.entry.set(Some(("object", i)));

@@ -167,10 +167,19 @@ impl Builder<'_> {
         } else {
             return Err(self.err(s, &key, "no shape"));
         };
+        // Located at the shape's value, as an object's shape is.
+        let which = match &shape {
+            Solid::Sphere(_) => "sphere",
+            Solid::Cuboid(_) => "box",
+            Solid::Cone(_) => "cone",
+            Solid::Torus(_) => "torus",
+            Solid::Volume(_) => "volume",
+        };
+        let at = self.spans.value(&format!("{key}.{which}")).unwrap_or(s);
         Ok(CsgLeaf {
             shape,
             material,
-            loc: self.loc(s),
+            loc: self.loc(at),
         })
     }
 
