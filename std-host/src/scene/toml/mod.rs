@@ -211,6 +211,13 @@ fn key_near(text: &str, at: usize) -> String {
     if !key.is_empty() && after[key.len()..].trim_start().starts_with('=') {
         if key == lead && line.trim().is_empty() {
             with_table(key)
+        } else if let Some(inner) = (!lead.is_empty())
+            .then(|| line.split_once('='))
+            .flatten()
+            .and_then(|(_, value)| inline_path(value))
+        {
+            // A key inside the line's inline tables: the path through them.
+            format!("{}{inner}.{key}", with_table(lead))
         } else {
             key.to_owned()
         }
@@ -223,6 +230,78 @@ fn key_near(text: &str, at: usize) -> String {
     } else {
         String::new()
     }
+}
+
+/// The path, from the value that `value` starts, to the inline table open
+/// at its end (`.sphere`, `.difference[1]`, empty at the value's own
+/// table): each open table adds the key it is the value of, each open
+/// array the index of its element; `None` when `value` is not inside an
+/// inline table.
+fn inline_path(value: &str) -> Option<String> {
+    // Open containers: an inline table or an array, with the path's
+    // length when it opened.
+    enum Open {
+        Table,
+        Array(usize),
+    }
+    let mut open: Vec<(Open, usize)> = Vec::new();
+    let mut path: Vec<String> = Vec::new();
+    let mut word = String::new();
+    let mut chars = value.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' | '\'' => {
+                // A quoted key or a string value: skipped whole.
+                let mut quoted = String::new();
+                let mut escaped = false;
+                for q in chars.by_ref() {
+                    if q == c && !escaped {
+                        break;
+                    }
+                    escaped = c == '"' && q == '\\' && !escaped;
+                    quoted.push(q);
+                }
+                word = quoted;
+            }
+            '=' => {
+                if matches!(open.last(), Some((Open::Table, _))) && !word.is_empty() {
+                    path.push(format!(".{}", std::mem::take(&mut word)));
+                }
+            }
+            '{' => open.push((Open::Table, path.len())),
+            '[' => {
+                open.push((Open::Array(0), path.len()));
+                path.push("[0]".to_owned());
+            }
+            ',' => match open.last_mut() {
+                Some((Open::Table, at)) => path.truncate(*at),
+                Some((Open::Array(i), at)) => {
+                    *i = i.saturating_add(1);
+                    path.truncate(*at);
+                    path.push(format!("[{i}]"));
+                }
+                None => {}
+            },
+            '}' | ']' => {
+                if let Some((_, at)) = open.pop() {
+                    path.truncate(at);
+                }
+            }
+            c if c.is_whitespace() => continue,
+            c => {
+                if !(c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.') {
+                    word.clear();
+                } else {
+                    word.push(c);
+                }
+                continue;
+            }
+        }
+        if c != '"' && c != '\'' {
+            word.clear();
+        }
+    }
+    matches!(open.last(), Some((Open::Table, _))).then(|| path.concat())
 }
 
 /// The path of the table that the text after `before` continues: its last
@@ -277,9 +356,27 @@ mod tests {
         let e = error(&deep);
         assert!(e.starts_with("x.toml:12:"), "{e}");
         assert!(e.contains(": object[1].csg: "), "{e}");
-        // A key inside an inline table keeps its bare name.
+        // A key inside inline tables: the path through them.
         let e = error(&format!("{CAMERA}[[light]]\nposition = {{ x = }}\n"));
         assert!(e.starts_with("x.toml:7:"), "{e}");
+        let e = error(&format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\nsphere = {{ centre = [0,0,0], radius = 1, radius = 2 }}\n"
+        ));
+        assert!(
+            e.starts_with("x.toml:9:42: object[0].sphere.radius: duplicate key"),
+            "{e}"
+        );
+        let e = error(&format!(
+            "{CAMERA}[material.m]\n[[object]]\nmaterial = \"m\"\ncsg = {{ difference = [\"a\", {{ union = [\"b\", \"c\"], union = [] }}] }}\n"
+        ));
+        assert!(
+            e.contains(": object[0].csg.difference[1].union: duplicate key"),
+            "{e}"
+        );
+        let e = error(&format!(
+            "{CAMERA}[volume.v]\nmetaballs = {{ dims = [2, 2, 2], \"min\" = [0, 0, 0], min = [1, 1, 1] }}\n"
+        ));
+        assert!(e.contains(": volume.v.metaballs.min: duplicate key"), "{e}");
         // A table defined twice: the table; a broken header: nothing.
         let e = error(&format!("{CAMERA}{OBJECT}[material.m]\n"));
         assert!(
