@@ -113,6 +113,17 @@ pub fn load_within(
 /// becomes while it is still held).
 pub const READ_BYTES: [u64; 2] = [12, 96];
 
+/// The line (from 1) of face `k` (from 0) of `text`: its `k`-th `f`
+/// statement, as the reader gives the faces in the file's order (1 when
+/// there are fewer).
+fn face_line(text: &str, k: usize) -> usize {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| l.split_whitespace().next() == Some("f"))
+        .nth(k)
+        .map_or(1, |(i, _)| i + 1)
+}
+
 fn invalid(
     file: &Arc<str>,
     line: usize,
@@ -452,6 +463,8 @@ pub fn parse_within(
         normals: Some(Vec::new()),
         triangles: Vec::new(),
     };
+    // Faces read so far, over all models: the reader keeps the file's order.
+    let mut faces_before = 0usize;
     for m in &models {
         let m = &m.mesh;
         let base = mesh.positions.len();
@@ -497,10 +510,14 @@ pub fn parse_within(
         let mut first = 0usize;
         let mut face = Vec::new();
         for k in arities {
+            // Its line, found only for a message.
+            let face_index = faces_before;
+            let at = || face_line(&text, face_index);
+            faces_before += 1;
             let idx = m.indices.get(first..first + k).unwrap_or_default();
             first += k;
             if idx.len() != k || idx.iter().any(|&i| i as usize >= count) {
-                return Err(invalid(&file, 1, 1, "face", "index out of range"));
+                return Err(invalid(&file, at(), 1, "face", "index out of range"));
             }
             let global = |i: u32| base + i as usize;
             face.clear();
@@ -515,7 +532,7 @@ pub fn parse_within(
             };
             // A face has at most MAX_FACE_VERTICES vertices (`prescan`).
             let cut = super::polygon::cut(&face, budget)
-                .map_err(|problem| invalid(&file, 1, 1, "face", problem))?;
+                .map_err(|problem| invalid(&file, at(), 1, "face", problem))?;
             mesh.triangles
                 .extend(super::polygon::triangles(&face, cut.as_deref()).map(|t| t.map(off)));
         }
@@ -570,6 +587,21 @@ mod tests {
 
     /// A mesh whose text or elements would take more than the memory
     /// limit is refused before it is read, naming the limit.
+    /// A face refused as it is cut is located at its own `f` line.
+    #[test]
+    fn a_face_beyond_the_cut_budget_is_located_at_its_line() {
+        let text = "v 0 0 0\nv 4 0 0\nv 4 3 0\nv 3 3 0\nv 3 1 0\nv 2 1 0\nv 2 3 0\nv 0 3 0\n\
+                    f 1 2 3\ng second\n# a comment\nf 1 2 3 4 5 6 7 8\n";
+        let e = parse_within("t.obj", text, u64::MAX, &mut CutBudget::with_left(63))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj:12:1: face: non-convex, and cutting it"),
+            "{e}"
+        );
+        parse_within("t.obj", text, u64::MAX, &mut CutBudget::with_left(64)).unwrap();
+    }
+
     #[test]
     fn meshes_keep_the_memory_limit() {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 3\n";

@@ -62,6 +62,12 @@ impl CutBudget {
         Self { left: Self::SCENE }
     }
 
+    /// A budget with `left` to spend (for tests of the refusal).
+    #[cfg(test)]
+    pub(crate) const fn with_left(left: u64) -> Self {
+        Self { left }
+    }
+
     /// Spends the work of cutting a non-convex polygon of `n` vertices.
     fn spend(&mut self, n: usize) -> Result<(), &'static str> {
         let n = u64::try_from(n).unwrap_or(u64::MAX);
