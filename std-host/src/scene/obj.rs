@@ -216,6 +216,22 @@ fn check_coordinates<'a>(
 /// without a location (see the module docs): every vertex and normal
 /// coordinate, the vertex count of every face and every face index.
 fn prescan(file: &Arc<str>, text: &str, max_memory: u64) -> Result<(), SceneError> {
+    // Another mesh format's text (which the OBJ reader would skip line by
+    // line, to a mesh without faces).
+    let first = text.split_whitespace().next().unwrap_or("");
+    let other = match first {
+        "ply" => Some("a PLY mesh, not OBJ: meshes are read from Wavefront OBJ files; convert it"),
+        "solid" => {
+            Some("an ASCII STL mesh, not OBJ: meshes are read from Wavefront OBJ files; convert it")
+        }
+        w if w.starts_with('{') => Some(
+            "JSON (a glTF mesh?), not OBJ: meshes are read from Wavefront OBJ files; convert it",
+        ),
+        _ => None,
+    };
+    if let Some(problem) = other {
+        return Err(invalid(file, 1, 1, "OBJ", problem));
+    }
     // Totals for positive indices (tobj resolves them once the object is
     // complete, against everything read by then; the whole file bounds
     // that), running counts for negative ones; and the faces' corners.
@@ -588,6 +604,23 @@ mod tests {
     /// A mesh whose text or elements would take more than the memory
     /// limit is refused before it is read, naming the limit.
     /// A face refused as it is cut is located at its own `f` line.
+    /// Another mesh format's text is named, not read as an OBJ without
+    /// faces.
+    #[test]
+    fn other_mesh_formats_are_named() {
+        for (text, what) in [
+            ("ply\nformat ascii 1.0\nelement vertex 3\n", "a PLY mesh"),
+            ("solid cube\n facet normal 0 0 1\n", "an ASCII STL mesh"),
+            ("{\"asset\": {\"version\": \"2.0\"}}", "JSON (a glTF mesh?)"),
+        ] {
+            let e = parse("m.obj", text).unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!("m.obj:1:1: OBJ: {what}, not OBJ")),
+                "{e}"
+            );
+        }
+    }
+
     #[test]
     fn a_face_beyond_the_cut_budget_is_located_at_its_line() {
         let text = "v 0 0 0\nv 4 0 0\nv 4 3 0\nv 3 3 0\nv 3 1 0\nv 2 1 0\nv 2 3 0\nv 0 3 0\n\
