@@ -24,8 +24,8 @@
 //! non-convex one of more than [`MAX_NONCONVEX_VERTICES`] vertices, or one
 //! that would take the scene's non-convex polygons past their
 //! [`CutBudget`]: ear clipping may take time quadratic in the vertex count
-//! (a spiral of 65,536 vertices takes seconds), so the budget bounds the
-//! time a scene file can ask for.
+//! (an outline that winds as a spiral does), so the budget bounds the time
+//! a scene file can ask for.
 //!
 //! [`Scene::polygon_triangles`]: super::Scene::polygon_triangles
 
@@ -36,9 +36,9 @@ pub const MAX_NONCONVEX_VERTICES: usize = 1 << 16;
 
 /// The ear-clipping work one scene's non-convex polygons may ask for: the
 /// squares of their vertex counts add up to at most [`CutBudget::SCENE`]
-/// (one polygon of [`MAX_NONCONVEX_VERTICES`] vertices; on this project's
-/// machines the slowest outline of that size, a spiral, is cut in about
-/// 15 s, a comb in 0.2 s). Convex polygons, whose fan is their cut, cost nothing.
+/// (one polygon of [`MAX_NONCONVEX_VERTICES`] vertices), a bound on the
+/// ear clipping's steps whatever the outlines. Convex polygons, whose fan
+/// is their cut, cost nothing.
 /// One budget covers a whole scene: an NFF file, or a TOML scene with its
 /// polygons and every OBJ mesh it loads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
