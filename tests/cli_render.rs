@@ -336,16 +336,30 @@ fn saved_raster_options_are_checked() {
         let small = ["--width", "16", "--height", "16"];
         let paper = ["--mode", "paper", "-q"];
         cli_with(&["render", r, "-o", o], &[&small[..], &paper].concat()).unwrap();
-        // Twenty-six-connected rays on a raster voxelized for them are fine.
+        // Twenty-six-connected rays on a raster voxelized for them are fine
+        // in the paper's mode; the verifying modes refuse them, before any
+        // work: they step diagonally past voxels verification would need.
         let r26 = dir.join("t26.rrt");
         let r26 = r26.to_str().unwrap();
         let twenty_six = ["--connectivity", "twenty-six", "-q"];
         voxelize(r26, &twenty_six);
         cli_with(
             &["render", r26, "-o", o],
-            &[&small[..], &twenty_six].concat(),
+            &[&small[..], &twenty_six, &paper[..]].concat(),
         )
         .unwrap();
+        for mode in ["exact", "verified"] {
+            fails_with(
+                &[&["render", r26, "-o", o, "--mode", mode][..], &twenty_six].concat(),
+                &format!(
+                    "26-connected rays step diagonally past voxels the ray passes through, so the {mode} mode's verification would miss the objects there"
+                ),
+            );
+        }
+        fails_with(
+            &["render", &tetra(), "-o", o, "--connectivity", "twenty-six"],
+            "so the exact mode's verification would miss",
+        );
     });
 }
 

@@ -153,7 +153,7 @@ fn view_args(view: Option<&View>) -> ViewArgs {
 /// size), `frame=(k, n)` renders frame `k` of the `n`-frame orbit of the
 /// view, `raster` is `--raster`, `min_weight` `--min-weight`, `mode` is
 /// `"exact"`, `"verified"` or `"paper"`, `connectivity` `"adaptive"`,
-/// `"six"` or `"twenty-six"`.
+/// `"six"` or `"twenty-six"` (with `mode="paper"` only).
 #[pyfunction]
 #[pyo3(signature = (scene = None, *, view = None, frame = None, width = None, height = None, supersample = 1, depth = 3, min_weight = rrt_host::trace::DEFAULT_MIN_WEIGHT, threads = 0, mode = "exact", connectivity = "adaptive", raster = None, float = false, alpha = false))]
 #[allow(clippy::too_many_arguments)]

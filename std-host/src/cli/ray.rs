@@ -39,7 +39,9 @@ pub struct RayArgs {
 pub enum ConnectivityArg {
     /// 6-connected: every voxel the ray passes through.
     Six,
-    /// 26-connected: one voxel per slice across the driving axis.
+    /// 26-connected: one voxel per slice across the driving axis (renders
+    /// in the paper's mode only: it steps diagonally past voxels the ray
+    /// passes through).
     TwentySix,
     /// 26-steps in empty space, 6-steps near surfaces.
     Adaptive,

@@ -116,12 +116,22 @@ pub struct RenderArgs {
 /// camera path, an unwritable output, the scene's, builder's, tracer's or
 /// encoder's error.
 pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
-    // Sizes given on the command line are checked before any work.
+    // Sizes and tracing options given on the command line are checked
+    // before any work.
     check_sizes(
         args.width.unwrap_or(1),
         args.height.unwrap_or(1),
         args.supersample,
     )?;
+    let trace_options = TraceOptions {
+        mode: args.raster.mode.into(),
+        connectivity: args.raster.connectivity.into(),
+        depth: args.depth,
+        min_weight: args.min_weight,
+        packets: args.packets,
+        ..TraceOptions::default()
+    };
+    trace_options.check()?;
     let frames = match (args.orbit, &args.path) {
         (Some(n), _) => Frames::Orbit(n),
         (None, Some(p)) => Frames::Path(crate::scene::path::load(p, &p.display().to_string())?),
@@ -189,18 +199,7 @@ pub fn run(args: &RenderArgs, out: &mut impl Write) -> Result<(), CliError> {
     let scene = match &loaded {
         Loaded::Built { scene, .. } | Loaded::Saved { scene, .. } => scene,
     };
-    let tracer = Tracer::new(
-        scene,
-        TraceOptions {
-            mode: args.raster.mode.into(),
-            connectivity: args.raster.connectivity.into(),
-            depth: args.depth,
-            min_weight: args.min_weight,
-            packets: args.packets,
-            ..TraceOptions::default()
-        },
-    )
-    .map_err(|why| match (&loaded, &args.scene) {
+    let tracer = Tracer::new(scene, trace_options).map_err(|why| match (&loaded, &args.scene) {
         // What the raster was voxelized for is the saved file's.
         (Loaded::Saved { .. }, Some(path)) => CliError::SavedTrace {
             path: path.clone(),

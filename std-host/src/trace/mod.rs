@@ -306,6 +306,23 @@ impl Default for TraceOptions {
     }
 }
 
+impl TraceOptions {
+    /// Refuses options that no raster can honour, before any raster is
+    /// made: a depth of 0, and 26-connected rays in a verifying mode.
+    ///
+    /// # Errors
+    /// [`TraceError::Depth`], [`TraceError::DiagonalSteps`].
+    pub fn check(&self) -> Result<(), TraceError> {
+        if self.depth == 0 {
+            return Err(TraceError::Depth);
+        }
+        if self.connectivity == Connectivity::TwentySix && self.mode.verifies() {
+            return Err(TraceError::DiagonalSteps(self.mode.name()));
+        }
+        Ok(())
+    }
+}
+
 /// [`TraceOptions::min_weight`]'s default: 2⁻¹⁶.
 pub const DEFAULT_MIN_WEIGHT: f64 = 1.0 / 65536.0;
 
@@ -669,6 +686,13 @@ pub enum TraceError {
         "the raster was voxelized for 6-connected or adaptive rays; 26-connected rays would pass through its surfaces (voxelize again with --connectivity twenty-six)"
     )]
     Separation,
+    /// 26-connected rays in a verifying mode: they step diagonally past
+    /// voxels the ray passes through, where verification would then miss
+    /// the objects (holes in thin and small objects).
+    #[error(
+        "26-connected rays step diagonally past voxels the ray passes through, so the {0} mode's verification would miss the objects there (holes in thin and small objects): render with --connectivity adaptive (the default: 26-steps away from surfaces, the exact image) or six, or with --mode paper"
+    )]
+    DiagonalSteps(&'static str),
     /// A depth of 0.
     #[error("depth: expected at least 1 (the eye ray), found 0")]
     Depth,
@@ -684,11 +708,10 @@ impl<'s> Tracer<'s> {
     ///
     /// # Errors
     /// [`TraceError`]: an inconsistent raster, 26-connected rays through
-    /// surfaces voxelized for 6-connected ones, depth 0.
+    /// surfaces voxelized for 6-connected ones or in a verifying mode,
+    /// depth 0.
     pub fn new(scene: &'s VoxelScene, opts: TraceOptions) -> Result<Self, TraceError> {
-        if opts.depth == 0 {
-            return Err(TraceError::Depth);
-        }
+        opts.check()?;
         if opts.mode.verifies() && !scene.exact {
             return Err(TraceError::NotExact(opts.mode.name()));
         }
