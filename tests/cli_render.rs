@@ -345,7 +345,7 @@ fn saved_raster_options_are_checked() {
         voxelize(r26, &twenty_six);
         cli_with(
             &["render", r26, "-o", o],
-            &[&small[..], &twenty_six, &paper[..]].concat(),
+            &[&small[..], &twenty_six, &["--mode", "paper"][..]].concat(),
         )
         .unwrap();
         for mode in ["exact", "verified"] {
@@ -468,7 +468,7 @@ fn a_scenes_volumes_and_vertices_keep_the_memory_limit() {
         let q = ["-o", o, "-q", "--max-memory"];
         fails_with(
             &[&["render", v][..], &q, &["1536K"]].concat(),
-            "volumes.toml:16:22: volume.v1.metaballs.dims: computed volume: sizes 64×64×64 of float take 1.0 MiB beside the scene's other volumes' 1.0 MiB, more than the memory limit of 1.5 MiB (--max-memory)",
+            "volumes.toml:16:22: volume.v1.metaballs.dims: computed volume: sizes 64×64×64 of float take 1.0 MiB beside the 1.0 MiB of the volumes and textures read before, more than the memory limit of 1.5 MiB (--max-memory)",
         );
         fails_with(
             &[&["render", v][..], &q, &["512K"]].concat(),

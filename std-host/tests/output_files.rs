@@ -179,10 +179,12 @@ enum When {
     Writing,
 }
 
-/// Starts `args` in `d`, waits until a temporary file beside `target`
-/// exists (the output has been started and the work is under way), sends
-/// `signal`, and checks that the run fails, `target` is byte for byte what
-/// it was and nothing else is left in `d`.
+/// Starts `args` in `d`, waits until the work is under way (`Working`: a
+/// while after the start, with no temporary file beside `target`, which
+/// exists only while the output is written; `Writing`: until the
+/// temporary file has bytes), sends `signal`, and checks that the run
+/// fails, `target` is byte for byte what it was and nothing else is left
+/// in `d`.
 fn interrupt(d: &Path, args: &[&str], target: &str, signal: &str) {
     interrupt_when(d, args, target, signal, When::Working);
 }
@@ -198,30 +200,33 @@ fn interrupt_when(d: &Path, args: &[&str], target: &str, signal: &str, when: Whe
         .spawn()
         .unwrap();
     let t = Instant::now();
-    let tmp = loop {
-        let tmp = names(d)
+    let temporary = || {
+        names(d)
             .into_iter()
-            .find(|n| n.starts_with(target) && n.ends_with(".tmp"));
-        let ready = tmp.as_ref().is_some_and(|tmp| match when {
-            When::Working => true,
-            When::Writing => std::fs::metadata(d.join(tmp)).is_ok_and(|m| m.len() > 0),
-        });
-        if let (true, Some(tmp)) = (ready, tmp) {
-            break tmp;
-        }
-        assert!(
-            t.elapsed() < Duration::from_secs(120),
-            "no temporary file appeared"
-        );
-        assert!(child.try_wait().unwrap().is_none(), "finished too soon");
-        std::thread::sleep(Duration::from_millis(1));
+            .find(|n| n.starts_with(target) && n.ends_with(".tmp"))
     };
-    // Into the work (voxelizing or rendering), then the signal.
-    if let When::Working = when {
-        std::thread::sleep(Duration::from_millis(300));
+    match when {
+        When::Working => {
+            // Into the work (voxelizing or rendering): nothing beside the
+            // target yet.
+            std::thread::sleep(Duration::from_millis(500));
+            assert!(child.try_wait().unwrap().is_none(), "finished too soon");
+            assert_eq!(temporary(), None, "a temporary file before the output");
+        }
+        When::Writing => loop {
+            let tmp = temporary();
+            if tmp.is_some_and(|tmp| std::fs::metadata(d.join(tmp)).is_ok_and(|m| m.len() > 0)) {
+                break;
+            }
+            assert!(
+                t.elapsed() < Duration::from_secs(120),
+                "no temporary file appeared"
+            );
+            assert!(child.try_wait().unwrap().is_none(), "finished too soon");
+            std::thread::sleep(Duration::from_millis(1));
+        },
     }
     assert!(child.try_wait().unwrap().is_none(), "finished too soon");
-    assert!(d.join(&tmp).exists());
     let kill = Command::new("kill")
         .args([signal, &child.id().to_string()])
         .status()

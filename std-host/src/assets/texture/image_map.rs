@@ -259,7 +259,7 @@ impl ImageTexture {
         if size > max_memory {
             return Err(TextureError::TooMuchMemory {
                 path: path.to_path_buf(),
-                what: format!("its {size} bytes"),
+                what: format!("the file of {size} bytes"),
                 bytes: size,
                 limit: max_memory,
             });
